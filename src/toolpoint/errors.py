@@ -1,0 +1,32 @@
+"""Errors raised for bad user input.
+
+The CLI turns an :class:`InputError` into one line on stderr and exit code 2;
+the Python API lets it propagate (it is a ``ValueError``).
+"""
+
+from __future__ import annotations
+
+from os import PathLike
+
+
+class InputError(ValueError):
+    """Bad input, located by file and field.
+
+    ``str(err)`` is a single line: ``"<file>: <field>: <message>"`` (parts that
+    are unknown are left out).
+    """
+
+    def __init__(self, message: str, *, file: str | PathLike | None = None, field: str | None = None):
+        self.message = " ".join(str(message).split())  # keep it to one line
+        self.file = None if file is None else str(file)
+        self.field = field
+        parts = [p for p in (self.file, self.field) if p]
+        super().__init__(": ".join(parts + [self.message]))
+
+
+class ExtrapolationWarning(UserWarning):
+    """A prediction outside the range a model was trained on."""
+
+
+class IdentifiabilityWarning(UserWarning):
+    """A parameter that the data cannot pin down (wide confidence interval or at a bound)."""
