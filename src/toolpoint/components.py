@@ -1,0 +1,235 @@
+"""Beam components → end-point receptances.
+
+Two exact routes to the same receptances, chosen per frequency for round-off:
+
+* **transfer chain** — T = Pₙ Tₙ ⋯ P₁ T₁ P₀ (pieces T, spring point matrices
+  P = [[I, 0], [G, I]]); with end loads (F, M) at both ends the end receptance is
+  R = [[T21⁻¹T22, T21⁻¹], [T11T21⁻¹T22 − T12, T11T21⁻¹]]. Every entry keeps its
+  relative precision at low frequency, where a free–free stiffness matrix is
+  nearly singular (its inverse loses (ω₁/ω)⁴·ε in the elastic part), but the
+  product grows like exp(Σ βL), so it is used only while Σ|β|L ≤ ``CHAIN_LIMIT``,
+  and only for free–free components (holder, tool, a suspended spindle);
+* **stiffness sweep** — condensation of the chain's dynamic stiffness onto
+  its end nodes, well conditioned at high frequency.
+
+A component (multi-segment beam, optional bearings to ground) is cut into
+pieces at segment ends and bearing positions, and each piece into equal
+sub-pieces so that its bending wavenumber times length stays ≤ ``max_beta_l``
+at the top frequency (the exact segment stiffness is then far from its own
+clamped–clamped poles, and well conditioned). The piece matrices are exact
+(:mod:`toolpoint.beam`), so no mesh convergence is involved: refining only
+re-expresses the same solution.
+
+Global dynamic stiffness D(ω) (2 DOF per node: w, ψ) is assembled for all
+frequencies at once and solved in one batched LAPACK call for the columns of
+the requested end nodes: R = (D⁻¹)[ends, ends] is the receptance matrix,
+[[h, l], [n, p]] per node pair (h = w/F, l = w/M, n = ψ/F, p = ψ/M).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .assembly import Component
+from .beam import inv2, mul2, stiffness_from_transfer, transfer_matrix
+
+MAX_BETA_L = 2.0
+# Above Σ βL ≈ 6 (past the first free–free mode, βL = 4.73) the stiffness
+# sweep is well conditioned while the chain starts to lose digits (e^6 ≈ 400).
+CHAIN_LIMIT = 6.0
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """Nodes (x in m) and exact pieces of one component."""
+
+    x: np.ndarray  # node positions, m
+    pieces: tuple  # (Section, length m, left node index)
+    ground: tuple  # (node, k, c, kr, cr) springs to ground
+
+    @property
+    def n_nodes(self) -> int:
+        return self.x.size
+
+
+def interior_cuts(x0: float, x1: float, points, tol: float = 1e-9) -> list[float]:
+    """[x0, points strictly inside (x0, x1), x1]; a point within ``tol`` m of an end is that end."""
+    inside = sorted(p for p in points if x0 + tol < p < x1 - tol)
+    return [x0] + [p for i, p in enumerate(inside) if i == 0 or p - inside[i - 1] > tol] + [x1]
+
+
+def mesh(component: Component, fmax_hz: float, max_beta_l: float = MAX_BETA_L) -> Mesh:
+    """Cut ``component`` at segment ends and bearings; sub-divide for conditioning at fmax_hz."""
+    wmax = 2 * np.pi * max(float(fmax_hz), 1.0)
+    edges = np.cumsum([0.0] + [s.length for s in component.segments])
+    xs = [0.0]
+    pieces = []
+    for seg, x0, x1 in zip(component.segments, edges[:-1], edges[1:]):
+        sec = seg.section()
+        cuts = interior_cuts(x0, x1, [b.x for b in component.bearings])
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            n = max(1, int(np.ceil(float(sec.wavenumber(wmax)) * (b - a) / max_beta_l)))
+            for k in range(n):
+                pieces.append((sec, (b - a) / n, len(xs) - 1))
+                xs.append(a + (b - a) * (k + 1) / n)
+    x = np.array(xs)
+    x[-1] = edges[-1]
+    ground = []
+    for b in component.bearings:
+        node = int(np.argmin(abs(x - b.x)))
+        ground.append((node, b.k, b.c, b.kr, b.cr))
+    return Mesh(x, tuple(pieces), tuple(ground))
+
+
+def _piece_transfers(m: Mesh, omega: np.ndarray) -> list[np.ndarray]:
+    """Transfer matrix of every piece; equal pieces share one evaluation."""
+    cache: dict[tuple[int, float], np.ndarray] = {}
+    out = []
+    for sec, length, _ in m.pieces:
+        key = (id(sec), round(length, 15))
+        if key not in cache:
+            cache[key] = transfer_matrix(sec, length, omega)
+        out.append(cache[key])
+    return out
+
+
+def _piece_matrices(m: Mesh, omega: np.ndarray) -> list[np.ndarray]:
+    """Dynamic stiffness of every piece (shared like the transfer matrices)."""
+    done: dict[int, np.ndarray] = {}
+    return [done.setdefault(id(T), stiffness_from_transfer(T)) for T in _piece_transfers(m, omega)]
+
+
+def _ground(m: Mesh, omega: np.ndarray) -> np.ndarray:
+    """Spring-to-ground 2×2 matrices G (n_nodes, F, 2, 2), diag(k + iωc, kr + iωcr)."""
+    G = np.zeros((m.n_nodes, omega.size, 2, 2), complex)
+    for node, k, c, kr, cr in m.ground:
+        G[node, :, 0, 0] += k + 1j * omega * c
+        G[node, :, 1, 1] += kr + 1j * omega * cr
+    return G
+
+
+def chain_growth(m: Mesh, omega: np.ndarray) -> np.ndarray:
+    """Σ βL over the pieces (F,): the transfer chain's growth exponent."""
+    return sum(sec.wavenumber(omega) * length for sec, length, _ in m.pieces)
+
+
+def assemble(meshes: list[Mesh], links: list[tuple], omega) -> tuple[np.ndarray, list[int]]:
+    """Global dynamic stiffness (F, N, N) of several meshes joined by springs.
+
+    ``links`` holds (mesh_a, node_a, mesh_b, node_b, kt, ct, kr, cr): a zero-length
+    joint K = diag(kt + iωct, kr + iωcr) between two nodes. Returns D and the
+    first DOF index of each mesh.
+    """
+    w = np.asarray(omega, float).reshape(-1)
+    offsets = np.cumsum([0] + [2 * m.n_nodes for m in meshes])
+    D = np.zeros((w.size, offsets[-1], offsets[-1]), complex)
+    for m, off in zip(meshes, offsets[:-1]):
+        for (sec, length, node), Dp in zip(m.pieces, _piece_matrices(m, w)):
+            i = off + 2 * node
+            D[:, i : i + 4, i : i + 4] += Dp
+        for node, k, c, kr, cr in m.ground:
+            i = off + 2 * node
+            D[:, i, i] += k + 1j * w * c
+            D[:, i + 1, i + 1] += kr + 1j * w * cr
+    for ma, na, mb, nb, kt, ct, kr, cr in links:
+        for d, kk in ((0, kt + 1j * w * ct), (1, kr + 1j * w * cr)):
+            i, j = offsets[ma] + 2 * na + d, offsets[mb] + 2 * nb + d
+            D[:, i, i] += kk
+            D[:, j, j] += kk
+            D[:, i, j] -= kk
+            D[:, j, i] -= kk
+    return D, list(offsets[:-1])
+
+
+def receptance(D: np.ndarray, dofs: list[int]) -> np.ndarray:
+    """(D⁻¹)[dofs, dofs] for every frequency: (F, k, k)."""
+    E = np.zeros((D.shape[1], len(dofs)))
+    E[dofs, np.arange(len(dofs))] = 1.0
+    X = np.linalg.solve(D, np.broadcast_to(E, (D.shape[0],) + E.shape))
+    return X[:, dofs, :]
+
+
+def _chain_receptance(m: Mesh, omega: np.ndarray) -> np.ndarray:
+    """End receptance (F, 4, 4) by the transfer chain (see module docstring)."""
+    G = _ground(m, omega)
+    grounded = {g[0] for g in m.ground}
+    T = np.broadcast_to(np.eye(4, dtype=complex), (omega.size, 4, 4)).copy()
+    for (_, _, node), Tp in zip(m.pieces, _piece_transfers(m, omega)):
+        if node in grounded:  # point matrix [[I, 0], [G, I]] at the piece's left node
+            T[:, 2:, :] += G[node] @ T[:, :2, :]
+        T = Tp @ T
+    if m.n_nodes - 1 in grounded:
+        T[:, 2:, :] += G[-1] @ T[:, :2, :]
+    T11, T12, T21, T22 = T[:, :2, :2], T[:, :2, 2:], T[:, 2:, :2], T[:, 2:, 2:]
+    T21i = inv2(T21)
+    R = np.empty_like(T)
+    R[:, :2, :2] = mul2(T21i, T22)
+    R[:, :2, 2:] = T21i
+    R[:, 2:, :2] = mul2(T11, R[:, :2, :2]) - T12
+    R[:, 2:, 2:] = mul2(T11, T21i)
+    return R
+
+
+def _chain_end_stiffness(m: Mesh, omega: np.ndarray) -> np.ndarray:
+    """Dynamic stiffness (F, 4, 4) condensed onto the first and last node of a chain.
+
+    Interior nodes are condensed one at a time (block Gaussian elimination along
+    the chain, ``Z ← Z − Z_·k Π⁻¹ Z_k·`` with the 2×2 pivot Π at node k), which
+    costs a few 2×2 operations per node instead of a dense solve. A pivot is
+    singular only at a natural frequency of the part of the chain between the
+    first node and node k + 1 with both clamped; springs and damping keep it
+    regular in practice, and the tests compare with the dense LAPACK solve.
+    """
+    G = _ground(m, omega)
+    P = _piece_matrices(m, omega)
+    Z = P[0].copy()
+    Z[:, :2, :2] += G[0]
+    Z[:, 2:, 2:] += G[1]
+    for k, Pk in enumerate(P[1:], start=1):
+        Pi = inv2(Z[:, 2:, 2:] + Pk[:, :2, :2])
+        A = mul2(Z[:, :2, 2:], Pi)  # Z_0k Π⁻¹
+        B = mul2(Pk[:, 2:, :2], Pi)  # P_ba Π⁻¹
+        Zn = np.empty_like(Z)
+        Zn[:, :2, :2] = Z[:, :2, :2] - mul2(A, Z[:, 2:, :2])
+        Zn[:, :2, 2:] = -mul2(A, Pk[:, :2, 2:])
+        Zn[:, 2:, :2] = -mul2(B, Z[:, 2:, :2])
+        Zn[:, 2:, 2:] = Pk[:, 2:, 2:] - mul2(B, Pk[:, :2, 2:]) + G[k + 1]
+        Z = Zn
+    return Z
+
+
+def end_receptances(component: Component, freq_hz, ends: str = "both") -> np.ndarray:
+    """Receptance matrix at the component's ends, one global x axis.
+
+    ``ends="both"`` → (F, 4, 4) on [w_start, ψ_start, w_end, ψ_end];
+    ``ends="end"`` → (F, 2, 2) at the end (x = L) only; ``"start"`` likewise.
+    Units: m/N, m/(N m) = 1/N, rad/N, rad/(N m).
+    A free–free component is singular at 0 Hz: ask for ω > 0 only.
+    """
+    f = np.asarray(freq_hz, float).reshape(-1)
+    if not component.bearings and np.any(f == 0):
+        raise ValueError(f"{component.name}: free–free receptance is singular at 0 Hz")
+    m = mesh(component, f.max() if f.size else 1.0)
+    w = 2 * np.pi * f
+    R = np.empty((f.size, 4, 4), complex)
+    # The chain is for free–free parts only: stiff springs in a chain mix scales
+    # and cost digits, while a grounded stiffness matrix is regular at low ω.
+    low = chain_growth(m, w) <= CHAIN_LIMIT if not component.bearings else np.zeros(f.size, bool)
+    if np.any(low):
+        R[low] = _chain_receptance(m, w[low])
+    if not np.all(low):
+        R[~low] = np.linalg.inv(_chain_end_stiffness(m, w[~low]))
+    sel = {"both": slice(0, 4), "end": slice(2, 4), "start": slice(0, 2)}[ends]
+    return R[:, sel, sel]
+
+
+def end_receptances_dense(component: Component, freq_hz, ends: str = "both") -> np.ndarray:
+    """Same as :func:`end_receptances` by a dense LAPACK solve of the whole chain (a check)."""
+    f = np.asarray(freq_hz, float).reshape(-1)
+    m = mesh(component, f.max() if f.size else 1.0)
+    D, _ = assemble([m], [], 2 * np.pi * f)
+    last = 2 * (m.n_nodes - 1)
+    dofs = {"both": [0, 1, last, last + 1], "end": [last, last + 1], "start": [0, 1]}[ends]
+    return receptance(D, dofs)
