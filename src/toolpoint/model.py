@@ -22,9 +22,38 @@ import numpy as np
 
 from .assembly import Assembly, Joint, load_assembly
 from .components import assemble, end_receptances, mesh, receptance
-from .coupling import ToolPointCoupler, couple
+from .coupling import ToolPointCoupler
+from .subassembly import Subassembly
 from .errors import InputError
 from .frf import FRF
+
+
+class ToolPointModel:
+    """A tool on a given spindle–holder subassembly: tool-point receptance for many joints.
+
+    Parameters
+    ----------
+    tool : Component — the overhang, holder tip → tool tip.
+    subassembly : Subassembly — holder-tip receptances (model or measured);
+        interpolated onto ``freq_hz`` inside its band only.
+    freq_hz : (F,) frequencies > 0, Hz.
+    """
+
+    def __init__(self, tool, subassembly: Subassembly, freq_hz):
+        f = np.asarray(freq_hz, float).reshape(-1)
+        if f.size == 0 or np.any(~np.isfinite(f)) or np.any(f <= 0) or np.any(np.diff(f) <= 0):
+            raise ValueError("frequencies must be finite, > 0 and strictly increasing")
+        self.tool = tool
+        self.freq_hz = f
+        self.omega = 2 * np.pi * f
+        self.SH = subassembly.at(f).R
+        self.T = end_receptances(tool, f)
+        self.coupler = ToolPointCoupler(self.T, self.SH, self.omega)
+
+    def tool_point(self, params) -> np.ndarray:
+        """Tool-point receptance h (N, F) or (F,), m/N, for params (N, 4) or (4,) =
+        [kt N/m, ct N s/m, kr N m/rad, cr N m s/rad]."""
+        return self.coupler(params)
 
 
 class AssemblyModel:
@@ -46,10 +75,9 @@ class AssemblyModel:
         fz = f[1:] if self.has_zero else f
         self.freq_nonzero_hz = fz
         self.omega = 2 * np.pi * fz
-        self.S = end_receptances(assembly.spindle, fz, "end")
-        self.H = end_receptances(assembly.holder, fz)
+        self.subassembly = Subassembly.from_assembly(assembly, fz)
+        self.SH = self.subassembly.R
         self.T = end_receptances(assembly.tool, fz)
-        self.SH = couple(self.H, self.S, assembly.spindle_holder.as_array(), self.omega)
         self.coupler = ToolPointCoupler(self.T, self.SH, self.omega)
 
     # ----------------------------------------------------------------- batched
