@@ -1,0 +1,100 @@
+"""`toolpoint identify` and `toolpoint reproduce` end to end, and their bad input."""
+
+import json
+
+import numpy as np
+import pytest
+
+from toolpoint.cli.main import main
+from toolpoint.frf import FRF
+from toolpoint.frfio import write_csv_frf
+from toolpoint.identify import model_for
+
+
+@pytest.fixture(scope="module")
+def measured_csv(tmp_path_factory, example):
+    f = np.arange(1.0, 3001.0)
+    h = model_for(example, f).tool_point(example.holder_tool.as_array())
+    p = tmp_path_factory.mktemp("meas") / "measured.csv"
+    write_csv_frf(p, FRF(f, h))
+    return p
+
+
+def test_identify_writes_result_and_plot(tmp_path, example_path, measured_csv, capsys):
+    out, png = tmp_path / "r.json", tmp_path / "fit.png"
+    assert main(["identify", str(example_path), str(measured_csv), "--seed", "3", "--out", str(out),
+                 "--plot", str(png)]) == 0
+    doc = json.loads(out.read_text())
+    for key in ("kt", "ct", "kr", "cr", "ci95", "method", "seed", "evaluations", "seconds", "objective", "warnings"):
+        assert key in doc
+    assert doc["kt"] == pytest.approx(2.1e7, rel=1e-6) and doc["cr"] == pytest.approx(3.0, rel=1e-4)
+    assert doc["method"] == "hybrid" and doc["seed"] == 3 and doc["evaluations"] > 0
+    assert set(doc["ci95"]) == {"kt", "ct", "kr", "cr"}
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    assert "ignored" in capsys.readouterr().err  # the file's holder_tool joint is not used
+
+
+def test_bounds_from_the_command_line_are_used(tmp_path, example_path, measured_csv):
+    out = tmp_path / "r.json"
+    assert main(["identify", str(example_path), str(measured_csv), "--bounds", "kt=1e6:1e7", "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["bounds"]["kt"] == [1e6, 1e7]
+    assert doc["kt"] <= 1e7 * (1 + 1e-12)
+    assert any("upper search bound" in w for w in doc["warnings"])
+
+
+def _bad(tmp_path, name, text):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+@pytest.mark.parametrize(
+    "content, field",
+    [
+        ("f,re,im\n1,1e-7,0\n", "header"),
+        ("freq_hz,real,imag\n" + "".join(f"{i},1e-7,nan\n" for i in range(1, 20)), "imag"),
+        ("freq_hz,real,imag\n" + "".join(f"{i},1e-7,0\n" for i in (1, 2, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11)), "freq"),
+        ("freq_hz,real,imag\n" + "".join(f"{i},1e-7,0\n" for i in (1, 3, 2, 4, 5, 6, 7, 8, 9, 10, 11, 12)), "freq"),
+        ("freq_hz,real,imag\n" + "".join(f"{i},1e-7,0\n" for i in range(1, 6)), "points"),
+    ],
+    ids=["header", "nan", "duplicate", "non-increasing", "too-few"],
+)
+def test_bad_measured_file(tmp_path, example_path, content, field, capsys):
+    meas = _bad(tmp_path, "m.csv", content)
+    out = tmp_path / "r.json"
+    assert main(["identify", str(example_path), str(meas), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "m.csv" in err[0] and field in err[0], err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "extra, field",
+    [(["--method", "magic"], "--method"), (["--bounds", "kt=1e9:1e6"], "--bounds.kt"),
+     (["--bounds", "ct=0:10"], "--bounds.ct"), (["--bounds", "kt=abc"], "--bounds")],
+)
+def test_bad_options(tmp_path, example_path, measured_csv, extra, field, capsys):
+    out = tmp_path / "r.json"
+    assert main(["identify", str(example_path), str(measured_csv), "--out", str(out), *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and field in err[0], err
+    assert not out.exists()
+
+
+def test_bounds_in_the_assembly_file(tmp_path, example_path, measured_csv, capsys):
+    text = example_path.read_text() + "\n[identify.bounds]\ncr = [300, 1]\n"
+    a = _bad(tmp_path, "a.toml", text)
+    assert main(["identify", str(a), str(measured_csv)]) == 2
+    err = capsys.readouterr().err
+    assert "a.toml" in err and "identify.bounds.cr" in err
+
+
+def test_reproduce_quick(tmp_path):
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "numerical_case.toml"
+    assert main(["reproduce", str(example), "--out", str(tmp_path), "--methods", "hybrid,pso"]) == 0
+    assert (tmp_path / "fig4.png").exists() and (tmp_path / "table1.csv").exists()
+    doc = json.loads((tmp_path / "result_hybrid.json").read_text())
+    assert max(doc["relative_error"].values()) < 1e-4
