@@ -1,0 +1,237 @@
+"""Zero-order approximation (Altintas & Budak 1995) of milling stability."""
+
+import numpy as np
+import pytest
+
+from toolpoint.errors import InputError
+from toolpoint.frf import FRF
+from toolpoint.stability import (
+    LobeResult,
+    ModalModel,
+    average_directional_matrix,
+    directional_coefficients,
+    immersion_angles,
+    zoa_lobes,
+)
+from toolpoint.stability.milling import interval_directional_matrix
+
+# Benchmark of Insperger & Stépán (2004) / Bayly et al.: one mode in x.
+FN, ZETA, MASS = 922.0, 0.011, 0.03993
+KT, KN = 6e8, 2e8
+KR = KN / KT
+CUT = dict(teeth=2, kt=KT, kr=KR)
+
+
+def single_mode(freq_hz, fn=FN, zeta=ZETA, mass=MASS):
+    return ModalModel([fn], [zeta], [mass]).frf(freq_hz)
+
+
+def closed_form_min(h0, fn=FN, zeta=ZETA, mass=MASS):
+    """a_lim,min = 2kζ(1+ζ)/h0 for one mode (k = m ω_n²) and its directional factor h0 > 0.
+
+    a_lim = −1/(2 h0 Re Φ): with h0 > 0 it needs Re Φ < 0, lowest −1/(4kζ(1+ζ));
+    with h0 < 0 (e.g. half-immersion down-milling) Re Φ > 0, highest 1/(4kζ(1−ζ)).
+    """
+    k = mass * (2 * np.pi * fn) ** 2
+    return 2 * k * zeta * (1 + np.sign(h0) * zeta) / abs(h0)
+
+
+# ---------------------------------------------------------------- geometry
+def test_immersion_angles():
+    assert immersion_angles(1.0, "down") == pytest.approx((0.0, np.pi))
+    assert immersion_angles(1.0, "up") == pytest.approx((0.0, np.pi))
+    assert immersion_angles(0.5, "down") == pytest.approx((np.pi / 2, np.pi))
+    assert immersion_angles(0.5, "up") == pytest.approx((0.0, np.pi / 2))
+
+
+def test_directional_coefficients_slotting():
+    a = directional_coefficients(0.0, np.pi, KR)
+    assert a == pytest.approx(np.array([[-np.pi * KR, -np.pi], [np.pi, -np.pi * KR]]))
+    h0 = average_directional_matrix(2, KT, KR, 0.0, np.pi)
+    assert h0[0, 0] == pytest.approx(2 * KN / 4)  # N·Kn/4
+
+
+@pytest.mark.parametrize("teeth,ri,milling", [(2, 1.0, "down"), (3, 0.5, "up"), (4, 0.7, "down"), (2, 0.05, "down")])
+def test_interval_average_matches_tooth_pass_average(teeth, ri, milling):
+    """Averaging H over a whole tooth period in pieces gives H₀ = −N K_t [α]/(4π)."""
+    st, ex = immersion_angles(ri, milling)
+    edges = st + np.linspace(0, 2 * np.pi / teeth, 37)
+    H = interval_directional_matrix(edges, teeth, KT, KR, st, ex)
+    assert H.mean(axis=0) == pytest.approx(average_directional_matrix(teeth, KT, KR, st, ex), rel=1e-12, abs=1e-3)
+
+
+# ---------------------------------------------------------------- closed form
+@pytest.mark.parametrize("df", [1.0, 0.1])
+def test_single_mode_slotting_minimum_closed_form(df):
+    """0.298 mm for the benchmark; to 1e-3 even on a 1 Hz grid (parabolic refinement)."""
+    f = np.arange(0.0, 3000.0 + df / 2, df)
+    res = zoa_lobes(single_mode(f), "rigid", **CUT, radial_immersion=1.0, rpm=np.linspace(5000, 25000, 1000))
+    ref = closed_form_min(2 * KN / 4)
+    assert ref == pytest.approx(0.298e-3, abs=0.0005e-3)
+    assert res.min_depth_m == pytest.approx(ref, rel=1e-3)
+    # The chatter frequency at the minimum is where Re Φ is lowest: f_n √(1 + 2ζ).
+    assert res.min_chatter_hz == pytest.approx(FN * np.sqrt(1 + 2 * ZETA), rel=2e-4)
+    assert np.min(res.depth_m) >= res.min_depth_m * (1 - 1e-9)
+
+
+@pytest.mark.parametrize("ri,milling,sign", [(0.5, "down", -1), (0.3, "up", 1), (0.8, "down", 1)])
+def test_single_mode_minimum_closed_form_partial_immersion(ri, milling, sign):
+    st, ex = immersion_angles(ri, milling)
+    h0 = average_directional_matrix(2, KT, KR, st, ex)[0, 0]
+    assert np.sign(h0) == sign  # both signs of the x directional factor are covered
+    f = np.linspace(0.0, 3000.0, 3001)
+    res = zoa_lobes(single_mode(f), "rigid", **CUT, radial_immersion=ri, milling=milling,
+                    rpm=np.linspace(5000, 25000, 500))
+    assert res.min_depth_m == pytest.approx(closed_form_min(h0), rel=1e-3)
+
+
+# ---------------------------------------------------------------- the eigenvalue solution itself
+def _char_det(res, h0, phi_xx, phi_yy, teeth):
+    """|det[I + a(1 − e^{−iωT}) H₀ Φ(iω)]| on every lobe point — eq. (2) must vanish there."""
+    out = []
+    for lobe in res.lobes:
+        w = 2 * np.pi * lobe.chatter_hz
+        T = 60.0 / (teeth * lobe.rpm)
+        c = lobe.depth_m * (1 - np.exp(-1j * w * T))
+        pxx, pyy = phi_xx(lobe.chatter_hz), phi_yy(lobe.chatter_hz)
+        det = (1 + c * h0[0, 0] * pxx) * (1 + c * h0[1, 1] * pyy) - c**2 * h0[0, 1] * h0[1, 0] * pxx * pyy
+        out.append(np.abs(det))
+    return np.concatenate(out)
+
+
+@pytest.mark.parametrize("ri,milling", [(1.0, "down"), (0.5, "up"), (0.25, "down")])
+def test_lobe_points_solve_characteristic_equation(ri, milling):
+    """Both directions flexible (different modes): each lobe point is a root of eq. (2),
+    which checks the eigenvalues, the ε branch and the lobe-number-to-speed map."""
+    f = np.linspace(1.0, 3000.0, 3000)
+    mx, my = ModalModel([922.0, 1800.0], [0.011, 0.02], [0.04, 0.1]), ModalModel([1000.0], [0.015], [0.05])
+    res = zoa_lobes(mx.frf(f), my.frf(f), teeth=3, kt=KT, kr=0.3, radial_immersion=ri, milling=milling,
+                    rpm=np.linspace(3000, 30000, 400))
+    st, ex = immersion_angles(ri, milling)
+    h0 = average_directional_matrix(3, KT, 0.3, st, ex)
+    det = _char_det(res, h0, lambda q: mx.frf(q).values, lambda q: my.frf(q).values, 3)
+    assert det.size > 1000
+    assert det.max() < 1e-8
+    assert {lobe.branch for lobe in res.lobes} == {0, 1}  # both eigenvalue branches give lobes
+    assert {lobe.k for lobe in res.lobes} >= {0, 1, 2, 3}
+
+
+def test_limit_is_minimum_over_lobes():
+    """The vectorised envelope equals a per-lobe interpolation done the slow way:
+    between neighbouring lobe points f, ε and a_lim vary linearly, so
+    n(t) = 60 f(t) / (N w(t)) with w = k + ε/2π = 60 f/(N n) linear too."""
+    teeth = CUT["teeth"]
+    f = np.linspace(1.0, 3000.0, 3000)
+    rpm = np.linspace(4000, 26000, 700)
+    res = zoa_lobes(single_mode(f), None, **CUT, radial_immersion=0.5, rpm=rpm)
+    ref = np.full(rpm.size, np.inf)
+    for lobe in res.lobes:
+        r, d, fc = lobe.rpm, lobe.depth_m, lobe.chatter_hz
+        assert np.all(np.diff(r) > 0)  # single-mode lobes do not fold back in speed
+        c = 60.0 * fc / teeth
+        w = c / r
+        j = np.searchsorted(r, rpm, side="right") - 1
+        inside = (j >= 0) & (j < r.size - 1)
+        j, n = j[inside], rpm[inside]
+        t = (c[j] - n * w[j]) / (n * (w[j + 1] - w[j]) - (c[j + 1] - c[j]))
+        ref[inside] = np.minimum(ref[inside], d[j] + t * (d[j + 1] - d[j]))
+    # Interior points agree exactly; at each lobe's ends the grid limit also
+    # uses the segment crossing the range end (not in the lobe's own points).
+    inner = (rpm > rpm[2]) & (rpm < rpm[-3])
+    ok = np.isclose(res.depth_m, ref, rtol=1e-9) | (res.depth_m < ref)
+    assert ok[inner].all()
+    assert np.isclose(res.depth_m, ref, rtol=1e-9)[inner].mean() > 0.97
+    assert np.all(res.depth_m > 0)
+    assert np.all(np.isfinite(res.chatter_hz[np.isfinite(res.depth_m)]))
+
+
+# ---------------------------------------------------------------- physics trends
+def test_lobes_move_right_when_frequency_rises():
+    """With the stiffness fixed, f_n → s·f_n maps the chart exactly onto speeds × s."""
+    s = 1.1
+    k = MASS * (2 * np.pi * FN) ** 2
+    f = np.linspace(0.0, 3000.0, 3001)
+    rpm = np.linspace(5000, 25000, 800)
+    base = zoa_lobes(single_mode(f), "rigid", **CUT, radial_immersion=0.5, rpm=rpm)
+    mass_s = k / (2 * np.pi * FN * s) ** 2
+    moved = zoa_lobes(single_mode(f * s, fn=FN * s, mass=mass_s), "rigid", **CUT, radial_immersion=0.5, rpm=rpm * s)
+    assert moved.depth_m == pytest.approx(base.depth_m, rel=1e-9)
+    assert moved.min_rpm == pytest.approx(s * base.min_rpm, rel=1e-9)
+    assert moved.pocket()[0] == pytest.approx(s * base.pocket()[0], rel=1e-9)
+    # Same grid: the chatter frequencies follow the mode up.
+    up = zoa_lobes(single_mode(f, fn=FN * s, mass=mass_s), "rigid", **CUT, radial_immersion=0.5, rpm=rpm)
+    assert up.min_chatter_hz == pytest.approx(s * base.min_chatter_hz, rel=1e-3)
+
+
+def test_lobes_move_down_when_damping_drops():
+    f = np.linspace(0.0, 3000.0, 30001)
+    rpm = np.linspace(5000, 25000, 800)
+    base = zoa_lobes(single_mode(f), "rigid", **CUT, radial_immersion=1.0, rpm=rpm)
+    low = zoa_lobes(single_mode(f, zeta=ZETA / 2), "rigid", **CUT, radial_immersion=1.0, rpm=rpm)
+    assert low.min_depth_m / base.min_depth_m == pytest.approx((ZETA / 2) * (1 + ZETA / 2) / (ZETA * (1 + ZETA)), rel=1e-3)
+    assert np.all(low.depth_m <= base.depth_m * (1 + 1e-12))
+
+
+# ---------------------------------------------------------------- API details
+def test_symmetric_default_and_regridded_y():
+    f = np.linspace(0.0, 3000.0, 3001)
+    x = single_mode(f)
+    rpm = np.linspace(5000, 25000, 300)
+    a = zoa_lobes(x, None, **CUT, radial_immersion=0.5, rpm=rpm)
+    b = zoa_lobes(x, x, **CUT, radial_immersion=0.5, rpm=rpm)
+    assert a.depth_m == pytest.approx(b.depth_m, rel=1e-12)
+    # y on a finer, narrower grid: x is cut to the common band, y interpolated onto it.
+    fy = np.linspace(200.0, 2500.0, 9201)
+    c = zoa_lobes(x, single_mode(fy), **CUT, radial_immersion=0.5, rpm=rpm)
+    assert c.params["freq_band_hz"] == (200.0, 2500.0)
+    assert c.min_depth_m == pytest.approx(a.min_depth_m, rel=2e-3)
+
+
+def test_result_is_si_and_plots(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    f = np.linspace(0.0, 3000.0, 3001)
+    res = zoa_lobes(single_mode(f), "rigid", **CUT, radial_immersion=1.0, rpm=np.linspace(5000, 25000, 200))
+    assert isinstance(res, LobeResult) and res.method == "zoa"
+    assert res.depth_mm == pytest.approx(1e3 * res.depth_m)
+    assert 1e-4 < res.min_depth_m < 1e-3  # metres
+    ax = res.plot()
+    assert ax.get_xlabel() == "spindle speed [rpm]"
+    assert ax.get_ylabel() == "axial depth of cut [mm]"
+    plt.close("all")
+
+
+def test_mobility_input_is_converted():
+    f = np.linspace(1.0, 3000.0, 3000)
+    rec = single_mode(f)
+    mob = FRF(f, 1j * rec.omega * rec.values, "mobility")
+    rpm = np.linspace(5000, 25000, 200)
+    a = zoa_lobes(rec, "rigid", **CUT, radial_immersion=1.0, rpm=rpm)
+    b = zoa_lobes(mob, "rigid", **CUT, radial_immersion=1.0, rpm=rpm)
+    assert b.depth_m == pytest.approx(a.depth_m, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "kw,field",
+    [
+        (dict(teeth=0), "teeth"),
+        (dict(teeth=2.5), "teeth"),
+        (dict(kt=0.0), "kt"),
+        (dict(kt=-1e8), "kt"),
+        (dict(kr=-0.1), "kr"),
+        (dict(radial_immersion=0.0), "radial_immersion"),
+        (dict(radial_immersion=1.2), "radial_immersion"),
+        (dict(milling="climb"), "milling"),
+        (dict(rpm=np.linspace(20000, 2000, 10)), "rpm"),
+        (dict(rpm=[0.0, 100.0]), "rpm"),
+    ],
+)
+def test_bad_input(kw, field):
+    f = np.linspace(0.0, 3000.0, 301)
+    args = dict(teeth=2, kt=KT, kr=KR, radial_immersion=0.5, rpm=np.linspace(2000, 20000, 10)) | kw
+    with pytest.raises(InputError) as err:
+        zoa_lobes(single_mode(f), **args)
+    assert err.value.field == field
