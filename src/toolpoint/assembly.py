@@ -116,7 +116,7 @@ class FrequencyGrid:
 class Assembly:
     spindle: Component
     holder: Component
-    tool: Component
+    tool: Component | None
     spindle_holder: Joint
     holder_tool: Joint | None = None
     frequency: FrequencyGrid = FrequencyGrid()
@@ -275,14 +275,19 @@ def _frequency(r: _Reader, doc: dict) -> FrequencyGrid:
     return FrequencyGrid(start, stop, step)
 
 
-def parse_assembly(doc: dict, source: str = "<memory>", *, require_holder_tool: bool = False) -> Assembly:
-    """Build an :class:`Assembly` from a parsed TOML document (dict)."""
+def parse_assembly(doc: dict, source: str = "<memory>", *, require_holder_tool: bool = False,
+                   require_tool: bool = True) -> Assembly:
+    """Build an :class:`Assembly` from a parsed TOML document (dict).
+
+    ``require_tool=False`` accepts a spindle–holder description without [tool]
+    (``Assembly.tool`` is then None), as a campaign's subassembly model.
+    """
     r = _Reader(source)
     r.unknown_keys(doc, {"frequency", "materials", "spindle", "holder", "tool", "joints", "identify"}, "file")
     mats = _materials(r, doc)
     spindle = _component(r, doc, "spindle", mats, with_bearings=True)
     holder = _component(r, doc, "holder", mats, with_bearings=False)
-    tool = _component(r, doc, "tool", mats, with_bearings=False)
+    tool = _component(r, doc, "tool", mats, with_bearings=False) if (require_tool or "tool" in doc) else None
     joints = r.table(doc, "joints", "joints")
     r.unknown_keys(joints, {"spindle_holder", "holder_tool"}, "joints")
     sh = parse_joint(r, r.table(joints, "spindle_holder", "joints.spindle_holder"), "joints.spindle_holder")
@@ -306,6 +311,7 @@ def load_toml(path: str | Path) -> dict:
         raise InputError(f"malformed TOML ({e})", file=path, field="syntax") from None
 
 
-def load_assembly(path: str | Path, *, require_holder_tool: bool = False) -> Assembly:
+def load_assembly(path: str | Path, *, require_holder_tool: bool = False, require_tool: bool = True) -> Assembly:
     """Load and validate an assembly TOML file."""
-    return parse_assembly(load_toml(path), str(path), require_holder_tool=require_holder_tool)
+    return parse_assembly(load_toml(path), str(path), require_holder_tool=require_holder_tool,
+                          require_tool=require_tool)

@@ -100,12 +100,8 @@ def _divided_series(s1, s2, L, odd: bool, terms: int = 11):
     return out * L * L  # d/ds of x = L² s
 
 
-def _coefficients(sec: Section, L: float, w: np.ndarray):
-    """a, b, m, j and the Sylvester coefficients C0, S0, C1, S1 (each (F,))."""
-    a = 1.0 / (sec.kappa * sec.G * sec.A)
-    b = 1.0 / (sec.E * sec.I)
-    m = sec.rho * sec.A * w**2 + 0j
-    j = sec.rho * sec.I * w**2 + 0j
+def _coefficients(a, b, m, j, L):
+    """Sylvester coefficients C0, S0, C1, S1 for element-wise arrays a, b, m, j, L (all (N,))."""
     p = a * m + b * j
     q = b * m * (a * j - 1)
     r = np.sqrt(p * p - 4 * q)
@@ -114,44 +110,56 @@ def _coefficients(sec: Section, L: float, w: np.ndarray):
     with np.errstate(divide="ignore", invalid="ignore"):
         s2 = np.where(s1 != 0, q / s1, 0)
 
-    C0, S0, C1, S1 = (np.empty(w.size, complex) for _ in range(4))
+    C0, S0, C1, S1 = (np.empty(a.size, complex) for _ in range(4))
     # Series where |s|L² is small (incl. ω = 0, where s1 = s2 = 0), closed form elsewhere.
     small = np.maximum(abs(s1), abs(s2)) * L * L < SERIES_LIMIT
     if np.any(small):
-        t1, t2 = s1[small], s2[small]
-        dC = _divided_series(t1, t2, L, odd=False)
-        dS = L * _divided_series(t1, t2, L, odd=True)
+        t1, t2, Ls = s1[small], s2[small], L[small]
+        dC = _divided_series(t1, t2, Ls, odd=False)
+        dS = Ls * _divided_series(t1, t2, Ls, odd=True)
         C1[small], S1[small] = dC, dS
-        C0[small] = _series(L * L * t1, odd=False) - t1 * dC
-        S0[small] = L * _series(L * L * t1, odd=True) - t1 * dS
+        C0[small] = _series(Ls * Ls * t1, odd=False) - t1 * dC
+        S0[small] = Ls * _series(Ls * Ls * t1, odd=True) - t1 * dS
     big = ~small
     if np.any(big):
-        t1, t2 = s1[big], s2[big]
+        t1, t2, Lb = s1[big], s2[big], L[big]
         r1, r2 = np.sqrt(t1), np.sqrt(t2)
-        gC1, gC2 = np.cosh(L * r1), np.cosh(L * r2)
-        gS1, gS2 = np.sinh(L * r1) / r1, np.sinh(L * r2) / r2
+        gC1, gC2 = np.cosh(Lb * r1), np.cosh(Lb * r2)
+        gS1, gS2 = np.sinh(Lb * r1) / r1, np.sinh(Lb * r2) / r2
         dC = (gC1 - gC2) / (t1 - t2)
         dS = (gS1 - gS2) / (t1 - t2)
         C1[big], S1[big] = dC, dS
         C0[big] = gC1 - t1 * dC
         S0[big] = gS1 - t1 * dS
-    return a, b, m, j, C0, S0, C1, S1
+    return C0, S0, C1, S1
 
 
-def transfer_matrix(sec: Section, L: float, omega) -> np.ndarray:
-    """Transfer matrix T (F, 4, 4) on [w, ψ, Q, M] over length L (m), ω in rad/s (F,).
+def transfer_matrices(pieces, omega) -> np.ndarray:
+    """Transfer matrices (P, F, 4, 4) on [w, ψ, Q, M] of pieces [(Section, length m), …] at ω (F,) rad/s.
 
     T = C0 I + S0 A + C1 A² + S1 A³, written out entry by entry (A² and A³ in
-    closed form) so that no batched 4×4 products are needed.
+    closed form), all pieces and frequencies in one vectorised pass.
     """
     w = np.asarray(omega, dtype=float).reshape(-1)
-    a, b, m, j, C0, S0, C1, S1 = _coefficients(sec, L, w)
-    T = np.empty((w.size, 4, 4), complex)
+    P, F = len(pieces), w.size
+    col = lambda v: np.repeat(np.asarray(v), F)  # noqa: E731 — per piece, repeated over frequency
+    a = col([1.0 / (s.kappa * s.G * s.A) for s, _ in pieces])
+    b = col([1.0 / (s.E * s.I) for s, _ in pieces])
+    m = col([s.rho * s.A for s, _ in pieces]) * np.tile(w**2, P) + 0j
+    j = col([s.rho * s.I for s, _ in pieces]) * np.tile(w**2, P) + 0j
+    L = col([float(length) for _, length in pieces])
+    C0, S0, C1, S1 = _coefficients(a, b, m, j, L)
+    T = np.empty((P * F, 4, 4), complex)
     T[:, 0] = np.stack([C0 - a * m * C1, S0 - (a * m + b * j) * S1, a * S0 - (a * a * m + b) * S1, b * C1], -1)
     T[:, 1] = np.stack([b * m * S1, C0 - b * j * C1, -b * C1, b * S0 - b * b * j * S1], -1)
     T[:, 2] = np.stack([-m * S0 + a * m * m * S1, -m * C1, C0 - a * m * C1, -b * m * S1], -1)
     T[:, 3] = np.stack([m * C1, -j * S0 + (m + j * j * b) * S1, -S0 + (a * m + b * j) * S1, C0 - b * j * C1], -1)
-    return T
+    return T.reshape(P, F, 4, 4)
+
+
+def transfer_matrix(sec: Section, L: float, omega) -> np.ndarray:
+    """Transfer matrix T (F, 4, 4) of one uniform piece of length L (m); see :func:`transfer_matrices`."""
+    return transfer_matrices([(sec, L)], omega)[0]
 
 
 def mul2(A: np.ndarray, B: np.ndarray) -> np.ndarray:

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .assembly import Component
-from .beam import inv2, mul2, stiffness_from_transfer, transfer_matrix
+from .beam import inv2, mul2, stiffness_from_transfer, transfer_matrices
 
 MAX_BETA_L = 2.0
 # Above Σ βL ≈ 6 (past the first free–free mode, βL = 4.73) the stiffness
@@ -84,15 +84,13 @@ def mesh(component: Component, fmax_hz: float, max_beta_l: float = MAX_BETA_L) -
 
 
 def _piece_transfers(m: Mesh, omega: np.ndarray) -> list[np.ndarray]:
-    """Transfer matrix of every piece; equal pieces share one evaluation."""
-    cache: dict[tuple[int, float], np.ndarray] = {}
-    out = []
-    for sec, length, _ in m.pieces:
-        key = (id(sec), round(length, 15))
-        if key not in cache:
-            cache[key] = transfer_matrix(sec, length, omega)
-        out.append(cache[key])
-    return out
+    """Transfer matrix of every piece; equal pieces share one evaluation, all in one pass."""
+    keys = [(id(sec), round(length, 15)) for sec, length, _ in m.pieces]
+    unique = list(dict.fromkeys(keys))
+    first = {k: i for i, k in reversed(list(enumerate(keys)))}
+    Ts = transfer_matrices([m.pieces[first[k]][:2] for k in unique], omega)
+    at = {k: Ts[i] for i, k in enumerate(unique)}
+    return [at[k] for k in keys]
 
 
 def _piece_matrices(m: Mesh, omega: np.ndarray) -> list[np.ndarray]:

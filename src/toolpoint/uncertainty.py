@@ -48,7 +48,8 @@ def identifiability_warnings(x_log, ci, bounds, max_ratio: float = 2.0, bound_to
     span = bounds.log_hi - bounds.log_lo
     for i, name in enumerate(PARAMS):
         lo, hi = ci[i]
-        ratio = hi / lo if lo > 0 else np.inf
+        with np.errstate(over="ignore"):
+            ratio = hi / lo if lo > 0 else np.inf
         if not np.isfinite(ratio) or ratio > max_ratio:
             out.append(
                 f"{name} is not identifiable from this FRF: its 95 % interval {lo:.3g}–{hi:.3g} {UNITS[name]} "

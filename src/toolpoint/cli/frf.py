@@ -42,6 +42,7 @@ def run(args) -> int:
     if plot:
         save_figure(fig, plot)
     f_pk, h_pk = frf.peak()
+    static = f"; static {frf.values[0].real:.4g} m/N" if frf.freq_hz[0] == 0 else ""
     print(f"{frf.label}: {len(frf)} points {frf.freq_hz[0]:g}–{frf.freq_hz[-1]:g} Hz; "
-          f"dominant peak {f_pk:g} Hz, |h| = {h_pk:.4g} m/N; static {abs(frf.values[0]):.4g} m/N → {out}")
+          f"dominant peak {f_pk:g} Hz, |h| = {h_pk:.4g} m/N{static} → {out}")
     return 0

@@ -38,7 +38,6 @@ the user-facing axis of the lobes.
 
 from __future__ import annotations
 
-import contextlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,13 +52,10 @@ def single_thread_blas():
 
     The solvers call LAPACK on stacks of small matrices (or tall-thin least
     squares); there OpenBLAS threads only contend — measured 6–20× slower on
-    the 2-core development machine. Needs threadpoolctl (a scikit-learn
-    dependency); without it BLAS keeps its own setting.
+    the 2-core development machine.
     """
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        return contextlib.nullcontext()
+    from threadpoolctl import threadpool_limits
+
     return threadpool_limits(1, user_api="blas")
 
 
