@@ -15,7 +15,7 @@ import sys
 from ..errors import InputError
 
 # Order is the order shown in --help.
-COMMANDS = ("frf", "identify", "reproduce", "anfis", "lobes")
+COMMANDS = ("frf", "identify", "reproduce", "campaign", "predict", "anfis", "lobes")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,249 @@
+"""A campaign folder: ``campaign.toml`` + ``measurements.csv`` → typed objects.
+
+``campaign.toml`` (lengths in mm at the boundary, all else SI)::
+
+    [campaign]
+    band_hz = [20.0, 4000.0]        # frequency band to fit (Hz)
+    [materials.carbide]             # optional, as in an assembly file
+    E = 580e9
+    rho = 14500.0
+    nu = 0.22
+    [tool_family]
+    material = "carbide"            # default "steel"
+    flute_ratio = 0.8               # equivalent diameter of the fluted part / D
+    flute_length_ratio = 2.0        # flute length = ratio × D, capped at the overhang
+    [holders.ER40]                  # one entry per holder/collet; the subassembly comes from
+    model = "spindle_holder.toml"   #   a model (spindle + holder + spindle–holder joint), or
+    # blank = { segments = [{ length_mm = 50, od_mm = 20 }], x2_mm = 40,
+    #           G11 = "sh/G11.csv", G12 = "sh/G12.csv", G22 = "sh/G22.csv", smooth_hz = 25 }
+    # files = { h = "h.csv", l = "l.csv", n = "n.csv", p = "p.csv" }
+    [identify]
+    method = "hybrid"
+    bounds = { kt = [1e6, 1e9] }    # optional, the paper's by default
+
+``measurements.csv``: columns ``id, diameter_mm, overhang_mm, frf`` (path
+relative to the folder) and optionally ``holder`` (default: the only holder).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..assembly import MM, Component, Material, Segment, _materials, _Reader, _segments, load_assembly, load_toml
+from ..errors import InputError
+from ..frfio import read_frf
+from ..inverse_rcsa import smooth_subassembly, subassembly_from_blank, subassembly_from_files
+from ..objective import Bounds
+from ..subassembly import Subassembly
+
+
+@dataclass(frozen=True)
+class ToolFamily:
+    material: Material
+    flute_ratio: float = 0.8
+    flute_length_ratio: float = 2.0
+
+    def tool(self, diameter_mm: float, overhang_mm: float) -> Component:
+        """The overhang as a beam: plain shank, then flutes of equivalent diameter ratio·D."""
+        D, L = diameter_mm * MM, overhang_mm * MM
+        flutes = min(L, self.flute_length_ratio * D)
+        segs = []
+        if L - flutes > 1e-9:
+            segs.append(Segment(L - flutes, D, 0.0, self.material))
+        segs.append(Segment(flutes, self.flute_ratio * D, 0.0, self.material))
+        return Component("tool", tuple(segs))
+
+
+@dataclass(frozen=True)
+class Measurement:
+    id: str
+    diameter_mm: float
+    overhang_mm: float
+    frf: Path
+    holder: str
+    line: int
+
+
+@dataclass(frozen=True)
+class HolderSource:
+    name: str
+    kind: str  # "model" | "blank" | "files"
+    spec: dict
+
+
+@dataclass(frozen=True)
+class Campaign:
+    folder: Path
+    band_hz: tuple[float, float]
+    family: ToolFamily
+    holders: dict[str, HolderSource]
+    measurements: tuple[Measurement, ...]
+    method: str
+    bounds: Bounds
+    materials: dict  # by name, for blank segments
+
+    @property
+    def toml(self) -> Path:
+        return self.folder / "campaign.toml"
+
+    def subassembly(self, name: str, freq_hz=None) -> Subassembly:
+        """The holder's subassembly on ``freq_hz`` (Hz, inside its measured band), or on
+        its own measured grid when ``freq_hz`` is None (not for a model source)."""
+        src = self.holders[name]
+        where = f"holders.{name}.{src.kind}"
+        if src.kind == "model":
+            a = load_assembly(self.folder / src.spec["path"], require_tool=False)
+            return Subassembly.from_assembly(a, np.asarray(freq_hz, float))
+        if src.kind == "files":
+            sub = subassembly_from_files(*(self.folder / src.spec[k] for k in "hlnp"))
+        else:
+            r = _Reader(str(self.toml))
+            blank = Component("blank", _segments(r, src.spec, where, self.materials))
+            G = [read_frf(self.folder / src.spec[k]) for k in ("G11", "G12", "G22")]
+            sub = subassembly_from_blank(blank, float(src.spec["x2_mm"]) * MM, *G)
+            if src.spec.get("smooth_hz"):
+                sub = smooth_subassembly(sub, float(src.spec["smooth_hz"]))
+        if freq_hz is None:
+            return sub
+        try:
+            return sub.at(np.asarray(freq_hz, float))
+        except ValueError as e:
+            raise InputError(str(e), file=self.toml, field=where) from None
+
+
+def _band(r: _Reader, doc: dict) -> tuple[float, float]:
+    c = r.table(doc, "campaign", "campaign")
+    band = c.get("band_hz")
+    try:
+        lo, hi = (float(v) for v in band)
+    except (TypeError, ValueError):
+        raise r.err("campaign.band_hz", f"must be [lo, hi] in Hz, got {band!r}") from None
+    if not (0 < lo < hi and math.isfinite(hi)):
+        raise r.err("campaign.band_hz", f"need 0 < lo < hi, got [{lo:g}, {hi:g}]")
+    return lo, hi
+
+
+def _family(r: _Reader, doc: dict, mats: dict) -> ToolFamily:
+    t = r.table(doc, "tool_family", "tool_family", required=False) or {}
+    r.unknown_keys(t, {"material", "flute_ratio", "flute_length_ratio"}, "tool_family")
+    name = t.get("material", "steel")
+    if name not in mats:
+        raise r.err("tool_family.material", f"unknown material {name!r} (known: {', '.join(sorted(mats))})")
+    ratio = r.number(t, "flute_ratio", "tool_family", default=0.8, positive=True)
+    if ratio > 1:
+        raise r.err("tool_family.flute_ratio", f"must be ≤ 1, got {ratio:g}")
+    length = r.number(t, "flute_length_ratio", "tool_family", default=2.0, positive=True)
+    return ToolFamily(mats[name], ratio, length)
+
+
+def _holders(r: _Reader, doc: dict, folder: Path) -> dict[str, HolderSource]:
+    hs = r.table(doc, "holders", "holders")
+    if not hs:
+        raise r.err("holders", "needs at least one holder entry")
+    out = {}
+    for name, spec in hs.items():
+        path = f"holders.{name}"
+        if not isinstance(spec, dict):
+            raise r.err(path, "must be a table")
+        kinds = [k for k in ("model", "blank", "files") if k in spec]
+        if len(kinds) != 1:
+            raise r.err(path, "give exactly one of model, blank, files")
+        kind = kinds[0]
+        if kind == "model":
+            p = folder / str(spec["model"])
+            if not p.is_file():
+                raise r.err(f"{path}.model", f"file not found: {p}")
+            out[name] = HolderSource(name, kind, {"path": str(spec["model"])})
+        elif kind == "files":
+            f = spec["files"]
+            if not isinstance(f, dict) or set(f) != set("hlnp"):
+                raise r.err(f"{path}.files", "must be {h = …, l = …, n = …, p = …}")
+            out[name] = HolderSource(name, kind, dict(f))
+        else:
+            b = spec["blank"]
+            if not isinstance(b, dict):
+                raise r.err(f"{path}.blank", "must be a table")
+            for k in ("segments", "x2_mm", "G11", "G12", "G22"):
+                if k not in b:
+                    raise r.err(f"{path}.blank.{k}", "missing value")
+            out[name] = HolderSource(name, kind, dict(b))
+    return out
+
+
+def _measurements(path: Path, holders: dict) -> tuple[Measurement, ...]:
+    try:
+        with open(path, newline="") as fh:
+            rows = list(csv.reader(fh))
+    except FileNotFoundError:
+        raise InputError("file not found", file=path) from None
+    if not rows:
+        raise InputError("empty file", file=path, field="header")
+    head = [h.strip() for h in rows[0]]
+    need = ["id", "diameter_mm", "overhang_mm", "frf"]
+    for col in need:
+        if col not in head:
+            raise InputError(f"missing column {col!r} (have {', '.join(head)})", file=path, field=col)
+    idx = {c: head.index(c) for c in head}
+    default_holder = next(iter(holders)) if len(holders) == 1 else None
+    seen: dict[str, int] = {}
+    out = []
+    for n, row in enumerate(rows[1:], start=2):
+        if not any(c.strip() for c in row):
+            continue
+        if len(row) != len(head):
+            raise InputError(f"line {n}: {len(row)} cells, header has {len(head)}", file=path, field="row")
+        get = lambda c: row[idx[c]].strip()  # noqa: E731
+        mid = get("id")
+        if not mid:
+            raise InputError(f"line {n}: empty id", file=path, field="id")
+        if mid in seen:
+            raise InputError(f"duplicate id {mid!r} on lines {seen[mid]} and {n}", file=path, field="id")
+        seen[mid] = n
+        vals = {}
+        for c in ("diameter_mm", "overhang_mm"):
+            try:
+                vals[c] = float(get(c))
+            except ValueError:
+                raise InputError(f"line {n}: {get(c)!r} is not a number", file=path, field=c) from None
+            if not (vals[c] > 0 and math.isfinite(vals[c])):
+                raise InputError(f"line {n}: must be > 0, got {get(c)}", file=path, field=c)
+        holder = get("holder") if "holder" in idx and get("holder") else default_holder
+        if holder is None:
+            raise InputError(f"line {n}: several holders defined, name one in the 'holder' column", file=path,
+                             field="holder")
+        if holder not in holders:
+            raise InputError(f"line {n}: unknown holder {holder!r} (campaign.toml has {', '.join(holders)})",
+                             file=path, field="holder")
+        out.append(Measurement(mid, vals["diameter_mm"], vals["overhang_mm"], path.parent / get("frf"), holder, n))
+    if not out:
+        raise InputError("no measurements", file=path, field="rows")
+    return tuple(out)
+
+
+def load_campaign(folder: str | Path) -> Campaign:
+    """Read and validate a campaign folder."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError("not a folder", file=folder)
+    toml = folder / "campaign.toml"
+    doc = load_toml(toml)
+    r = _Reader(str(toml))
+    r.unknown_keys(doc, {"campaign", "materials", "tool_family", "holders", "identify"}, "file")
+    mats = _materials(r, doc)
+    band = _band(r, doc)
+    family = _family(r, doc, mats)
+    holders = _holders(r, doc, folder)
+    ident = r.table(doc, "identify", "identify", required=False) or {}
+    method = ident.get("method", "hybrid")
+    from ..optim import METHODS
+
+    if method not in METHODS:
+        raise r.err("identify.method", f"unknown method {method!r} (one of {', '.join(METHODS)})")
+    bounds = Bounds.from_dict(ident.get("bounds"), source=str(toml), section="identify.bounds")
+    return Campaign(folder, band, family, holders, _measurements(folder / "measurements.csv", holders), method,
+                    bounds, mats)

@@ -1,0 +1,615 @@
+r"""``toolpoint campaign learn`` — ANFIS joint-parameter models from a campaign.
+
+Reads ``RESULTS_DIR/identified.csv`` (written by ``toolpoint campaign run``:
+one identified holder–tool joint per tool assembly), splits the successfully
+identified assemblies at random into training and test data, and fits one
+:class:`~toolpoint.anfis.ANFIS` model per joint parameter with the inputs
+(tool diameter D, overhang L), as in Čiča et al., section 5 (3×7 Gaussian MFs,
+linear consequents, 21 rules, 148 training / 30 test sets).
+
+Targets
+    ``kt`` and ``kr`` always. The damping coefficients ``ct`` and ``cr`` only
+    where the identification pinned them down: a damping target is learned
+    only if at least 80 % of the ``ok`` rows have a 95 % confidence interval
+    with hi/lo ≤ 2 (:data:`IDENTIFIABLE_RATIO`, :data:`IDENTIFIABLE_SHARE`);
+    otherwise it is left out with a message. An explicit ``targets`` list is
+    used as given (with a note if a target fails that test).
+
+Metrics
+    The paper's four on the training and the test data: NRMSE, AFV, MAPE %
+    and max APE % (:mod:`toolpoint.metrics`), always in the target's own unit
+    (with ``log_target`` the predictions are transformed back first). The
+    paper's test numbers for kt and kr are printed beside ours.
+
+Baselines (same split, same metrics)
+    * ``gpr`` — :class:`~sklearn.gaussian_process.GaussianProcessRegressor`,
+      kernel C·RBF(ℓ_D, ℓ_L) + White (one length scale per input, fitted
+      noise), ``normalize_y``, inputs standardised, 3 optimiser restarts.
+    * ``gbr`` — :class:`~sklearn.ensemble.GradientBoostingRegressor`
+      (scikit-learn defaults, ``random_state=seed``).
+
+    Both fit log10 of the target (stiffnesses span decades, and the metrics
+    that matter most here are relative); if a target has a value ≤ 0 they fit
+    it as is. They show whether ANFIS is the right choice for the data at hand.
+
+Over-fitting
+    A 3×7 grid has 21 rules × 3 linear consequents = 63 parameters plus the
+    MFs; on ~150 scattered (D, L) points some rules see few samples, and the
+    hybrid learning keeps the epoch with the lowest *training* error (the test
+    data are never used for model selection). When the ANFIS test NRMSE
+    exceeds :data:`OVERFIT_RATIO` × its training NRMSE a warning is printed and
+    ``metrics[target]["anfis"]["overfit"]`` is true; the baselines show what
+    the data allow.
+
+Outputs (every file written atomically)
+    ``models/split.csv``      id, set (train/test) of each ok row, in file order
+    ``models/<target>.json``  the ANFIS model (:meth:`ANFIS.load`)
+    ``models/metrics.json``   everything :func:`learn` returns
+    ``models/metrics.csv``    one row per target × model × data set
+    ``plots/anfis_<target>_test.png``        target and prediction per test sample (Figs. 6/7)
+    ``plots/anfis_<target>_regression.png``  prediction vs target, fitted line, R (Fig. 8)
+    ``plots/anfis_<target>_membership.png``  the trained membership functions
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..anfis import ANFIS, MF_PARAMS
+from ..atomic import atomic_open
+from ..cli.anfis import PAPER_METRICS, _plot_membership, _plot_per_sample, _plot_regression, _predict_quietly
+from ..errors import InputError
+
+__all__ = ["learn", "add_arguments", "run_cli", "PAPER", "IDENTIFIABLE_RATIO", "IDENTIFIABLE_SHARE"]
+
+INPUTS = ("diameter_mm", "overhang_mm")
+ALL_TARGETS = ("kt", "ct", "kr", "cr")
+DAMPING = ("ct", "cr")
+UNITS = {"kt": "N/m", "ct": "N s/m", "kr": "N m/rad", "cr": "N m s/rad"}
+#: A 95 % interval is "narrow" if hi/lo ≤ this ratio …
+IDENTIFIABLE_RATIO = 2.0
+#: … and a damping target is learned if at least this share of ok rows has one.
+IDENTIFIABLE_SHARE = 0.8
+#: ANFIS test NRMSE above this multiple of its training NRMSE is reported as over-fitting.
+OVERFIT_RATIO = 2.0
+#: Extra ok rows needed beyond the test set (the training set must support the grid).
+MIN_TRAIN = 10
+
+#: Keys of the metrics (JSON/CSV/return value) → (column title, function). MAPE and max APE in %.
+METRICS = {key: (title, fn) for key, (title, fn) in zip(("nrmse", "afv", "mape", "max_ape"), PAPER_METRICS)}
+
+#: Čiča et al., section 5: ANFIS test-set results (30 sets).
+PAPER = {
+    "kt": {"nrmse": 0.09427, "afv": 0.99541, "mape": 4.5, "max_ape": 11.8},
+    "kr": {"nrmse": 0.08993, "afv": 0.99591, "mape": 0.7, "max_ape": 3.2},
+}
+PAPER_N_TEST = 30
+
+MODEL_LABELS = {"anfis": "ANFIS", "gpr": "GP regression", "gbr": "gradient boosting", "paper": "Čiča et al. ANFIS"}
+
+
+# -------------------------------------------------------------------- input
+def _read_identified(path: Path, required: list[str]):
+    """Rows of identified.csv as dicts (plus their line numbers); InputError on trouble."""
+    if not path.is_file():
+        raise InputError("file not found (run 'toolpoint campaign run' first)", file=path)
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            reader = csv.DictReader(fh)
+            header = [h.strip() for h in (reader.fieldnames or [])]
+            reader.fieldnames = header
+            rows = [(reader.line_num, row) for row in reader]
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise InputError(f"cannot read CSV: {err}", file=path) from None
+    if not header:
+        raise InputError("empty file (no header row)", file=path)
+    for name in required:
+        if name not in header:
+            raise InputError(f"no such column (columns: {', '.join(header)})", file=path, field=name)
+    return rows
+
+
+def _number(path, line, row, name, *, required=True) -> float:
+    cell = (row.get(name) or "").strip()
+    try:
+        v = float(cell)
+    except ValueError:
+        if required:
+            raise InputError(f"line {line}: {cell!r} is not a number (status ok)", file=path, field=name) from None
+        return math.nan
+    if not math.isfinite(v):
+        if required:
+            raise InputError(f"line {line}: {cell!r} is not a finite number (status ok)", file=path, field=name)
+        return math.nan
+    return v
+
+
+def _narrow_share(lo: np.ndarray, hi: np.ndarray) -> float:
+    """Share of rows whose interval [lo, hi] has 0 < lo and hi/lo ≤ IDENTIFIABLE_RATIO (NaN → wide)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ok = (lo > 0) & np.isfinite(lo) & np.isfinite(hi) & (hi / np.where(lo > 0, lo, 1.0) <= IDENTIFIABLE_RATIO)
+    return float(np.mean(ok)) if lo.size else 0.0
+
+
+def _check_settings(test_size, mfs, mf, order, epochs, step_size, targets):
+    if isinstance(test_size, bool) or not isinstance(test_size, (int, np.integer)) or test_size < 1:
+        raise InputError(f"must be a whole number ≥ 1, got {test_size!r}", field="test_size")
+    m = [mfs] if isinstance(mfs, (int, np.integer)) else list(mfs)
+    if len(m) not in (1, len(INPUTS)) or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in m):
+        raise InputError(f"expected one whole number or one per input ({', '.join(INPUTS)}), got {mfs!r}", field="mfs")
+    if min(m) < 2:
+        raise InputError("each input needs at least 2 membership functions", field="mfs")
+    if mf not in MF_PARAMS:
+        raise InputError(f"must be one of {', '.join(MF_PARAMS)}, got {mf!r}", field="mf")
+    if isinstance(order, bool) or order not in (0, 1):
+        raise InputError(f"must be 0 (constant) or 1 (linear), got {order!r}", field="order")
+    if isinstance(epochs, bool) or not isinstance(epochs, (int, np.integer)) or epochs < 1:
+        raise InputError(f"must be a whole number ≥ 1, got {epochs!r}", field="epochs")
+    if not (isinstance(step_size, (int, float)) and math.isfinite(step_size) and step_size > 0):
+        raise InputError(f"must be a positive number, got {step_size!r}", field="step_size")
+    n_mfs = int(m[0]) if len(m) == 1 else tuple(int(v) for v in m)
+    if targets is None:
+        return n_mfs, None
+    names = [targets] if isinstance(targets, str) else list(targets)
+    for t in names:
+        if t not in ALL_TARGETS:
+            raise InputError(f"unknown target {t!r} (one of {', '.join(ALL_TARGETS)})", field="targets")
+    if not names or len(set(names)) != len(names):
+        raise InputError(f"expected distinct targets from {', '.join(ALL_TARGETS)}, got {targets!r}", field="targets")
+    return n_mfs, names
+
+
+# ---------------------------------------------------------------- baselines
+def _one_thread():
+    """Single-threaded BLAS while fitting: the matrices are ~150 × 150, where
+    threads only cost (and oversubscribe a machine running several jobs)."""
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(limits=1, user_api="blas")
+
+
+def _exp10(v):
+    return np.power(10.0, v)
+
+
+def _baselines(seed: int, log: bool):
+    """Unfitted baseline regressors {key: estimator} (target in log10 if ``log``)."""
+    from sklearn.compose import TransformedTargetRegressor
+    from sklearn.ensemble import GradientBoostingRegressor
+    from sklearn.gaussian_process import GaussianProcessRegressor
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+
+    kernel = ConstantKernel(1.0, (1e-3, 1e3)) * RBF(length_scale=[1.0] * len(INPUTS), length_scale_bounds=(1e-2, 1e2)) + WhiteKernel(
+        1e-3, (1e-10, 1.0)
+    )
+    gpr = make_pipeline(
+        StandardScaler(),
+        GaussianProcessRegressor(kernel=kernel, normalize_y=True, n_restarts_optimizer=3, random_state=seed),
+    )
+    gbr = GradientBoostingRegressor(random_state=seed)
+
+    def wrap(est):
+        return TransformedTargetRegressor(regressor=est, func=np.log10, inverse_func=_exp10) if log else est
+
+    return {"gpr": wrap(gpr), "gbr": wrap(gbr)}
+
+
+def _describe_baseline(key, est) -> str:
+    """Fitted hyper-parameters worth recording (GP kernel)."""
+    inner = getattr(est, "regressor_", est)
+    if key == "gpr":
+        return str(inner.steps[-1][1].kernel_)
+    return f"{inner.n_estimators_} trees, depth {inner.max_depth}, learning rate {inner.learning_rate}"
+
+
+# ------------------------------------------------------------------ metrics
+def _metrics(y, pred) -> dict[str, float]:
+    out = {}
+    for key, (_, fn) in METRICS.items():
+        try:
+            out[key] = float(fn(y, pred))
+        except ValueError:  # e.g. MAPE of a zero target
+            out[key] = math.nan
+    out["n"] = int(len(y))
+    return out
+
+
+def _ratio(test: float, train: float) -> float:
+    """test / train error (inf if the test error is not finite, 1 if it cannot be judged)."""
+    if not math.isfinite(test):
+        return math.inf
+    if not math.isfinite(train):
+        return 1.0
+    if train <= 0:
+        return math.inf if test > 0 else 1.0
+    return test / train
+
+
+def _jsonable(obj):
+    """NaN → None, NumPy → Python, recursively."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def _fmt(v) -> str:
+    return f"{v:>10.4g}" if v is not None and math.isfinite(v) else f"{'—':>10}"
+
+
+# --------------------------------------------------------------------- main
+def learn(
+    results_dir,
+    *,
+    test_size=30,
+    mfs=(3, 7),
+    mf="gauss",
+    order=1,
+    epochs=200,
+    step_size=0.01,
+    seed=0,
+    targets=None,
+    log_target=False,
+    baselines=True,
+    plots=True,
+    out=print,
+) -> dict:
+    """Train ANFIS (and baseline) models of the joint parameters on a campaign's results.
+
+    Parameters
+    ----------
+    results_dir : folder holding ``identified.csv``; models go to
+        ``results_dir/models``, plots to ``results_dir/plots``.
+    test_size : number of ok rows held out for testing (paper: 30 of 178).
+    mfs, mf, order, epochs, step_size, log_target : ANFIS settings
+        (:class:`~toolpoint.anfis.ANFIS` ``n_mfs``, ``mf``, …).
+    seed : seed of the random split (``numpy.random.default_rng``) and of the baselines.
+    targets : None (kt, kr, and ct/cr where identifiable) or a list of names.
+    baselines : also fit the GP and gradient-boosting baselines.
+    plots : write the PNG plots.
+    out : callable taking one line of text (default :func:`print`).
+
+    Returns
+    -------
+    dict, the content of ``models/metrics.json`` (NaN where a metric is undefined;
+    ``null`` in the JSON file). The numbers are under
+    ``result["metrics"][target][model][set][metric]`` with model in
+    ``anfis``/``gpr``/``gbr``, set in ``train``/``test`` and metric in
+    ``nrmse``, ``afv``, ``mape`` (%), ``max_ape`` (%), plus ``n``.
+
+    Raises
+    ------
+    InputError : missing identified.csv or column, a non-number in an ok row,
+        fewer than ``test_size + 10`` ok rows, a bad setting, or an output that
+        cannot be written.
+    """
+    n_mfs, explicit = _check_settings(test_size, mfs, mf, order, epochs, step_size, targets)
+    results_dir = Path(results_dir)
+    path = results_dir / "identified.csv"
+    models_dir, plots_dir = results_dir / "models", results_dir / "plots"
+
+    candidates = explicit if explicit is not None else list(ALL_TARGETS)
+    required = ["id", *INPUTS, "status"] + candidates
+    if explicit is None:
+        required += [f"{t}_{b}" for t in DAMPING for b in ("lo", "hi")]
+    required = list(dict.fromkeys(required))
+    rows = _read_identified(path, required)
+
+    ok = [(line, row) for line, row in rows if (row.get("status") or "").strip().lower() == "ok"]
+    n_failed = len(rows) - len(ok)
+    if len(ok) < test_size + MIN_TRAIN:
+        raise InputError(
+            f"{len(ok)} rows with status ok, need at least test_size + {MIN_TRAIN} = {test_size + MIN_TRAIN}",
+            file=path,
+            field="status",
+        )
+    ids = [(row.get("id") or "").strip() for _, row in ok]
+    seen = set()
+    for (line, _), i in zip(ok, ids):
+        if not i:
+            raise InputError(f"line {line}: empty id", file=path, field="id")
+        if i in seen:
+            raise InputError(f"line {line}: id {i!r} appears more than once", file=path, field="id")
+        seen.add(i)
+    X = np.array([[_number(path, line, row, c) for c in INPUTS] for line, row in ok])
+    # lenient here (NaN); a target that is learned must be a number in every ok row (checked below)
+    values = {t: np.array([_number(path, line, row, t, required=False) for line, row in ok]) for t in candidates}
+
+    # identifiability: share of ok rows with a narrow 95 % interval, per parameter
+    share = {}
+    for t in ALL_TARGETS:
+        lo_c, hi_c = f"{t}_lo", f"{t}_hi"
+        if rows and lo_c in rows[0][1] and hi_c in rows[0][1]:
+            lo = np.array([_number(path, line, row, lo_c, required=False) for line, row in ok])
+            hi = np.array([_number(path, line, row, hi_c, required=False) for line, row in ok])
+            share[t] = _narrow_share(lo, hi)
+
+    excluded = {}
+    chosen = []
+    for t in candidates:
+        if t in DAMPING and t in share and share[t] < IDENTIFIABLE_SHARE:
+            why = (
+                f"{t} not identifiable: only {100 * share[t]:.0f} % of the {len(ok)} ok rows have a 95 % interval "
+                f"with hi/lo ≤ {IDENTIFIABLE_RATIO:g} (need ≥ {100 * IDENTIFIABLE_SHARE:.0f} %)"
+            )
+            if explicit is None:
+                excluded[t] = why
+                out(f"{t} left out: {why}")
+                continue
+            out(f"note: {why}; learned anyway because it was asked for")
+        chosen.append(t)
+        bad = np.flatnonzero(~np.isfinite(values[t]))
+        if bad.size:
+            line, row = ok[bad[0]]
+            _number(path, line, row, t)  # raises, naming the line
+    for t in ("kt", "kr"):
+        if t in chosen and t in share and share[t] < IDENTIFIABLE_SHARE:
+            out(f"note: only {100 * share[t]:.0f} % of the ok rows have a narrow 95 % interval for {t}; "
+                "the model learns identification scatter as well as the trend")
+
+    # seeded random split
+    perm = np.random.default_rng(seed).permutation(len(ok))
+    test_idx, train_idx = np.sort(perm[:test_size]), np.sort(perm[test_size:])
+    is_test = np.zeros(len(ok), dtype=bool)
+    is_test[test_idx] = True
+    Xtr, Xte = X[train_idx], X[test_idx]
+    for i, name in enumerate(INPUTS):
+        if np.ptp(Xtr[:, i]) == 0:
+            raise InputError("constant in the training data; a grid partition needs a range", file=path, field=name)
+
+    if models_dir.exists() and not models_dir.is_dir():
+        raise InputError("exists and is not a folder", file=models_dir)
+    if plots and plots_dir.exists() and not plots_dir.is_dir():
+        raise InputError("exists and is not a folder", file=plots_dir)
+    try:
+        with atomic_open(models_dir / "split.csv", "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(["id", "set"])
+            for i, t in zip(ids, is_test):
+                w.writerow([i, "test" if t else "train"])
+    except OSError as err:
+        raise InputError(f"cannot write: {err.strerror or err}", file=models_dir / "split.csv") from None
+
+    rules = int(np.prod(np.broadcast_to(n_mfs, (len(INPUTS),))))
+    mfs_text = "x".join(map(str, np.broadcast_to(n_mfs, (len(INPUTS),))))
+    out(
+        f"{path}: {len(rows)} rows, {len(ok)} ok"
+        + (f", {n_failed} failed/other (ignored)" if n_failed else "")
+        + f"; split (seed {seed}): {len(train_idx)} train / {len(test_idx)} test"
+        + (" (paper: 148 / 30)" if (len(train_idx), len(test_idx)) != (148, 30) else " (as in the paper)")
+    )
+    out(
+        f"ANFIS: inputs {', '.join(INPUTS)}; {mfs_text} {mf} MFs ({rules} rules), order {order}, "
+        f"{epochs} epochs, step size {step_size:g}" + (", target fitted as log10" if log_target else "")
+    )
+
+    lo, hi = Xtr.min(axis=0), Xtr.max(axis=0)
+    outside = int(np.sum(np.any((Xte < lo) | (Xte > hi), axis=1)))
+    if outside:
+        out(f"note: {outside} of {len(test_idx)} test samples lie outside the training range of D, L (models extrapolate there)")
+
+    result = {
+        "source": str(path),
+        "settings": {
+            "test_size": int(test_size),
+            "mfs": list(np.broadcast_to(n_mfs, (len(INPUTS),)).tolist()),
+            "mf": mf,
+            "order": int(order),
+            "epochs": int(epochs),
+            "step_size": float(step_size),
+            "seed": int(seed),
+            "log_target": bool(log_target),
+            "baselines": bool(baselines),
+            "identifiable_ratio": IDENTIFIABLE_RATIO,
+            "identifiable_share": IDENTIFIABLE_SHARE,
+        },
+        "inputs": list(INPUTS),
+        "n_rows": len(rows),
+        "n_ok": len(ok),
+        "n_train": int(len(train_idx)),
+        "n_test": int(len(test_idx)),
+        "n_test_outside_training_range": outside,
+        "targets": list(chosen),
+        "excluded": excluded,
+        "identifiable_share": share,
+        "units": {t: UNITS[t] for t in chosen},
+        "metrics": {},
+        "baseline_settings": {},
+        "best_test_model": {},
+        "paper": {t: dict(PAPER[t], n=PAPER_N_TEST) for t in chosen if t in PAPER},
+        "files": {"split": str(models_dir / "split.csv")},
+    }
+
+    for t in chosen:
+        y = values[t]
+        ytr, yte = y[train_idx], y[test_idx]
+        if log_target and np.any(ytr <= 0):
+            raise InputError("log_target needs positive values", file=path, field=t)
+        model = ANFIS(
+            n_mfs=n_mfs,
+            mf=mf,
+            order=order,
+            epochs=int(epochs),
+            step_size=float(step_size),
+            log_target=bool(log_target),
+            input_names=list(INPUTS),
+            target_name=t,
+            random_state=int(seed),
+        )
+        try:
+            with _one_thread():
+                model.fit(Xtr, ytr)
+        except ValueError as err:
+            raise InputError(f"ANFIS training failed: {err}", file=path, field=t) from None
+        model_path = models_dir / f"{t}.json"
+        try:
+            model.save(model_path)
+        except OSError as err:
+            raise InputError(f"cannot write: {err.strerror or err}", file=model_path) from None
+        result["files"][t] = str(model_path)
+
+        p_tr, _ = _predict_quietly(model, Xtr)
+        p_te, _ = _predict_quietly(model, Xte)  # extrapolation reported once, above
+        res = {"anfis": {"train": _metrics(ytr, p_tr), "test": _metrics(yte, p_te)}}
+        res["anfis"]["kept_epoch"] = int(model.best_epoch_)
+        ratio = _ratio(res["anfis"]["test"]["nrmse"], res["anfis"]["train"]["nrmse"])
+        res["anfis"]["overfit"] = bool(ratio > OVERFIT_RATIO)
+
+        if baselines:
+            log = bool(np.all(y > 0))
+            settings = {}
+            for key, est in _baselines(int(seed), log).items():
+                with warnings.catch_warnings(), _one_thread():
+                    warnings.simplefilter("ignore")  # GP optimiser convergence chatter
+                    est.fit(Xtr, ytr)
+                    b_tr, b_te = est.predict(Xtr), est.predict(Xte)
+                res[key] = {"train": _metrics(ytr, b_tr), "test": _metrics(yte, b_te)}
+                settings[key] = {"log10_target": log, "fitted": _describe_baseline(key, est)}
+            result["baseline_settings"][t] = settings
+        result["metrics"][t] = res
+
+        if plots:
+            label = f"{t} [{UNITS[t]}]"
+            files = {
+                "test": plots_dir / f"anfis_{t}_test.png",
+                "regression": plots_dir / f"anfis_{t}_regression.png",
+                "membership": plots_dir / f"anfis_{t}_membership.png",
+            }
+            try:
+                _plot_per_sample(files["test"], yte, p_te, label, f"{t}: experimental vs ANFIS, test data")
+                _plot_regression(files["regression"], yte, p_te, label, f"{t}, test data")
+                _plot_membership(files["membership"], model)
+            except OSError as err:
+                raise InputError(f"cannot write plots: {err.strerror or err}", file=plots_dir) from None
+            result["files"][f"{t}_plots"] = [str(p) for p in files.values()]
+
+        # table
+        out("")
+        out(f"{t} [{UNITS[t]}]   (ANFIS kept epoch {model.best_epoch_})")
+        out(f"{'model':<20} {'set':<5} {'n':>4} " + " ".join(f"{title:>10}" for title, _ in METRICS.values()))
+        for key in ("anfis", "gpr", "gbr"):
+            if key in res:
+                for s in ("train", "test"):
+                    m = res[key][s]
+                    out(f"{MODEL_LABELS[key]:<20} {s:<5} {m['n']:>4} " + " ".join(_fmt(m[k]) for k in METRICS))
+        if t in PAPER:
+            out(f"{MODEL_LABELS['paper']:<20} {'test':<5} {PAPER_N_TEST:>4} " + " ".join(_fmt(PAPER[t][k]) for k in METRICS))
+        if res["anfis"]["overfit"]:
+            out(
+                f"warning: ANFIS test NRMSE is {ratio:.3g}× its training NRMSE — {rules} rules over-fit "
+                f"{len(train_idx)} samples; try fewer MFs (e.g. --mfs 3,3), fewer --epochs or --log-target, "
+                "and compare the baselines"
+            )
+        scored = {k: v["test"]["mape"] for k, v in res.items() if math.isfinite(v["test"]["mape"])}
+        if scored:
+            best = min(scored, key=scored.get)
+            result["best_test_model"][t] = best
+            if len(scored) > 1:
+                line = f"lowest test MAPE: {MODEL_LABELS[best]} {scored[best]:.3g} %"
+                if best != "anfis" and "anfis" in scored:
+                    line += f" (ANFIS {scored['anfis']:.3g} %)"
+                    if scored["anfis"] > 1.5 * scored[best]:
+                        line += f" — {MODEL_LABELS[best]} suits these data better than this ANFIS"
+                out(line)
+
+    # files
+    metrics_json, metrics_csv = models_dir / "metrics.json", models_dir / "metrics.csv"
+    result["files"]["metrics_json"] = str(metrics_json)
+    result["files"]["metrics_csv"] = str(metrics_csv)
+    try:
+        with atomic_open(metrics_json, "w", encoding="utf-8") as fh:
+            json.dump(_jsonable(result), fh, indent=1, ensure_ascii=False, allow_nan=False)
+            fh.write("\n")
+        with atomic_open(metrics_csv, "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(["target", "unit", "model", "set", "n", *METRICS])
+            for t, res in result["metrics"].items():
+                for key, sets in res.items():
+                    for s in ("train", "test"):
+                        m = sets[s]
+                        w.writerow([t, UNITS[t], key, s, m["n"], *("" if not math.isfinite(m[k]) else repr(m[k]) for k in METRICS)])
+                if t in PAPER:
+                    w.writerow([t, UNITS[t], "paper", "test", PAPER_N_TEST, *(repr(PAPER[t][k]) for k in METRICS)])
+    except OSError as err:
+        raise InputError(f"cannot write: {err.strerror or err}", file=models_dir) from None
+    out("")
+    out(f"models and metrics in {models_dir}" + (f"; plots in {plots_dir}" if plots else ""))
+    return result
+
+
+# ---------------------------------------------------------------------- CLI
+#: learn() keyword → CLI option, to name the option in an InputError.
+_OPTIONS = {
+    "test_size": "--test-size",
+    "mfs": "--mfs",
+    "mf": "--mf",
+    "order": "--order",
+    "epochs": "--epochs",
+    "step_size": "--step-size",
+    "targets": "--targets",
+}
+
+
+def add_arguments(parser) -> None:
+    """Add the options of ``toolpoint campaign learn`` (not the positional RESULTS_DIR)."""
+    parser.add_argument("--test-size", type=int, default=30, help="ok rows held out for testing (default 30, as in the paper)")
+    parser.add_argument("--mfs", default="3,7", help="MFs per input (diameter, overhang): one number or two, e.g. 3,7 (default)")
+    parser.add_argument("--mf", default="gauss", choices=tuple(MF_PARAMS), help="membership function type (default gauss)")
+    parser.add_argument("--order", type=int, default=1, choices=(0, 1), help="consequent order: 0 constant, 1 linear (default 1)")
+    parser.add_argument("--epochs", type=int, default=200, help="ANFIS training epochs (default 200)")
+    parser.add_argument("--step-size", type=float, default=0.01, help="ANFIS initial step size, in input units (default 0.01)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the random train/test split and the baselines (default 0)")
+    parser.add_argument("--log-target", action="store_true", help="ANFIS fits log10 of the target (metrics stay in SI units)")
+    parser.add_argument("--no-baselines", action="store_true", help="skip the GP and gradient-boosting comparison models")
+    parser.add_argument("--targets", help="comma-separated targets from kt,ct,kr,cr (default: kt,kr and identifiable dampings)")
+    parser.add_argument("--no-plots", action="store_true", help="do not write PNG plots")
+
+
+def run_cli(args) -> int:
+    """Run :func:`learn` from parsed arguments (``args.results_dir`` plus :func:`add_arguments`' options)."""
+    text = str(getattr(args, "mfs", "3,7"))
+    try:
+        mfs = tuple(int(s) for s in text.split(","))
+    except ValueError:
+        raise InputError(f"expected an integer or comma-separated integers, got {text!r}", field="--mfs") from None
+    targets = getattr(args, "targets", None)
+    if targets is not None:
+        targets = [s.strip() for s in targets.split(",")]
+    plots = not getattr(args, "no_plots", False)
+    if plots:
+        import matplotlib
+
+        matplotlib.use("Agg")
+    try:
+        learn(
+            args.results_dir,
+            test_size=args.test_size,
+            mfs=mfs[0] if len(mfs) == 1 else mfs,
+            mf=args.mf,
+            order=args.order,
+            epochs=args.epochs,
+            step_size=args.step_size,
+            seed=args.seed,
+            targets=targets,
+            log_target=args.log_target,
+            baselines=not args.no_baselines,
+            plots=plots,
+        )
+    except InputError as err:
+        if err.file is None and err.field in _OPTIONS:
+            raise InputError(err.message, field=_OPTIONS[err.field]) from None
+        raise
+    return 0

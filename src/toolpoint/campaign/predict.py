@@ -1,0 +1,125 @@
+"""The joint and the tool-point FRF of a tool that was never measured.
+
+ANFIS models (one JSON per target, from ``toolpoint campaign learn``) give
+kt, kr — and ct, cr where they were identifiable — from (diameter_mm,
+overhang_mm). A damping without a model takes the median of the identified
+values of the campaign (``identified.csv`` beside the models folder), which is
+said in the returned notes. RCSA then couples the tool to the subassembly.
+"""
+
+from __future__ import annotations
+
+import csv
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..anfis import ANFIS
+from ..assembly import Assembly, load_assembly
+from ..errors import ExtrapolationWarning, InputError
+from ..frf import FRF
+from ..model import ToolPointModel
+from ..objective import PARAMS
+from ..subassembly import Subassembly
+from .config import ToolFamily, load_campaign
+
+
+def load_models(models_dir) -> dict[str, ANFIS]:
+    d = Path(models_dir)
+    if not d.is_dir():
+        raise InputError("models folder not found", file=d, field="--models")
+    models = {}
+    for p in PARAMS:
+        f = d / f"{p}.json"
+        if f.exists():
+            try:
+                models[p] = ANFIS.load(f)
+            except (ValueError, KeyError, OSError) as e:
+                raise InputError(f"not a toolpoint ANFIS model ({e})", file=f) from None
+    for p in ("kt", "kr"):
+        if p not in models:
+            raise InputError(f"no model for {p} ({p}.json)", file=d, field="--models")
+    return models
+
+
+def _median_identified(models_dir: Path) -> dict[str, float]:
+    path = models_dir.parent / "identified.csv"
+    if not path.exists():
+        return {}
+    with open(path, newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r.get("status") == "ok"]
+    return {p: float(np.median([float(r[p]) for r in rows])) for p in PARAMS if rows}
+
+
+def _training_range(model: ANFIS):
+    r = np.asarray(model.input_range_, float)  # (n_inputs, 2): training data range per input
+    return r[:, 0], r[:, 1]
+
+
+def predict_joint(models_dir, diameter_mm: float, overhang_mm: float) -> tuple[np.ndarray, list[str]]:
+    """[kt, ct, kr, cr] (SI) for one tool, and notes (fallbacks, extrapolation)."""
+    d = Path(models_dir)
+    models = load_models(d)
+    notes = []
+    x = np.array([[diameter_mm, overhang_mm]], float)
+    lo, hi = _training_range(models["kt"])
+    if np.any(x[0] < lo) or np.any(x[0] > hi):
+        msg = (f"D = {diameter_mm:g} mm, L = {overhang_mm:g} mm lies outside the trained range "
+               f"D {lo[0]:g}–{hi[0]:g} mm, L {lo[1]:g}–{hi[1]:g} mm: extrapolation")
+        warnings.warn(msg, ExtrapolationWarning, stacklevel=2)
+        notes.append(msg)
+    med = None
+    out = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)  # said once above
+        for p in PARAMS:
+            if p in models:
+                v = float(models[p].predict(x)[0])
+                if not v > 0:
+                    raise InputError(f"the {p} model predicts {v:.4g} ≤ 0 here (extrapolated too far?)",
+                                     file=d / f"{p}.json")
+            else:
+                med = _median_identified(d) if med is None else med
+                if p not in med:
+                    raise InputError(f"no model for {p} and no identified.csv beside the models to take a median from",
+                                     file=d, field="--models")
+                v = med[p]
+                notes.append(f"{p}: no model (not identifiable in the campaign); campaign median {v:.4g} used")
+            out.append(v)
+    return np.array(out), notes
+
+
+def predict_frf(source, diameter_mm: float, overhang_mm: float, models_dir, *, holder: str | None = None,
+                freq_hz=None) -> tuple[FRF, np.ndarray, list[str]]:
+    """Tool-point receptance of a tool (D, L in mm) on a campaign's holder or an assembly's spindle–holder.
+
+    ``source``: a campaign folder (tool family and subassembly from it) or an
+    assembly TOML (spindle, holder and spindle–holder joint from it; the tool a
+    cylinder of D with 0.8 D flutes over 2 D, in the file's tool material).
+    """
+    joint, notes = predict_joint(models_dir, diameter_mm, overhang_mm)
+    src = Path(source)
+    if src.is_dir():
+        c = load_campaign(src)
+        name = holder or next(iter(c.holders))
+        if name not in c.holders:
+            raise InputError(f"unknown holder {name!r} (one of {', '.join(c.holders)})", file=c.toml, field="--holder")
+        lo, hi = c.band_hz
+        if c.holders[name].kind == "model":
+            f = np.arange(lo, hi + 0.5) if freq_hz is None else np.asarray(freq_hz, float)
+            sub = c.subassembly(name, f)
+        else:
+            sub = c.subassembly(name, None)
+            sub = sub if freq_hz is None else sub.at(freq_hz)
+        tool = c.family.tool(diameter_mm, overhang_mm)
+    else:
+        a: Assembly = load_assembly(src, require_tool=False)
+        f = a.frequency.array() if freq_hz is None else np.asarray(freq_hz, float)
+        f = f[f > 0]
+        sub = Subassembly.from_assembly(a, f)
+        mat = a.tool.segments[0].material if a.tool is not None else a.materials["steel"]
+        tool = ToolFamily(mat).tool(diameter_mm, overhang_mm)
+    h = ToolPointModel(tool, sub, sub.freq_hz).tool_point(joint)
+    frf = FRF(sub.freq_hz, h, "receptance", f"predicted D{diameter_mm:g} L{overhang_mm:g}")
+    return frf, joint, notes

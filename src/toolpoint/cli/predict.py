@@ -1,0 +1,51 @@
+"""``toolpoint predict ASSEMBLY_OR_CAMPAIGN --diameter D --overhang L --models DIR --out FRF.csv [--plot PNG]``."""
+
+from __future__ import annotations
+
+import sys
+
+from ..errors import InputError
+from ..frfio import write_frf
+from ..objective import PARAMS, UNITS
+from .common import out_path, save_figure, use_agg, warnings_to_stderr
+
+
+def register(sub) -> None:
+    p = sub.add_parser("predict", help="tool-point FRF of an unmeasured tool from the ANFIS-predicted joint")
+    p.add_argument("source", help="campaign folder or assembly TOML (spindle, holder, spindle–holder joint)")
+    p.add_argument("--diameter", type=float, required=True, help="tool diameter D, mm")
+    p.add_argument("--overhang", type=float, required=True, help="tool overhang L, mm")
+    p.add_argument("--models", required=True, help="models folder from `toolpoint campaign learn`")
+    p.add_argument("--holder", help="holder name (campaigns with several)")
+    p.add_argument("--out", required=True, help="FRF file (.csv, .uff or .frf; receptance m/N)")
+    p.add_argument("--plot", help="figure of the predicted FRF")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..campaign.predict import predict_frf
+
+    for name in ("diameter", "overhang"):
+        if not getattr(args, name) > 0:
+            raise InputError("must be > 0 (mm)", file="command line", field=f"--{name}")
+    out = out_path(args.out, "--out")
+    plot = out_path(args.plot, "--plot") if args.plot else None
+    with warnings_to_stderr():
+        frf, joint, notes = predict_frf(args.source, args.diameter, args.overhang, args.models, holder=args.holder)
+    for n in notes:
+        print(f"note: {n}", file=sys.stderr)
+    fig = None
+    if plot:
+        use_agg()
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(2, 1, sharex=True, figsize=(7, 5.5), constrained_layout=True)
+        frf.plot(ax=ax)
+        ax[0].set_title(f"predicted tool point: D {args.diameter:g} mm, L {args.overhang:g} mm")
+    write_frf(out, frf)
+    if fig is not None:
+        save_figure(fig, plot)
+    f_pk, h_pk = frf.peak()
+    print("predicted joint: " + ", ".join(f"{p} = {v:.4g} {UNITS[p]}" for p, v in zip(PARAMS, joint)))
+    print(f"dominant peak {f_pk:g} Hz, |h| = {h_pk:.4g} m/N → {out}")
+    return 0
