@@ -232,3 +232,18 @@ def test_bad_input(tmp_path):
     with pytest.raises(InputError) as err:
         learn(broken, test_size=10, **quiet)
     assert err.value.field == "kt" and "line 7" in str(err.value)
+
+
+def test_rows_where_a_target_was_not_identified_are_not_learned(tmp_path):
+    """A fit that ran to a bound (wide interval) is not data about the joint: left out of that target."""
+    rows = identified_rows(n=80, n_failed=0)
+    for k in (3, 7, 11):  # absurd kt with a wide interval, as a fit stuck at the upper bound gives
+        rows[k]["kt"], rows[k]["kt_lo"], rows[k]["kt_hi"] = "1e9", "1e7", "1e11"
+    folder = write_identified(tmp_path, rows)
+    lines = []
+    r = learn(folder, test_size=20, mfs=(2, 2), epochs=20, targets=["kt"], baselines=False, plots=False,
+              out=lines.append)
+    m = r["metrics"]["kt"]["anfis"]
+    assert m["train"]["n"] + m["test"]["n"] == 77
+    assert any("kt:" in s and "left out" in s for s in lines)
+    assert m["test"]["mape"] < 10  # the outliers did not poison the fit

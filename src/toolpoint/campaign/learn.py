@@ -80,6 +80,8 @@ IDENTIFIABLE_SHARE = 0.8
 OVERFIT_RATIO = 2.0
 #: Extra ok rows needed beyond the test set (the training set must support the grid).
 MIN_TRAIN = 10
+#: A target is learned only from rows where it was identified; it needs this many training rows.
+MIN_RELIABLE = 20
 
 #: Keys of the metrics (JSON/CSV/return value) → (column title, function). MAPE and max APE in %.
 METRICS = {key: (title, fn) for key, (title, fn) in zip(("nrmse", "afv", "mape", "max_ape"), PAPER_METRICS)}
@@ -329,17 +331,21 @@ def learn(
     values = {t: np.array([_number(path, line, row, t, required=False) for line, row in ok]) for t in candidates}
 
     # identifiability: share of ok rows with a narrow 95 % interval, per parameter
-    share = {}
+    share, narrow = {}, {}
     for t in ALL_TARGETS:
         lo_c, hi_c = f"{t}_lo", f"{t}_hi"
         if rows and lo_c in rows[0][1] and hi_c in rows[0][1]:
             lo = np.array([_number(path, line, row, lo_c, required=False) for line, row in ok])
             hi = np.array([_number(path, line, row, hi_c, required=False) for line, row in ok])
             share[t] = _narrow_share(lo, hi)
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                narrow[t] = (lo > 0) & np.isfinite(hi) & (hi / np.where(lo > 0, lo, 1.0) <= IDENTIFIABLE_RATIO)
 
     excluded = {}
     chosen = []
     for t in candidates:
+        # A damping identified in only a few rows would be learned from a corner of the
+        # (D, L) plane and extrapolated everywhere else (measured: negative predictions).
         if t in DAMPING and t in share and share[t] < IDENTIFIABLE_SHARE:
             why = (
                 f"{t} not identifiable: only {100 * share[t]:.0f} % of the {len(ok)} ok rows have a 95 % interval "
@@ -349,7 +355,7 @@ def learn(
                 excluded[t] = why
                 out(f"{t} left out: {why}")
                 continue
-            out(f"note: {why}; learned anyway because it was asked for")
+            out(f"note: {why}; learned anyway (from those rows only) because it was asked for")
         chosen.append(t)
         bad = np.flatnonzero(~np.isfinite(values[t]))
         if bad.size:
@@ -435,7 +441,20 @@ def learn(
 
     for t in chosen:
         y = values[t]
-        ytr, yte = y[train_idx], y[test_idx]
+        # Rows whose identification did not pin this parameter down (95 % interval wider
+        # than a factor IDENTIFIABLE_RATIO, e.g. a fit that ran to a bound) are not data
+        # about the joint: they are left out of this target's training and test sets.
+        keep = narrow.get(t, np.ones(len(ok), bool))
+        t_tr, t_te = train_idx[keep[train_idx]], test_idx[keep[test_idx]]
+        if keep.sum() < len(ok):
+            out(f"{t}: {len(train_idx) - t_tr.size} training and {len(test_idx) - t_te.size} test rows left out "
+                f"(95 % interval wider than a factor {IDENTIFIABLE_RATIO:g}: not identified)")
+        if t_tr.size < MIN_RELIABLE or t_te.size == 0:
+            excluded[t] = f"{t}: too few identified rows ({t_tr.size} train, {t_te.size} test)"
+            out(f"{t} left out: {excluded[t]}")
+            continue
+        Xtr, Xte = X[t_tr], X[t_te]
+        ytr, yte = y[t_tr], y[t_te]
         if log_target and np.any(ytr <= 0):
             raise InputError("log_target needs positive values", file=path, field=t)
         model = ANFIS(

@@ -76,9 +76,9 @@ def predict_joint(models_dir, diameter_mm: float, overhang_mm: float) -> tuple[n
         for p in PARAMS:
             if p in models:
                 v = float(models[p].predict(x)[0])
-                if not v > 0:
-                    raise InputError(f"the {p} model predicts {v:.4g} ≤ 0 here (extrapolated too far?)",
-                                     file=d / f"{p}.json")
+                if not (v > 0 and np.isfinite(v)):
+                    raise InputError(f"the {p} model predicts {v:.4g} here, not a positive finite value "
+                                     "(over-fitted, or extrapolated too far?)", file=d / f"{p}.json")
             else:
                 med = _median_identified(d) if med is None else med
                 if p not in med:

@@ -16,8 +16,8 @@ def register(sub) -> None:
     s.add_argument("--n", type=int, default=178, help="number of tool assemblies (default 178)")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--noise", type=float, default=0.01, help="tool-point FRF noise, fraction of the peak (default 0.01)")
-    s.add_argument("--blank-noise", type=float, default=2e-4,
-                   help="noise of the blank FRFs for inverse RCSA, fraction of the peak (default 2e-4)")
+    s.add_argument("--blank-noise", type=float, default=5e-5,
+                   help="noise of the blank FRFs for inverse RCSA, fraction of the peak (default 5e-5)")
     s.add_argument("--format", choices=("csv", "uff"), default="csv", help="FRF file format (default csv)")
     s.set_defaults(func=_synth)
 
