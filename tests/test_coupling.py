@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from toolpoint.assembly import Component, Joint, Material, Segment
+from toolpoint.assembly import Component, Material, Segment
 from toolpoint.components import end_receptances
-from toolpoint.coupling import ToolPointCoupler, couple
+from toolpoint.coupling import couple
 from toolpoint.fe import FEModel, tool_point_fe
 from toolpoint.model import AssemblyModel
 

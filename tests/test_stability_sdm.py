@@ -7,7 +7,7 @@ from scipy.linalg import expm
 import toolpoint.stability.sdm as sdm_mod
 from toolpoint.errors import InputError
 from toolpoint.stability import ModalModel, average_directional_matrix, sdm_lobes, sdm_spectral_radius, zoa_lobes
-from toolpoint.stability.sdm import STEPS_PER_WAVE, expm_batch
+from toolpoint.stability.sdm import expm_batch
 
 # Benchmark of Insperger & Stépán (2004): 2 teeth, Kt = 6e8, Kn = 2e8 N/m²,
 # f_n = 922 Hz, ζ = 0.011, m = 0.03993 kg, flexible in x only, down-milling.
