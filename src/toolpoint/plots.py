@@ -29,7 +29,7 @@ def fit_figure(measured: FRF, fitted: dict[str, FRF], histories: dict[str, np.nd
             if h.size:
                 a2.loglog(np.arange(1, h.size + 1), h, label=name)
         a2.set_xlabel("iteration (generation)")
-        a2.set_ylabel("best objective ‖h − h̄‖ [m/N]")
+        a2.set_ylabel("best objective ‖h − h_meas‖ [m/N]")
         a2.grid(True, which="both", alpha=0.3)
         a2.legend(fontsize="small")
     return fig
