@@ -75,3 +75,17 @@ def test_good_base_runs(tmp_path):
 def test_missing_file(tmp_path, capsys):
     assert main(["frf", str(tmp_path / "nope.toml"), "--out", str(tmp_path / "o.csv")]) == 2
     assert re.search(r"nope\.toml: file not found", capsys.readouterr().err)
+
+
+def test_output_format_follows_the_extension(tmp_path, example_path, capsys):
+    from toolpoint.frfio import read_frf
+
+    uff = tmp_path / "frf.uff"
+    assert main(["frf", str(example_path), "--out", str(uff)]) == 0
+    csv_ = tmp_path / "frf.csv"
+    assert main(["frf", str(example_path), "--out", str(csv_)]) == 0
+    a, b = read_frf(uff), read_csv_frf(csv_)
+    assert np.allclose(a.values, b.values, rtol=5e-12, atol=0)  # UFF58 ASCII keeps 12 digits
+    bad = tmp_path / "frf.xyz"
+    assert main(["frf", str(example_path), "--out", str(bad)]) == 2
+    assert "--out" in capsys.readouterr().err and not bad.exists()

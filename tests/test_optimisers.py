@@ -55,7 +55,6 @@ def test_ga_beats_the_paper(case, seed):
     e = relative_errors(r.x, exact)
     assert all(_beats("ga", e).values()), e
     assert r.nit < GA().generations  # stopped on the stall test, not the cap
-    assert r.seconds < 15
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -66,7 +65,6 @@ def test_sa_beats_the_paper(case, seed):
     e = relative_errors(r.x, exact)
     assert all(_beats("sa", e).values()), e
     assert r.reanneals > 0
-    assert r.seconds < 5
 
 
 def test_ga_short_run_already_beats_the_paper(case):

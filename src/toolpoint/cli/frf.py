@@ -5,7 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..assembly import load_assembly
-from ..frfio import write_csv_frf
+from ..errors import InputError
+from ..frfio import write_frf
 from ..model import AssemblyModel
 from .common import out_path, save_figure, use_agg, warnings_to_stderr
 
@@ -13,7 +14,7 @@ from .common import out_path, save_figure, use_agg, warnings_to_stderr
 def register(sub) -> None:
     p = sub.add_parser("frf", help="tool-point (or holder-tip) receptance of an assembly by RCSA")
     p.add_argument("assembly", help="assembly TOML file")
-    p.add_argument("--out", required=True, help="CSV file to write (freq_hz,real,imag; m/N)")
+    p.add_argument("--out", required=True, help="FRF file to write, receptance m/N: .csv (freq_hz,real,imag), .uff or .frf")
     p.add_argument("--plot", help="PNG/PDF/SVG file with magnitude and phase")
     p.add_argument(
         "--point",
@@ -26,6 +27,8 @@ def register(sub) -> None:
 
 def run(args) -> int:
     out = out_path(args.out, "--out")
+    if out.suffix.lower() not in (".csv", ".uff", ".unv", ".uf", ".frf"):
+        raise InputError("use .csv, .uff/.unv or .frf (the format follows the extension)", file=out, field="--out")
     plot = out_path(args.plot, "--plot") if args.plot else None
     with warnings_to_stderr():
         assembly = load_assembly(args.assembly, require_holder_tool=(args.point == "tool"))
@@ -38,7 +41,7 @@ def run(args) -> int:
         fig, ax = plt.subplots(2, 1, sharex=True, figsize=(7, 5.5), constrained_layout=True)
         frf.plot(ax=ax, label=f"{frf.label} — {Path(args.assembly).name}")
         ax[0].set_title("RCSA receptance h = y/F")
-    write_csv_frf(out, frf)
+    write_frf(out, frf)
     if plot:
         save_figure(fig, plot)
     f_pk, h_pk = frf.peak()
