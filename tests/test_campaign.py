@@ -108,3 +108,29 @@ def test_band_outside_the_subassembly_is_refused_per_item(small, tmp_path):
     rows = {x["id"]: x for x in _rows(tmp_path / "res" / "identified.csv")}
     assert rows["T002"]["status"] == "failed" and "no extrapolation" in rows["T002"]["error"]
     assert r["failed"] == 1
+
+
+def test_blank_subassembly_with_modal_fit(small, tmp_path):
+    """synth's campaign.toml asks for smooth = "modal": the blank FRFs' noise goes, the peaks stay."""
+    from toolpoint.assembly import load_assembly
+    from toolpoint.subassembly import Subassembly
+
+    c = load_campaign(small)
+    sub = c.subassembly("ER40", None)
+    assert "modal fit" in sub.label
+    true = Subassembly.from_assembly(load_assembly(small / "truth" / "spindle_holder.toml", require_tool=False),
+                                     sub.freq_hz)
+    err = np.abs(sub.R - true.R) / np.abs(true.R)
+    assert np.median(err[:, 0, 0]) < 2e-3 and np.median(err[:, 1, 1]) < 1e-2
+    assert np.abs(sub.R[:, 0, 0]).max() == pytest.approx(np.abs(true.R[:, 0, 0]).max(), rel=1e-2)
+
+    bad = tmp_path / "c"
+    shutil.copytree(small, bad)
+    text = (bad / "campaign.toml").read_text()
+    for repl, field in (('smooth = "spline"', "holders.ER40.blank.smooth"),
+                        ('smooth = "modal", smooth_hz = 50', "holders.ER40.blank"),
+                        ("smooth_hz = -5", "holders.ER40.blank.smooth_hz")):
+        (bad / "campaign.toml").write_text(text.replace('smooth = "modal"', repl))
+        with pytest.raises(InputError) as e:
+            load_campaign(bad)
+        assert e.value.field == field

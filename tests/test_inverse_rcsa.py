@@ -293,3 +293,28 @@ def test_subassembly_from_files_and_model(example, tmp_path):
         subassembly_from_files(tmp_path / "h0.csv", tmp_path / "n0.csv", tmp_path / "n0.csv", tmp_path / "n0.csv")
     with pytest.raises(InputError):
         subassembly_from_files(tmp_path / "missing.csv", paths["l"], paths["n"], paths["p"])
+
+
+@pytest.mark.parametrize("level", [1e-4, 1e-3])
+def test_modal_fit_removes_noise_and_keeps_the_peaks(example, blank50, true_noise, level):
+    """smooth="modal": the three FRFs get one common-pole fit before the inversion.
+
+    Against Savitzky–Golay (25 Hz), which trades noise for rounded peaks: the
+    example's subassembly has a 9 Hz wide mode at 790 Hz, its largest |h|.
+    Measured, median relative error of h, l, p at 1e-3 noise: raw 16, 51, 51 %;
+    Savitzky–Golay 4.6, 16, 16 % with the peak of |h| cut to 0.73; modal 0.39,
+    2.0, 1.8 % with the peak within 0.04 % (1e-4 noise: ten times smaller).
+    """
+    rng = np.random.default_rng(11)
+    noisy = add_noise(measured(example, blank50, 0.04, F_NOISE), level, rng)
+    raw = subassembly_from_blank(blank50, 0.04, *noisy)
+    sg = subassembly_from_blank(blank50, 0.04, *noisy, smooth=25.0)
+    modal = subassembly_from_blank(blank50, 0.04, *noisy, smooth="modal")
+    peak = lambda s: np.abs(s.R[:, 0, 0]).max() / np.abs(true_noise.R[:, 0, 0]).max()  # noqa: E731
+    assert np.all(median_rel(modal, true_noise) < 0.1 * median_rel(raw, true_noise))
+    assert np.all(median_rel(modal, true_noise) < 0.3 * median_rel(sg, true_noise))
+    assert abs(peak(modal) - 1) < 0.01
+    assert abs(peak(sg) - 1) > 0.1
+    assert "modal fit" in modal.label
+    with pytest.raises(InputError, match="smooth"):
+        subassembly_from_blank(blank50, 0.04, *noisy, smooth="spline")

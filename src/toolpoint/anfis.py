@@ -279,10 +279,10 @@ def _design(wbar, Xe):
     return (wbar[:, :, None] * Xe[:, None, :]).reshape(n, -1)
 
 
-def _premise_gradient(nus, inv_s, dmus, rule_out, f, t):
-    """∇E w.r.t. each input's MF parameters, E = Σ (t − f)²; list of (m_i, p)."""
+def _premise_gradient(nus, inv_s, dmus, rule_out, f, t, sw):
+    """∇E w.r.t. each input's MF parameters, E = Σ s_n (t − f)²; list of (m_i, p)."""
     n, d = f.shape[0], len(nus)
-    dE_df = -2.0 * (t - f)
+    dE_df = -2.0 * sw * (t - f)
     Y = rule_out.reshape((n,) + tuple(nu.shape[1] for nu in nus))
     grads = []
     for i in range(d):
@@ -436,8 +436,15 @@ class ANFIS(RegressorMixin, BaseEstimator):
         return np.sum(_firing(nus) * self._rule_outputs(X), axis=1)
 
     # ---------------------------------------------------------------- API
-    def fit(self, X, y, X_val=None, y_val=None):
-        """Train by hybrid learning; see the module docstring for the algorithm."""
+    def fit(self, X, y, X_val=None, y_val=None, sample_weight=None):
+        """Train by hybrid learning; see the module docstring for the algorithm.
+
+        ``sample_weight`` (n,) ≥ 0, optional: weighted least squares, E = Σ s_n (t_n − f_n)²
+        in both the consequent solve and the premise gradient, and the training
+        RMSE is the weighted one, sqrt(Σ s e² / Σ s) — e.g. s_n = 1/σ_n² for targets
+        known to different precision (identified joints with their intervals).
+        Not in MATLAB's anfis; None (default) is exactly the unweighted algorithm.
+        """
         cols = getattr(X, "columns", None)
         y_name = getattr(y, "name", None)
         # numeric, finite, 2-D X and 1-D y (a column vector y is ravelled with a warning)
@@ -445,6 +452,16 @@ class ANFIS(RegressorMixin, BaseEstimator):
         n, d = X.shape
         if n < 2:
             raise ValueError(f"ANFIS needs at least 2 samples, got n_samples = {n}")
+        if sample_weight is None:
+            sw = np.ones(n)
+        else:
+            sw = np.asarray(sample_weight, dtype=float).reshape(-1)
+            if sw.size != n or np.any(~np.isfinite(sw)) or np.any(sw < 0):
+                raise ValueError(f"sample_weight must be {n} finite values ≥ 0, got shape {sw.shape}")
+            if np.count_nonzero(sw) < 2:
+                raise ValueError("sample_weight: fewer than 2 weights are non-zero")
+            sw = sw / sw.mean()
+        rw = np.sqrt(sw)
         n_mfs = self._check_params(d)
         t = self._transform_target(t_raw)
 
@@ -462,7 +479,8 @@ class ANFIS(RegressorMixin, BaseEstimator):
                 raise ValueError(f"X_val has {Xv.shape[1]} columns but X has {d}")
             tv = self._transform_target(_as_target(y_val, Xv.shape[0], "y_val"), "y_val")
 
-        lo, hi = X.min(axis=0), X.max(axis=0)
+        used = X[sw > 0]  # a zero-weight sample is as if absent, also for the MF layout
+        lo, hi = used.min(axis=0), used.max(axis=0)
         names = self.input_names if self.input_names is not None else cols
         names = None if names is None else [str(s) for s in names]
         if names is not None and len(names) != d:
@@ -487,12 +505,12 @@ class ANFIS(RegressorMixin, BaseEstimator):
             # 1. consequents by least squares, premise fixed
             nus, inv_s, dmus = _premise_layer(kind, premise, X, grad=True)
             wbar = _firing(nus)
-            theta = np.linalg.lstsq(_design(wbar, Xe), t, rcond=None)[0]
+            theta = np.linalg.lstsq(_design(wbar, Xe) * rw[:, None], t * rw, rcond=None)[0]
             C = theta.reshape(-1, q)
             rule_out = Xe @ C.T
             f = np.sum(wbar * rule_out, axis=1)
             # 2. errors for these parameters; remember the best
-            e_trn = float(np.sqrt(np.mean((t - f) ** 2)))
+            e_trn = float(np.sqrt(np.mean(sw * (t - f) ** 2)))
             train_rmse.append(e_trn)
             if has_val:
                 nv, _, _ = _premise_layer(kind, premise, Xv)
@@ -508,7 +526,7 @@ class ANFIS(RegressorMixin, BaseEstimator):
             if min(train_rmse) <= self.tol:  # MATLAB's error goal
                 break
             # 3. one normalised gradient step on the premise, consequents fixed
-            grads = _premise_gradient(nus, inv_s, dmus, rule_out, f, t)
+            grads = _premise_gradient(nus, inv_s, dmus, rule_out, f, t, sw)
             norm = float(np.sqrt(sum(np.sum(g**2) for g in grads)))
             if norm > 0:
                 premise = [_make_valid(kind, P - kappa * g / norm, span[i]) for i, (P, g) in enumerate(zip(premise, grads))]

@@ -86,11 +86,12 @@ from .components import CHAIN_LIMIT, assemble, chain_growth, mesh, receptance
 from .errors import InputError
 from .frf import FRF
 from .frfio import read_frf
+from .polefit import fit_common_poles
 from .subassembly import Subassembly
 
 __all__ = [
     "blank_receptances", "blank_frfs", "subassembly_from_blank", "subassembly_from_files",
-    "subassembly_from_assembly", "smooth_subassembly", "sensitivity", "noise_std", "Conditioning",
+    "subassembly_from_assembly", "smooth_subassembly", "modal_smooth_subassembly", "sensitivity", "noise_std", "Conditioning",
     "conditioning",
 ]
 
@@ -255,8 +256,10 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
         (converted to receptance, m/N); all on one grid of frequencies > 0.
     G21 : optional second cross FRF (y2/F1); if given, G12 is replaced by the mean
         (G12 + G21)/2 (reciprocity), which halves that FRF's noise variance.
-    smooth : None, or a Savitzky–Golay window in Hz applied to the result
-        (:func:`smooth_subassembly`, ``polyorder``).
+    smooth : None; ``"modal"`` — the three FRFs are first replaced by a common-pole
+        modal fit (:func:`toolpoint.polefit.fit_common_poles`), which removes the
+        noise and keeps the peaks (recommended); or a Savitzky–Golay window in Hz
+        applied to the result (:func:`smooth_subassembly`, ``polyorder``).
 
     Returns a :class:`Subassembly` on the FRFs' grid: h m/N, l 1/N, n rad/N,
     p rad/(N m), with l = n. See the module docstring for the equations.
@@ -273,15 +276,29 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
                          "drop 0 Hz with .band(fmin=...)", field="G11")
     g = {k: v.to_receptance().values for k, v in given.items()}
     g12 = 0.5 * (g["G12"] + g["G21"]) if G21 is not None else g["G12"]
+    Gm = np.stack([g["G11"], g12, g["G22"]], -1)
+    label = ""
+    if _is_modal(smooth):
+        fit = fit_common_poles(f, Gm)
+        Gm = fit(f)
+        label = f", modal fit ({fit.n_modes} modes)"
     R = blank_receptances(blank, x2_m, f)
-    d = np.stack([R[:, a, b, 0, 0] for a, b in _PAIRS], -1) - np.stack([g["G11"], g12, g["G22"]], -1)
+    d = np.stack([R[:, a, b, 0, 0] for a, b in _PAIRS], -1) - Gm
     x = np.linalg.solve(_system(R), d[..., None])[..., 0]
     X = np.stack([x[:, :2], x[:, 1:]], 1)  # [[X00, X01], [X01, X11]]
     SH = inv2(X) - R[:, ROOT, ROOT]
     SH[:, 1, 0] = SH[:, 0, 1] = 0.5 * (SH[:, 0, 1] + SH[:, 1, 0])  # equal up to round-off
     sub = Subassembly(f, SH, f"spindle–holder (inverse RCSA, blank {blank.length * 1e3:g} mm, "
-                             f"x2 {float(x2_m) * 1e3:g} mm)")
-    return sub if smooth is None else smooth_subassembly(sub, smooth, polyorder)
+                             f"x2 {float(x2_m) * 1e3:g} mm{label})")
+    return sub if smooth is None or _is_modal(smooth) else smooth_subassembly(sub, float(smooth), polyorder)
+
+
+def _is_modal(smooth) -> bool:
+    if isinstance(smooth, str):
+        if smooth != "modal":
+            raise InputError(f"smooth must be \"modal\" or a window in Hz, got {smooth!r}", field="smooth")
+        return True
+    return False
 
 
 # --------------------------------------------------------------------------- other sources
@@ -293,7 +310,7 @@ def subassembly_from_assembly(assembly: Assembly, freq_hz) -> Subassembly:
     return Subassembly.from_assembly(assembly, freq_hz)
 
 
-def subassembly_from_files(h, l, n, p, *, smooth: float | None = None, polyorder: int = 3) -> Subassembly:
+def subassembly_from_files(h, l, n, p, *, smooth: float | str | None = None, polyorder: int = 3) -> Subassembly:
     """The subassembly from four FRF files (any format :func:`~toolpoint.frfio.read_frf` reads).
 
     Each file holds one entry of SH = [[h, l], [n, p]] at the holder tip, written
@@ -302,7 +319,8 @@ def subassembly_from_files(h, l, n, p, *, smooth: float | None = None, polyorder
     nominal m/N label is not checked against them (a mobility or accelerance file
     is converted by iω or −ω² as usual). All four must be on the same grid of
     frequencies > 0; otherwise :class:`InputError` names the file. l and n are
-    kept as given (reciprocity l = n is not enforced).
+    kept as given (reciprocity l = n is not enforced). ``smooth``: None, ``"modal"``
+    (:func:`modal_smooth_subassembly`) or a Savitzky–Golay window in Hz.
     """
     paths = {"h": h, "l": l, "n": n, "p": p}
     frfs = {k: read_frf(v) for k, v in paths.items()}
@@ -318,10 +336,25 @@ def subassembly_from_files(h, l, n, p, *, smooth: float | None = None, polyorder
     R = np.stack([np.stack([frfs["h"].values, frfs["l"].values], -1),
                   np.stack([frfs["n"].values, frfs["p"].values], -1)], 1)
     sub = Subassembly(f, R, f"spindle–holder (files {Path(str(h)).name}, …)")
-    return sub if smooth is None else smooth_subassembly(sub, smooth, polyorder)
+    if smooth is None:
+        return sub
+    return modal_smooth_subassembly(sub) if _is_modal(smooth) else smooth_subassembly(sub, float(smooth), polyorder)
 
 
 # --------------------------------------------------------------------------- smoothing
+def modal_smooth_subassembly(sub: Subassembly) -> Subassembly:
+    """h, l, n, p replaced by one common-pole modal fit (:mod:`toolpoint.polefit`).
+
+    For a subassembly that is already noisy (e.g. four measured files). With a
+    blank, ``subassembly_from_blank(..., smooth="modal")`` fits the measured
+    FRFs instead, before the noise is amplified, which is better.
+    """
+    Y = sub.R.reshape(-1, 4)
+    fit = fit_common_poles(sub.freq_hz, Y)
+    return Subassembly(sub.freq_hz, fit(sub.freq_hz).reshape(-1, 2, 2),
+                       f"{sub.label}, modal fit ({fit.n_modes} modes)")
+
+
 def smooth_subassembly(sub: Subassembly, window_hz: float, polyorder: int = 3, entries: str = "hlnp") -> Subassembly:
     """Savitzky–Golay smoothing of the ``entries`` (real and imaginary parts) over frequency.
 

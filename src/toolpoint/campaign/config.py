@@ -15,8 +15,10 @@
     [holders.ER40]                  # one entry per holder/collet; the subassembly comes from
     model = "spindle_holder.toml"   #   a model (spindle + holder + spindle–holder joint), or
     # blank = { segments = [{ length_mm = 50, od_mm = 20 }], x2_mm = 40,
-    #           G11 = "sh/G11.csv", G12 = "sh/G12.csv", G22 = "sh/G22.csv", smooth_hz = 25 }
+    #           G11 = "sh/G11.csv", G12 = "sh/G12.csv", G22 = "sh/G22.csv", smooth = "modal" }
     # files = { h = "h.csv", l = "l.csv", n = "n.csv", p = "p.csv" }
+    # smooth = "modal": common-pole modal fit of the measured FRFs (noise out, peaks
+    # kept; recommended); smooth_hz = 25: Savitzky–Golay window (rounds sharp peaks)
     [identify]
     method = "hybrid"
     bounds = { kt = [1e6, 1e9] }    # optional, the paper's by default
@@ -34,10 +36,20 @@ from pathlib import Path
 
 import numpy as np
 
-from ..assembly import MM, Component, Material, Segment, _materials, _Reader, _segments, load_assembly, load_toml
+from ..assembly import (
+    MM,
+    Component,
+    Material,
+    Segment,
+    _materials,
+    _Reader,
+    _segments,
+    load_assembly,
+    load_toml,
+)
 from ..errors import InputError
 from ..frfio import read_frf
-from ..inverse_rcsa import smooth_subassembly, subassembly_from_blank, subassembly_from_files
+from ..inverse_rcsa import subassembly_from_blank, subassembly_from_files
 from ..objective import Bounds
 from ..subassembly import Subassembly
 
@@ -99,21 +111,61 @@ class Campaign:
         if src.kind == "model":
             a = load_assembly(self.folder / src.spec["path"], require_tool=False)
             return Subassembly.from_assembly(a, np.asarray(freq_hz, float))
-        if src.kind == "files":
-            sub = subassembly_from_files(*(self.folder / src.spec[k] for k in "hlnp"))
-        else:
-            r = _Reader(str(self.toml))
-            blank = Component("blank", _segments(r, src.spec, where, self.materials))
-            G = [read_frf(self.folder / src.spec[k]) for k in ("G11", "G12", "G22")]
-            sub = subassembly_from_blank(blank, float(src.spec["x2_mm"]) * MM, *G)
-            if src.spec.get("smooth_hz"):
-                sub = smooth_subassembly(sub, float(src.spec["smooth_hz"]))
+        sub = self._measured_subassembly(name)
         if freq_hz is None:
             return sub
         try:
             return sub.at(np.asarray(freq_hz, float))
         except ValueError as e:
             raise InputError(str(e), file=self.toml, field=where) from None
+
+
+    def _measured_subassembly(self, name: str) -> Subassembly:
+        src = self.holders[name]
+        keys = [self.folder / src.spec[k] for k in (("G11", "G12", "G22") if src.kind == "blank" else tuple("hlnp"))]
+        # a modal fit takes seconds: remember it while its input files are unchanged
+        memo = (str(self.toml.resolve()), name, repr(sorted(src.spec.items())),
+                tuple(_stamp(p) for p in keys + [self.toml]))
+        if memo in _MEMO:
+            return _MEMO[memo]
+        smooth = src.spec.get("smooth")
+        if src.kind == "files":
+            sub = subassembly_from_files(*keys, smooth=smooth)
+        else:
+            r = _Reader(str(self.toml))
+            blank = Component("blank", _segments(r, src.spec, f"holders.{name}.blank", self.materials))
+            sub = subassembly_from_blank(blank, float(src.spec["x2_mm"]) * MM, *(read_frf(p) for p in keys),
+                                         smooth=smooth)
+        _MEMO.clear()  # one holder set at a time is enough
+        _MEMO[memo] = sub
+        return sub
+
+
+_MEMO: dict = {}
+
+
+def _stamp(path: Path):
+    try:
+        st = path.stat()
+    except OSError:
+        return None  # read_frf raises the one-line error
+    return st.st_mtime_ns, st.st_size
+
+
+def _smooth(r: _Reader, spec: dict, path: str):
+    """``smooth = "modal"`` or a Savitzky–Golay window ``smooth_hz`` (> 0); at most one."""
+    if "smooth" in spec and "smooth_hz" in spec:
+        raise r.err(path, "give smooth or smooth_hz, not both")
+    if "smooth" in spec:
+        if spec["smooth"] != "modal":
+            raise r.err(f"{path}.smooth", f'must be "modal" (or use smooth_hz = window in Hz), got {spec["smooth"]!r}')
+        return "modal"
+    if "smooth_hz" in spec:
+        v = spec["smooth_hz"]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (0 < v < math.inf):
+            raise r.err(f"{path}.smooth_hz", f"must be a window > 0 Hz, got {v!r}")
+        return float(v)
+    return None
 
 
 def _band(r: _Reader, doc: dict) -> tuple[float, float]:
@@ -161,9 +213,10 @@ def _holders(r: _Reader, doc: dict, folder: Path) -> dict[str, HolderSource]:
             out[name] = HolderSource(name, kind, {"path": str(spec["model"])})
         elif kind == "files":
             f = spec["files"]
-            if not isinstance(f, dict) or set(f) != set("hlnp"):
-                raise r.err(f"{path}.files", "must be {h = …, l = …, n = …, p = …}")
-            out[name] = HolderSource(name, kind, dict(f))
+            if not isinstance(f, dict) or set(f) - {"smooth", "smooth_hz"} != set("hlnp"):
+                raise r.err(f"{path}.files", 'must be {h = …, l = …, n = …, p = …} (optionally smooth = "modal")')
+            out[name] = HolderSource(name, kind, {**{k: f[k] for k in "hlnp"},
+                                                  "smooth": _smooth(r, f, f"{path}.files")})
         else:
             b = spec["blank"]
             if not isinstance(b, dict):
@@ -171,7 +224,9 @@ def _holders(r: _Reader, doc: dict, folder: Path) -> dict[str, HolderSource]:
             for k in ("segments", "x2_mm", "G11", "G12", "G22"):
                 if k not in b:
                     raise r.err(f"{path}.blank.{k}", "missing value")
-            out[name] = HolderSource(name, kind, dict(b))
+            sm = _smooth(r, b, f"{path}.blank")
+            out[name] = HolderSource(name, kind, {**{k: v for k, v in b.items() if k not in ("smooth", "smooth_hz")},
+                                                  "smooth": sm})
     return out
 
 

@@ -2,9 +2,9 @@
 
 ANFIS models (one JSON per target, from ``toolpoint campaign learn``) give
 kt, kr — and ct, cr where they were identifiable — from (diameter_mm,
-overhang_mm). A damping without a model takes the median of the identified
-values of the campaign (``identified.csv`` beside the models folder), which is
-said in the returned notes. RCSA then couples the tool to the subassembly.
+overhang_mm). A parameter without a model takes its campaign median
+(:func:`_median_identified`, from ``identified.csv`` beside the models
+folder), which is said in the returned notes. RCSA then couples the tool to the subassembly.
 """
 
 from __future__ import annotations
@@ -43,13 +43,34 @@ def load_models(models_dir) -> dict[str, ANFIS]:
     return models
 
 
-def _median_identified(models_dir: Path) -> dict[str, float]:
+def _median_identified(models_dir: Path) -> dict[str, tuple[float, str]]:
+    """Per parameter: (median, what it is the median of) over the campaign's ok rows —
+    the rows where the parameter was identified (95 % interval within a factor 2) if
+    there are at least 3, else all ok rows."""
     path = models_dir.parent / "identified.csv"
     if not path.exists():
         return {}
     with open(path, newline="") as fh:
         rows = [r for r in csv.DictReader(fh) if r.get("status") == "ok"]
-    return {p: float(np.median([float(r[p]) for r in rows])) for p in PARAMS if rows}
+    out = {}
+    for p in PARAMS:
+        v = np.array([_float(r.get(p)) for r in rows])
+        lo = np.array([_float(r.get(f"{p}_lo")) for r in rows])
+        hi = np.array([_float(r.get(f"{p}_hi")) for r in rows])
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            ident = np.isfinite(v) & (lo > 0) & (hi / lo <= 2.0)
+        if ident.sum() >= 3:
+            out[p] = (float(np.median(v[ident])), f"median of the {int(ident.sum())} tools where it was identified")
+        elif np.isfinite(v).any():
+            out[p] = (float(np.median(v[np.isfinite(v)])), f"median of all {int(np.isfinite(v).sum())} ok tools")
+    return out
+
+
+def _float(cell) -> float:
+    try:
+        return float(cell)
+    except (TypeError, ValueError):
+        return float("nan")
 
 
 def _training_range(model: ANFIS):
@@ -63,10 +84,14 @@ def predict_joint(models_dir, diameter_mm: float, overhang_mm: float) -> tuple[n
     models = load_models(d)
     notes = []
     x = np.array([[diameter_mm, overhang_mm]], float)
-    lo, hi = _training_range(models["kt"])
-    if np.any(x[0] < lo) or np.any(x[0] > hi):
-        msg = (f"D = {diameter_mm:g} mm, L = {overhang_mm:g} mm lies outside the trained range "
-               f"D {lo[0]:g}–{hi[0]:g} mm, L {lo[1]:g}–{hi[1]:g} mm: extrapolation")
+    ranges = {p: _training_range(m) for p, m in models.items()}
+    outside = [p for p, (lo, hi) in ranges.items() if np.any(x[0] < lo) or np.any(x[0] > hi)]
+    if outside:
+        lo = np.max([ranges[p][0] for p in outside], axis=0)
+        hi = np.min([ranges[p][1] for p in outside], axis=0)
+        msg = (f"D = {diameter_mm:g} mm, L = {overhang_mm:g} mm lies outside the range the {', '.join(outside)} "
+               f"model{'s were' if len(outside) > 1 else ' was'} trained on (D {lo[0]:g}–{hi[0]:g} mm, "
+               f"L {lo[1]:g}–{hi[1]:g} mm): extrapolation")
         warnings.warn(msg, ExtrapolationWarning, stacklevel=2)
         notes.append(msg)
     med = None
@@ -84,8 +109,8 @@ def predict_joint(models_dir, diameter_mm: float, overhang_mm: float) -> tuple[n
                 if p not in med:
                     raise InputError(f"no model for {p} and no identified.csv beside the models to take a median from",
                                      file=d, field="--models")
-                v = med[p]
-                notes.append(f"{p}: no model (not identifiable in the campaign); campaign median {v:.4g} used")
+                v, what = med[p]
+                notes.append(f"{p}: no model (not identifiable in the campaign); {what}, {v:.4g}, used")
             out.append(v)
     return np.array(out), notes
 
