@@ -268,3 +268,13 @@ def test_split_does_not_depend_on_row_order(tmp_path):
     ra, rb = learn(a, seed=7, **quick), learn(b, seed=7, **quick)
     assert read_split(a) == read_split(b)
     assert ra["metrics"]["kt"]["anfis"]["test"]["mape"] == rb["metrics"]["kt"]["anfis"]["test"]["mape"]
+
+
+def test_more_parameters_than_identified_rows_is_said(tmp_path):
+    folder = write_identified(tmp_path, identified_rows(n=60, n_failed=0))
+    lines = []
+    learn(folder, test_size=12, mfs=(3, 7), epochs=2, targets=["kt"], baselines=False, plots=False, out=lines.append)
+    assert any(s.startswith("note: kt was identified in 48 training rows, fewer than the 63") for s in lines)
+    lines.clear()
+    learn(folder, test_size=12, mfs=(3, 3), epochs=2, targets=["kt"], baselines=False, plots=False, out=lines.append)
+    assert not any("consequent parameters" in s for s in lines)

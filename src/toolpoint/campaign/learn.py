@@ -497,6 +497,10 @@ def learn(
             excluded[t] = f"{t}: too few identified rows ({t_tr.size} train, {t_te.size} test)"
             out(f"{t} left out: {excluded[t]}")
             continue
+        n_par = rules * (len(INPUTS) + 1 if order == 1 else 1)
+        if t_tr.size < n_par:
+            out(f"note: {t} was identified in {t_tr.size} training rows, fewer than the {n_par} consequent "
+                f"parameters of {rules} rules: where it was not identified, the model rests on weak rows only")
         Xfit, yfit, sfit = X[t_fit], y[t_fit], sig[t_fit]
         Xtr, Xte = X[t_tr], X[t_te]
         ytr, yte = y[t_tr], y[t_te]
