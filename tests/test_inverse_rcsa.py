@@ -318,3 +318,28 @@ def test_modal_fit_removes_noise_and_keeps_the_peaks(example, blank50, true_nois
     assert "modal fit" in modal.label
     with pytest.raises(InputError, match="smooth"):
         subassembly_from_blank(blank50, 0.04, *noisy, smooth="spline")
+
+
+def test_modal_fit_of_four_noisy_files(true_noise, tmp_path):
+    """smooth="modal" on h, l, n, p files: one common-pole fit of the four entries."""
+    rng = np.random.default_rng(4)
+    f = true_noise.freq_hz
+    paths = []
+    for name, (i, j) in zip("hlnp", ((0, 0), (0, 1), (1, 0), (1, 1))):
+        v = true_noise.R[:, i, j]
+        noisy = v + 1e-3 * np.abs(v).max() * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size))
+        paths.append(tmp_path / f"{name}.csv")
+        write_frf(paths[-1], FRF(f, noisy, label=name))
+    raw = subassembly_from_files(*paths)
+    modal = subassembly_from_files(*paths, smooth="modal")
+    assert "modal fit" in modal.label
+    assert np.all(median_rel(modal, true_noise) < 0.2 * median_rel(raw, true_noise))
+    assert np.abs(modal.R[:, 0, 0]).max() == pytest.approx(np.abs(true_noise.R[:, 0, 0]).max(), rel=0.01)
+    few = tmp_path / "few"
+    few.mkdir()
+    for p in paths:  # 5 frequencies: too few for a modal fit → one-line InputError, not a traceback
+        g = FRF(f[:5], np.ones(5, complex))
+        write_frf(few / p.name, g)
+    with pytest.raises(InputError, match="modal fit impossible") as e:
+        subassembly_from_files(*(few / p.name for p in paths), smooth="modal")
+    assert e.value.field == "smooth"

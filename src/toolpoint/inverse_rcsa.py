@@ -279,7 +279,7 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
     Gm = np.stack([g["G11"], g12, g["G22"]], -1)
     label = ""
     if _is_modal(smooth):
-        fit = fit_common_poles(f, Gm)
+        fit = _modal_fit(f, Gm)
         Gm = fit(f)
         label = f", modal fit ({fit.n_modes} modes)"
     R = blank_receptances(blank, x2_m, f)
@@ -291,6 +291,13 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
     sub = Subassembly(f, SH, f"spindle–holder (inverse RCSA, blank {blank.length * 1e3:g} mm, "
                              f"x2 {float(x2_m) * 1e3:g} mm{label})")
     return sub if smooth is None or _is_modal(smooth) else smooth_subassembly(sub, float(smooth), polyorder)
+
+
+def _modal_fit(f, Y):
+    try:
+        return fit_common_poles(f, Y)
+    except ValueError as e:  # too few points, an all-zero FRF: a one-line input error
+        raise InputError(f"modal fit impossible: {e}", field="smooth") from None
 
 
 def _is_modal(smooth) -> bool:
@@ -350,7 +357,7 @@ def modal_smooth_subassembly(sub: Subassembly) -> Subassembly:
     FRFs instead, before the noise is amplified, which is better.
     """
     Y = sub.R.reshape(-1, 4)
-    fit = fit_common_poles(sub.freq_hz, Y)
+    fit = _modal_fit(sub.freq_hz, Y)
     return Subassembly(sub.freq_hz, fit(sub.freq_hz).reshape(-1, 2, 2),
                        f"{sub.label}, modal fit ({fit.n_modes} modes)")
 

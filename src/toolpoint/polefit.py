@@ -136,7 +136,7 @@ def _fit(w, Y, fn0, z0, fb, w_min, w_max):
     sol = least_squares(lambda p: both(p)[0], x0, jac=lambda p: both(p)[1], bounds=(lo, hi),
                         x_scale=np.r_[np.maximum(fn0 * z0, 1e-2), np.ones(n)],
                         xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=50 * (n + 1))
-    return sol.x[:n], np.exp(sol.x[n:]), float(sol.fun @ sol.fun)
+    return sol.x[:n], np.exp(sol.x[n:])
 
 
 def fit_common_poles(freq_hz, Y, *, weights=None, max_modes: int = 16, tol: float = 1e-9,
@@ -159,6 +159,8 @@ def _fit_common_poles(freq_hz, Y, weights, max_modes, tol, patience) -> PoleFit:
     Y = Y.reshape(f.size, -1)
     if f.size < 10 or np.any(np.diff(f) <= 0) or f[0] <= 0:
         raise ValueError("need ≥ 10 increasing frequencies > 0 Hz")
+    if not np.all(np.isfinite(Y)) or np.any(np.abs(Y).max(0) == 0):
+        raise ValueError("every FRF must be finite and not all zero")
     wt = 1.0 / np.abs(Y).max(0) if weights is None else np.asarray(weights, float).reshape(-1)
     Yw = Y * wt
     w = 2 * np.pi * f
@@ -173,7 +175,7 @@ def _fit_common_poles(freq_hz, Y, weights, max_modes, tol, patience) -> PoleFit:
     best, since = None, 0
     while True:
         if fn.size:
-            fn, ze, rss = _fit(w, Yw, fn, ze, fb, w_min, w_max)
+            fn, ze = _fit(w, Yw, fn, ze, fb, w_min, w_max)
         D = _basis(w, fn, ze, w_min, w_max)
         C = _solve(D, Yw)
         r = D @ C - Yw

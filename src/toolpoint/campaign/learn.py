@@ -34,9 +34,9 @@ Target scale
     By default ANFIS fits log10 of each target (``--linear-target`` for the
     paper's linear fit). Joint parameters are positive and span decades over
     the family; a linear fit can go ≤ 0 between sparse data — measured on the
-    synthetic campaign with the paper's 3×7 grid: one of 30 test tools got a
-    negative ct and no FRF, none with log10 (and kt test MAPE 0.32 % against
-    0.28 %, the same).
+    synthetic campaign (seed 0, with the rows still split in file order) with
+    the paper's 3×7 grid: one of 30 test tools got a negative ct and no FRF,
+    none with log10 (and kt test MAPE 0.32 % against 0.28 %, the same).
 
 Metrics
     The paper's four on the training and the test data: NRMSE, AFV, MAPE %
