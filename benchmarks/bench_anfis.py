@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from toolpoint.anfis import ANFIS
+from toolpoint.learning.anfis import ANFIS
 
 
 def make_data(n=148, seed=0):

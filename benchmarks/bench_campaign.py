@@ -18,15 +18,15 @@ from pathlib import Path
 
 import numpy as np
 
-from toolpoint.assembly import load_assembly
+from toolpoint.dynamics.assembly import load_assembly
 from toolpoint.campaign.config import load_campaign
 from toolpoint.campaign.learn import learn
 from toolpoint.campaign.predict import predict_frf
 from toolpoint.campaign.run import run_campaign
 from toolpoint.campaign.synth import synthesise, truth_joint
 from toolpoint.errors import InputError
-from toolpoint.model import ToolPointModel
-from toolpoint.subassembly import Subassembly
+from toolpoint.dynamics.model import ToolPointModel
+from toolpoint.dynamics.subassembly import Subassembly
 
 
 def main() -> None:

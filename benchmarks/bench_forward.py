@@ -12,9 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from toolpoint.assembly import load_assembly
-from toolpoint.components import end_receptances
-from toolpoint.model import AssemblyModel
+from toolpoint.dynamics.assembly import load_assembly
+from toolpoint.dynamics.components import end_receptances
+from toolpoint.dynamics.model import AssemblyModel
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "numerical_case.toml"
 

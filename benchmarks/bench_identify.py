@@ -43,11 +43,12 @@ import numpy as np  # noqa: E402
 import scipy  # noqa: E402
 from scipy.optimize import differential_evolution, dual_annealing  # noqa: E402
 
-from toolpoint.assembly import load_assembly  # noqa: E402
+from toolpoint.dynamics.assembly import load_assembly  # noqa: E402
 from toolpoint.frf import FRF  # noqa: E402
-from toolpoint.identify import identify, make_algorithm, model_for, relative_errors  # noqa: E402
-from toolpoint.objective import PARAMS, JointProblem  # noqa: E402
-from toolpoint.optim import Termination  # noqa: E402
+from toolpoint.identification.identify import identify, make_algorithm, model_for, relative_errors  # noqa: E402
+from toolpoint.identification.objective import JointProblem  # noqa: E402
+from toolpoint.identification.params import PARAMS  # noqa: E402
+from toolpoint.identification.optim import Termination  # noqa: E402
 
 try:
     import pymoo

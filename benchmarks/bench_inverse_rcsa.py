@@ -1,4 +1,4 @@
-"""Inverse RCSA (toolpoint.inverse_rcsa): accuracy, conditioning and noise amplification.
+"""Inverse RCSA (toolpoint.dynamics.inverse_rcsa): accuracy, conditioning and noise amplification.
 
 Synthetic measurements on the numerical case (examples/numerical_case.toml):
 a Ø16 mm steel blank rigidly clamped in the holder, its G11, G12, G22
@@ -24,13 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
-from toolpoint.assembly import Component, Segment, load_assembly
-from toolpoint.components import assemble, mesh, receptance
+from toolpoint.dynamics.assembly import Component, Segment, load_assembly
+from toolpoint.dynamics.components import assemble, mesh, receptance
 from toolpoint.frf import FRF
-from toolpoint.inverse_rcsa import (
+from toolpoint.dynamics.inverse_rcsa import (
     ROOT, _split, blank_receptances, conditioning, noise_std, smooth_subassembly, subassembly_from_blank,
 )
-from toolpoint.subassembly import Subassembly
+from toolpoint.dynamics.subassembly import Subassembly
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "numerical_case.toml"
 MEDIAN_RAYLEIGH = np.sqrt(np.log(2))  # median |z| / rms |z| for circular complex Gaussian z

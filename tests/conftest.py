@@ -2,7 +2,7 @@ from pathlib import Path
 
 import pytest
 
-from toolpoint.assembly import load_assembly
+from toolpoint.dynamics.assembly import load_assembly
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "numerical_case.toml"

@@ -9,7 +9,7 @@ from sklearn.base import clone
 from sklearn.utils.estimator_checks import parametrize_with_checks
 from threadpoolctl import threadpool_limits
 
-from toolpoint.anfis import (
+from toolpoint.learning.anfis import (
     ANFIS,
     MF_PARAMS,
     _firing,
@@ -24,7 +24,7 @@ from toolpoint.anfis import (
     save_model,
 )
 from toolpoint.errors import ExtrapolationWarning
-from toolpoint.metrics import mape
+from toolpoint.learning.metrics import mape
 
 
 def sinc(v):

@@ -9,9 +9,9 @@ from hypothesis import strategies as st
 from scipy.linalg import expm
 from scipy.optimize import brentq
 
-from toolpoint.assembly import Bearing, Component, Material, Segment
-from toolpoint.beam import Section, cowper_kappa, transfer_matrix
-from toolpoint.components import end_receptances, end_receptances_dense
+from toolpoint.dynamics.assembly import Bearing, Component, Material, Segment
+from toolpoint.dynamics.beam import Section, cowper_kappa, transfer_matrix
+from toolpoint.dynamics.components import end_receptances, end_receptances_dense
 
 STEEL = Material("steel", 210e9, 7800.0, 0.3)
 
@@ -123,8 +123,8 @@ def test_transfer_chain_sweep_and_dense_solve_agree(segs, with_bearings, eta):
 
 def test_refinement_does_not_move_the_tool_point_frf(example):
     """Converged: sub-dividing every piece further changes the FRF by < 1e-4 (here ~1e-12)."""
-    from toolpoint import components
-    from toolpoint.model import AssemblyModel
+    from toolpoint.dynamics import components
+    from toolpoint.dynamics.model import AssemblyModel
 
     h = AssemblyModel(example).tool_point_frf().values
     old = components.MAX_BETA_L

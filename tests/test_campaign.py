@@ -95,7 +95,7 @@ def test_bad_campaign_inputs(small, tmp_path):
 
 def test_band_outside_the_subassembly_is_refused_per_item(small, tmp_path):
     from toolpoint.frf import FRF
-    from toolpoint.frfio import read_frf, write_frf
+    from toolpoint.io.frf_files import read_frf, write_frf
 
     c2 = tmp_path / "c"
     shutil.copytree(small, c2)
@@ -112,8 +112,8 @@ def test_band_outside_the_subassembly_is_refused_per_item(small, tmp_path):
 
 def test_blank_subassembly_with_modal_fit(small, tmp_path):
     """synth's campaign.toml asks for smooth = "modal": the blank FRFs' noise goes, the peaks stay."""
-    from toolpoint.assembly import load_assembly
-    from toolpoint.subassembly import Subassembly
+    from toolpoint.dynamics.assembly import load_assembly
+    from toolpoint.dynamics.subassembly import Subassembly
 
     c = load_campaign(small)
     sub = c.subassembly("ER40", None)

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from toolpoint.anfis import ANFIS
+from toolpoint.learning.anfis import ANFIS
 from toolpoint.campaign.learn import PAPER, add_arguments, learn, run_cli
 from toolpoint.errors import InputError
 

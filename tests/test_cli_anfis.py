@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import toolpoint.cli.main as cli_main
-from toolpoint.anfis import ANFIS
+from toolpoint.learning.anfis import ANFIS
 
 
 @pytest.fixture(autouse=True)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from toolpoint.cli.main import main
-from toolpoint.frfio import read_csv_frf
+from toolpoint.io.frf_files import read_csv_frf
 
 
 def test_frf_csv_and_plot(tmp_path, example_path):
@@ -78,7 +78,7 @@ def test_missing_file(tmp_path, capsys):
 
 
 def test_output_format_follows_the_extension(tmp_path, example_path, capsys):
-    from toolpoint.frfio import read_frf
+    from toolpoint.io.frf_files import read_frf
 
     uff = tmp_path / "frf.uff"
     assert main(["frf", str(example_path), "--out", str(uff)]) == 0

@@ -7,8 +7,8 @@ import pytest
 
 from toolpoint.cli.main import main
 from toolpoint.frf import FRF
-from toolpoint.frfio import write_csv_frf
-from toolpoint.identify import model_for
+from toolpoint.io.frf_files import write_csv_frf
+from toolpoint.identification.identify import model_for
 
 
 @pytest.fixture(scope="module")

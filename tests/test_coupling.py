@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from toolpoint.assembly import Component, Material, Segment
-from toolpoint.components import end_receptances
-from toolpoint.coupling import couple
-from toolpoint.fe import FEModel, tool_point_fe
-from toolpoint.model import AssemblyModel
+from toolpoint.dynamics.assembly import Component, Material, Segment
+from toolpoint.dynamics.components import end_receptances
+from toolpoint.dynamics.coupling import couple
+from toolpoint.dynamics.fe import FEModel, tool_point_fe
+from toolpoint.dynamics.model import AssemblyModel
 
 F = np.arange(0.0, 3001.0)
 

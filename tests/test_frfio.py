@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from toolpoint.errors import InputError
 from toolpoint.frf import FRF
-from toolpoint.frfio import (
+from toolpoint.io.frf_files import (
     G0, read_csv_frf, read_cutpro, read_frf, read_uff58, read_uff58_all, write_csv_frf, write_cutpro,
     write_frf, write_uff58,
 )

@@ -5,9 +5,10 @@ import pytest
 
 from toolpoint.errors import InputError
 from toolpoint.frf import FRF
-from toolpoint.identify import identify, model_for, relative_errors
-from toolpoint.objective import Bounds, JointProblem
-from toolpoint.optim import Termination
+from toolpoint.identification.identify import identify, model_for, relative_errors
+from toolpoint.identification.objective import JointProblem
+from toolpoint.identification.params import Bounds
+from toolpoint.identification.optim import Termination
 
 F = np.arange(1.0, 3001.0)
 

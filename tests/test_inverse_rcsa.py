@@ -11,17 +11,17 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from toolpoint.assembly import Bearing, Component, Segment
-from toolpoint.components import assemble, mesh, receptance
+from toolpoint.dynamics.assembly import Bearing, Component, Segment
+from toolpoint.dynamics.components import assemble, mesh, receptance
 from toolpoint.errors import InputError
-from toolpoint.fe import FEModel
+from toolpoint.dynamics.fe import FEModel
 from toolpoint.frf import FRF
-from toolpoint.frfio import write_frf
-from toolpoint.inverse_rcsa import (
+from toolpoint.io.frf_files import write_frf
+from toolpoint.dynamics.inverse_rcsa import (
     POINT2, ROOT, TIP, _split, blank_frfs, blank_receptances, conditioning, noise_std, sensitivity,
     smooth_subassembly, subassembly_from_assembly, subassembly_from_blank, subassembly_from_files,
 )
-from toolpoint.subassembly import Subassembly
+from toolpoint.dynamics.subassembly import Subassembly
 
 MEDIAN_RAYLEIGH = np.sqrt(np.log(2))  # median / rms of |circular complex Gaussian|
 F_NOISE = np.arange(20.0, 3001.0, 1.0)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from toolpoint.metrics import afv, mape, max_ape, ndei, nrmse, rmse
+from toolpoint.learning.metrics import afv, mape, max_ape, ndei, nrmse, rmse
 
 T = [1.0, 2.0, 3.0, 4.0]
 O = [1.1, 1.9, 3.2, 3.8]

@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 
 from toolpoint.frf import FRF
-from toolpoint.identify import identify, model_for, relative_errors
-from toolpoint.objective import Bounds, JointProblem
-from toolpoint.optim import GA, SA, Termination
+from toolpoint.identification.identify import identify, model_for, relative_errors
+from toolpoint.identification.objective import JointProblem
+from toolpoint.identification.params import Bounds
+from toolpoint.identification.optim import GA, SA, Termination
 
 F = np.arange(1.0, 3001.0)
 # Paper Table 1 (numerical case), relative errors as fractions: kt, ct, kr, cr.

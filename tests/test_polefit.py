@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.linalg import eig
 
-from toolpoint.polefit import fit_common_poles
+from toolpoint.dynamics.polefit import fit_common_poles
 
 M = np.diag([1.0, 0.6, 0.4])  # kg
 K = np.array([[3.0, -1.5, 0.0], [-1.5, 2.5, -1.0], [0.0, -1.0, 1.0]]) * 4e7  # N/m

@@ -16,7 +16,44 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .errors import InputError
+
 QUANTITIES = {"receptance": "m/N", "mobility": "m/(N·s)", "accelerance": "m/(N·s²)"}
+
+
+def check_freq_hz(freq_hz, *, file=None, field: str = "freq_hz", positive: bool = False,
+                  min_points: int = 1) -> np.ndarray:
+    """A frequency grid as a 1-D float array, checked: finite, ≥ 0 (> 0 with
+    ``positive``), strictly increasing, at least ``min_points`` long.
+
+    The one place frequency grids are checked; problems raise
+    :class:`~toolpoint.errors.InputError` naming ``file`` and ``field``.
+
+    Examples
+    --------
+    >>> check_freq_hz([0, 1, 2]).tolist()
+    [0.0, 1.0, 2.0]
+    >>> check_freq_hz([3, 1, 2], file="m.csv")
+    Traceback (most recent call last):
+    ...
+    toolpoint.errors.InputError: m.csv: freq_hz: frequencies must be strictly increasing (3 Hz is followed by 1 Hz)
+    """
+    try:
+        f = np.asarray(freq_hz, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError("frequencies must be numbers", file=file, field=field) from None
+    if f.size < min_points:
+        raise InputError(f"needs at least {min_points} frequencies, got {f.size}", file=file, field=field)
+    if not np.all(np.isfinite(f)):
+        raise InputError("frequencies must be finite", file=file, field=field)
+    if f.size and (f[0] <= 0 if positive else f[0] < 0):
+        raise InputError(f"frequencies must be {'> 0' if positive else '≥ 0'} Hz, got {f[0]:g}", file=file, field=field)
+    d = np.diff(f)
+    if np.any(d <= 0):
+        k = int(np.argmax(d <= 0))
+        raise InputError(f"frequencies must be strictly increasing ({f[k]:g} Hz is followed by {f[k + 1]:g} Hz)",
+                         file=file, field=field)
+    return f
 
 
 @dataclass(frozen=True)

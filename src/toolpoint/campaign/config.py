@@ -36,22 +36,21 @@ from pathlib import Path
 
 import numpy as np
 
-from ..assembly import (
+from ..dynamics.assembly import (
     MM,
     Component,
     Material,
     Segment,
-    _materials,
-    _Reader,
-    _segments,
+    parse_materials,
+    parse_segments,
     load_assembly,
-    load_toml,
 )
 from ..errors import InputError
-from ..frfio import read_frf
-from ..inverse_rcsa import subassembly_from_blank, subassembly_from_files
-from ..objective import Bounds
-from ..subassembly import Subassembly
+from ..io.toml import TomlReader, load_toml
+from ..io.frf_files import read_frf
+from ..dynamics.inverse_rcsa import subassembly_from_blank, subassembly_from_files
+from ..identification.params import Bounds
+from ..dynamics.subassembly import Subassembly
 
 
 @dataclass(frozen=True)
@@ -132,8 +131,8 @@ class Campaign:
         if src.kind == "files":
             sub = subassembly_from_files(*keys, smooth=smooth)
         else:
-            r = _Reader(str(self.toml))
-            blank = Component("blank", _segments(r, src.spec, f"holders.{name}.blank", self.materials))
+            r = TomlReader(str(self.toml))
+            blank = Component("blank", parse_segments(r, src.spec, f"holders.{name}.blank", self.materials))
             sub = subassembly_from_blank(blank, float(src.spec["x2_mm"]) * MM, *(read_frf(p) for p in keys),
                                          smooth=smooth)
         _MEMO.clear()  # one holder set at a time is enough
@@ -152,7 +151,7 @@ def _stamp(path: Path):
     return st.st_mtime_ns, st.st_size
 
 
-def _smooth(r: _Reader, spec: dict, path: str):
+def _smooth(r: TomlReader, spec: dict, path: str):
     """``smooth = "modal"`` or a Savitzky–Golay window ``smooth_hz`` (> 0); at most one."""
     if "smooth" in spec and "smooth_hz" in spec:
         raise r.err(path, "give smooth or smooth_hz, not both")
@@ -168,7 +167,7 @@ def _smooth(r: _Reader, spec: dict, path: str):
     return None
 
 
-def _band(r: _Reader, doc: dict) -> tuple[float, float]:
+def _band(r: TomlReader, doc: dict) -> tuple[float, float]:
     c = r.table(doc, "campaign", "campaign")
     band = c.get("band_hz")
     try:
@@ -180,7 +179,7 @@ def _band(r: _Reader, doc: dict) -> tuple[float, float]:
     return lo, hi
 
 
-def _family(r: _Reader, doc: dict, mats: dict) -> ToolFamily:
+def _family(r: TomlReader, doc: dict, mats: dict) -> ToolFamily:
     t = r.table(doc, "tool_family", "tool_family", required=False) or {}
     r.unknown_keys(t, {"material", "flute_ratio", "flute_length_ratio"}, "tool_family")
     name = t.get("material", "steel")
@@ -193,7 +192,7 @@ def _family(r: _Reader, doc: dict, mats: dict) -> ToolFamily:
     return ToolFamily(mats[name], ratio, length)
 
 
-def _holders(r: _Reader, doc: dict, folder: Path) -> dict[str, HolderSource]:
+def _holders(r: TomlReader, doc: dict, folder: Path) -> dict[str, HolderSource]:
     hs = r.table(doc, "holders", "holders")
     if not hs:
         raise r.err("holders", "needs at least one holder entry")
@@ -287,15 +286,15 @@ def load_campaign(folder: str | Path) -> Campaign:
         raise InputError("not a folder", file=folder)
     toml = folder / "campaign.toml"
     doc = load_toml(toml)
-    r = _Reader(str(toml))
+    r = TomlReader(str(toml))
     r.unknown_keys(doc, {"campaign", "materials", "tool_family", "holders", "identify"}, "file")
-    mats = _materials(r, doc)
+    mats = parse_materials(r, doc)
     band = _band(r, doc)
     family = _family(r, doc, mats)
     holders = _holders(r, doc, folder)
     ident = r.table(doc, "identify", "identify", required=False) or {}
     method = ident.get("method", "hybrid")
-    from ..optim import METHODS
+    from ..identification.optim import METHODS
 
     if method not in METHODS:
         raise r.err("identify.method", f"unknown method {method!r} (one of {', '.join(METHODS)})")

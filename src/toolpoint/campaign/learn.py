@@ -3,7 +3,7 @@ r"""``toolpoint campaign learn`` — ANFIS joint-parameter models from a campaig
 Reads ``RESULTS_DIR/identified.csv`` (written by ``toolpoint campaign run``:
 one identified holder–tool joint per tool assembly), splits the successfully
 identified assemblies at random into training and test data, and fits one
-:class:`~toolpoint.anfis.ANFIS` model per joint parameter with the inputs
+:class:`~toolpoint.learning.anfis.ANFIS` model per joint parameter with the inputs
 (tool diameter D, overhang L), as in Čiča et al., section 5 (3×7 Gaussian MFs,
 linear consequents, 21 rules, 148 training / 30 test sets).
 
@@ -40,7 +40,7 @@ Target scale
 
 Metrics
     The paper's four on the training and the test data: NRMSE, AFV, MAPE %
-    and max APE % (:mod:`toolpoint.metrics`), always in the target's own unit
+    and max APE % (:mod:`toolpoint.learning.metrics`), always in the target's own unit
     (with ``log_target`` the predictions are transformed back first). The
     paper's test numbers for kt and kr are printed beside ours.
 
@@ -84,8 +84,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..anfis import ANFIS, MF_PARAMS
-from ..atomic import atomic_open
+from ..learning.anfis import ANFIS, MF_PARAMS
+from ..io.atomic import atomic_open
 from ..cli.anfis import PAPER_METRICS, _plot_membership, _plot_per_sample, _plot_regression, _predict_quietly
 from ..errors import InputError
 
@@ -316,7 +316,7 @@ def learn(
         ``results_dir/models``, plots to ``results_dir/plots``.
     test_size : number of ok rows held out for testing (paper: 30 of 178).
     mfs, mf, order, epochs, step_size, log_target : ANFIS settings
-        (:class:`~toolpoint.anfis.ANFIS` ``n_mfs``, ``mf``, …).
+        (:class:`~toolpoint.learning.anfis.ANFIS` ``n_mfs``, ``mf``, …).
     seed : seed of the random split (``numpy.random.default_rng``) and of the baselines.
     targets : None (kt, kr, and ct/cr where identifiable) or a list of names.
     baselines : also fit the GP and gradient-boosting baselines.

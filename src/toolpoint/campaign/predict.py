@@ -15,13 +15,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..anfis import ANFIS
-from ..assembly import Assembly, load_assembly
+from ..learning.anfis import ANFIS
+from ..dynamics.assembly import Assembly, load_assembly
 from ..errors import ExtrapolationWarning, InputError
 from ..frf import FRF
-from ..model import ToolPointModel
-from ..objective import PARAMS
-from ..subassembly import Subassembly
+from ..dynamics.model import ToolPointModel
+from ..identification.params import PARAMS
+from ..dynamics.subassembly import Subassembly
 from .config import ToolFamily, load_campaign
 
 

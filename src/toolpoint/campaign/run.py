@@ -21,13 +21,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..assembly import Component
-from ..atomic import atomic_open
+from ..dynamics.assembly import Component
+from ..io.atomic import atomic_open
 from ..errors import InputError
 from ..frf import FRF
-from ..frfio import read_frf
-from ..objective import PARAMS, Bounds
-from ..subassembly import Subassembly
+from ..io.frf_files import read_frf
+from ..identification.params import PARAMS, Bounds
+from ..dynamics.subassembly import Subassembly
 from .config import Campaign, load_campaign
 
 COLUMNS = (
@@ -66,8 +66,8 @@ def identify_item(item: Item) -> dict:
     """Run one identification (in a worker); returns its identified.csv row."""
     from threadpoolctl import threadpool_limits
 
-    from ..identify import identify
-    from ..model import ToolPointModel
+    from ..identification.identify import identify
+    from ..dynamics.model import ToolPointModel
 
     t0 = time.perf_counter()
     # one BLAS thread per item: the workers already use every core
@@ -154,7 +154,7 @@ def run_campaign(folder, out_dir, *, method: str | None = None, workers: int | N
     """Identify all measurements of the campaign in ``folder``; rows go to ``out_dir/identified.csv``."""
     c = load_campaign(folder)
     method = method or c.method
-    from ..optim import METHODS
+    from ..identification.optim import METHODS
 
     if method not in METHODS:
         raise InputError(f"unknown method {method!r} (one of {', '.join(METHODS)})", file="command line",

@@ -27,13 +27,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..assembly import MM, Component, Material, Segment, load_assembly
-from ..atomic import atomic_open
+from ..dynamics.assembly import MM, Component, Material, Segment, load_assembly
+from ..io.atomic import atomic_open
 from ..frf import FRF
-from ..frfio import write_frf
-from ..inverse_rcsa import blank_frfs
-from ..model import ToolPointModel
-from ..subassembly import Subassembly
+from ..io.frf_files import write_frf
+from ..dynamics.inverse_rcsa import blank_frfs
+from ..dynamics.model import ToolPointModel
+from ..dynamics.subassembly import Subassembly
 from .config import ToolFamily
 
 DIAMETERS_MM = (9, 10, 12, 14, 16, 18, 20, 22, 25, 28, 30)
@@ -101,7 +101,7 @@ def synthesise(out: str | Path, n: int = 178, seed: int = 0, noise: float = 0.01
 
     The blank FRFs get less noise by default (5e-5 of the peak: many averaged
     impacts on a stiff spindle) because inverse RCSA amplifies it ~100–400×
-    into the subassembly (see :mod:`toolpoint.inverse_rcsa`). ``smooth`` is
+    into the subassembly (see :mod:`toolpoint.dynamics.inverse_rcsa`). ``smooth`` is
     written to campaign.toml: ``"modal"`` (common-pole fit of the blank FRFs,
     the default) or a Savitzky–Golay window in Hz. Measured on this holder,
     median error of h, l, p over 20–4000 Hz (exp. seed 1):

@@ -30,10 +30,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..anfis import ANFIS, MF_PARAMS, plot_membership
-from ..atomic import atomic_open, atomic_path
+from ..learning.anfis import ANFIS, MF_PARAMS, plot_membership
+from ..io.atomic import atomic_open, atomic_path
 from ..errors import ExtrapolationWarning, InputError
-from ..metrics import afv, mape, max_ape, nrmse
+from ..learning.metrics import afv, mape, max_ape, nrmse
 
 PAPER_METRICS = (("NRMSE", nrmse), ("AFV", afv), ("MAPE %", mape), ("max APE %", max_ape))
 

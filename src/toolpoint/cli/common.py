@@ -6,7 +6,7 @@ import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..atomic import atomic_path
+from ..io.atomic import atomic_path
 from ..errors import InputError
 
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..assembly import load_assembly
+from ..dynamics.assembly import load_assembly
 from ..errors import InputError
-from ..frfio import write_frf
-from ..model import AssemblyModel
+from ..io.frf_files import write_frf
+from ..dynamics.model import AssemblyModel
 from .common import out_path, save_figure, use_agg, warnings_to_stderr
 
 

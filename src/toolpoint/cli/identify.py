@@ -10,13 +10,13 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..assembly import load_assembly
-from ..atomic import atomic_open
+from ..dynamics.assembly import load_assembly
+from ..io.atomic import atomic_open
 from ..errors import InputError
-from ..frfio import read_frf
-from ..identify import identify, make_algorithm, model_for
-from ..objective import PARAMS, UNITS, Bounds
-from ..optim import METHODS
+from ..io.frf_files import read_frf
+from ..identification.identify import identify, make_algorithm, model_for
+from ..identification.params import PARAMS, UNITS, Bounds
+from ..identification.optim import METHODS
 from .common import out_path, save_figure, use_agg, warnings_to_stderr
 
 MIN_POINTS = 10
@@ -91,7 +91,7 @@ def run(args) -> int:
     fig = None
     if plot:
         use_agg()
-        from ..plots import fit_figure
+        from ..identification.figures import fit_figure
 
         fig = fit_figure(meas, {f"identified ({args.method})": res.model_frf}, {args.method: res.history},
                          title=f"{Path(args.measured).name}: identified holder–tool joint")

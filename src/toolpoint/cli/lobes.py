@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_open, atomic_path
+from ..io.atomic import atomic_open, atomic_path
 from ..errors import InputError
 from .common import out_path, use_agg, warnings_to_stderr
 
@@ -81,17 +81,17 @@ def _rpm_range(text: str) -> tuple[float, float]:
 
 
 def _load(path: str, flag: str, freq_hz=None):
-    """An FRF from a file, or from an assembly TOML (``toolpoint.model.frf_from_toml``)."""
+    """An FRF from a file, or from an assembly TOML (``toolpoint.dynamics.model.frf_from_toml``)."""
     p = Path(path)
     if not p.is_file():
         raise InputError("no such file", file=p, field=flag)
     try:
         if p.suffix.lower() == ".toml":
-            from ..model import frf_from_toml
+            from ..dynamics.model import frf_from_toml
 
             frf = frf_from_toml(p, freq_hz=freq_hz)
         else:
-            from ..frfio import read_frf
+            from ..io.frf_files import read_frf
 
             frf = read_frf(p, min_points=3)
         return frf.to_receptance()

@@ -5,8 +5,8 @@ from __future__ import annotations
 import sys
 
 from ..errors import InputError
-from ..frfio import write_frf
-from ..objective import PARAMS, UNITS
+from ..io.frf_files import write_frf
+from ..identification.params import PARAMS, UNITS
 from .common import out_path, save_figure, use_agg, warnings_to_stderr
 
 

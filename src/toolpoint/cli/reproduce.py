@@ -16,14 +16,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..assembly import load_assembly
-from ..atomic import atomic_open
+from ..dynamics.assembly import load_assembly
+from ..io.atomic import atomic_open
 from ..errors import InputError
 from ..frf import FRF
-from ..frfio import write_csv_frf
-from ..identify import make_algorithm, model_for, relative_errors
-from ..objective import PARAMS, UNITS
-from ..optim import METHODS
+from ..io.frf_files import write_csv_frf
+from ..identification.identify import make_algorithm, model_for, relative_errors
+from ..identification.params import PARAMS, UNITS
+from ..identification.optim import METHODS
 from .common import save_figure, use_agg, warnings_to_stderr
 from .identify import _run_with_progress, result_document
 
@@ -82,7 +82,7 @@ def run(args) -> int:
             print(f"{m:6s} done: {res.nfev} evaluations, {res.seconds:.2f} s", file=sys.stderr)
     _table(results, exact, out)
     use_agg()
-    from ..plots import fit_figure
+    from ..identification.figures import fit_figure
 
     fig = fit_figure(measured, {f"{m}": r.model_frf for m, r in results.items()},
                      {m: r.history for m, r in results.items()},

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .frf import FRF
+from ..frf import FRF
 
 
 def fit_figure(measured: FRF, fitted: dict[str, FRF], histories: dict[str, np.ndarray] | None = None, title: str = ""):

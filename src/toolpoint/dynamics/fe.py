@@ -5,7 +5,7 @@ holder and tool meshed with two-node Timoshenko beam elements, bearings as
 springs/dampers to ground, the spindle–holder and holder–tool joints as
 zero-length spring–dampers between coincident nodes. One global matrix,
 solved directly per frequency (banded LU) — nothing is shared with the exact
-segment solution of :mod:`toolpoint.beam` but the geometry.
+segment solution of :mod:`toolpoint.dynamics.beam` but the geometry.
 
 Element (Przemieniecki 1968; Friedman & Kosmatka 1993): cubic deflection and
 "interdependent" rotation interpolation, exact for static end loads, with

@@ -8,64 +8,18 @@ real and imaginary parts together,
     f(x) = ‖h(10^x) − h̄‖₂ = sqrt(Σ_j |h(ω_j) − h̄(ω_j)|²)   (m/N).
 
 A whole population X (N, 4) is evaluated in one call, vectorised over
-frequencies and members (see :class:`~toolpoint.coupling.ToolPointCoupler`:
+frequencies and members (see :class:`~toolpoint.dynamics.coupling.ToolPointCoupler`:
 with e = (T_ii,00 − h̄)·den − num, linear in the joint coefficients c(p),
 f² = Σ|e|²/|den|² is two real matrix products per block of members).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from .coupling import CHUNK, ToolPointCoupler, joint_coefficients
-from .errors import InputError
-from .frf import FRF
-
-PARAMS = ("kt", "ct", "kr", "cr")
-UNITS = {"kt": "N/m", "ct": "N s/m", "kr": "N m/rad", "cr": "N m s/rad"}
-# The paper's search ranges (section 4).
-PAPER_BOUNDS = {"kt": (1e6, 1e9), "ct": (1.0, 300.0), "kr": (1e5, 1e7), "cr": (1.0, 300.0)}
-
-
-@dataclass(frozen=True)
-class Bounds:
-    """Box bounds in SI units, one (lo, hi) per parameter of ``PARAMS``."""
-
-    lo: np.ndarray
-    hi: np.ndarray
-
-    @classmethod
-    def from_dict(cls, d: dict | None = None, *, source: str | None = None, section: str = "bounds") -> "Bounds":
-        """Paper defaults, overridden by ``d`` = {"kt": [lo, hi], …}; bad values raise InputError."""
-        merged = dict(PAPER_BOUNDS)
-        for key, val in (d or {}).items():
-            field = f"{section}.{key}"
-            if key not in PARAMS:
-                raise InputError(f"unknown parameter (one of {', '.join(PARAMS)})", file=source, field=field)
-            try:
-                lo, hi = (float(v) for v in val)
-            except (TypeError, ValueError):
-                raise InputError(f"must be [lo, hi], got {val!r}", file=source, field=field) from None
-            if not (np.isfinite(lo) and np.isfinite(hi)) or lo <= 0 or hi <= 0:
-                raise InputError(f"bounds must be finite and > 0, got [{lo:g}, {hi:g}]", file=source, field=field)
-            if lo >= hi:
-                raise InputError(f"lo must be < hi, got [{lo:g}, {hi:g}]", file=source, field=field)
-            merged[key] = (lo, hi)
-        return cls(np.array([merged[k][0] for k in PARAMS]), np.array([merged[k][1] for k in PARAMS]))
-
-    @property
-    def log_lo(self) -> np.ndarray:
-        return np.log10(self.lo)
-
-    @property
-    def log_hi(self) -> np.ndarray:
-        return np.log10(self.hi)
-
-    def as_dict(self) -> dict:
-        return {k: [float(a), float(b)] for k, a, b in zip(PARAMS, self.lo, self.hi)}
-
+from ..dynamics.coupling import CHUNK, ToolPointCoupler, joint_coefficients
+from ..frf import FRF
+from .params import PARAMS, Bounds
 
 class JointProblem:
     """Minimise f(x) over x = log10 [kt, ct, kr, cr] within ``bounds``.
@@ -73,7 +27,7 @@ class JointProblem:
     Parameters
     ----------
     coupler : ToolPointCoupler on the measured frequencies (see
-        :class:`toolpoint.model.ToolPointModel`).
+        :class:`toolpoint.dynamics.model.ToolPointModel`).
     measured : (F,) complex tool-point receptance, m/N.
     bounds : Bounds (SI).
 

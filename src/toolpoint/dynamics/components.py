@@ -17,7 +17,7 @@ pieces at segment ends and bearing positions, and each piece into equal
 sub-pieces so that its bending wavenumber times length stays ≤ ``max_beta_l``
 at the top frequency (the exact segment stiffness is then far from its own
 clamped–clamped poles, and well conditioned). The piece matrices are exact
-(:mod:`toolpoint.beam`), so no mesh convergence is involved: refining only
+(:mod:`toolpoint.dynamics.beam`), so no mesh convergence is involved: refining only
 re-expresses the same solution.
 
 Global dynamic stiffness D(ω) (2 DOF per node: w, ψ) is assembled for all

@@ -83,9 +83,9 @@ from scipy.signal import savgol_filter
 from .assembly import Assembly, Component
 from .beam import inv2, transfer_matrix
 from .components import CHAIN_LIMIT, assemble, chain_growth, mesh, receptance
-from .errors import InputError
-from .frf import FRF
-from .frfio import read_frf
+from ..errors import InputError
+from ..frf import FRF
+from ..io.frf_files import read_frf
 from .polefit import fit_common_poles
 from .subassembly import Subassembly
 
@@ -257,7 +257,7 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
     G21 : optional second cross FRF (y2/F1); if given, G12 is replaced by the mean
         (G12 + G21)/2 (reciprocity), which halves that FRF's noise variance.
     smooth : None; ``"modal"`` — the three FRFs are first replaced by a common-pole
-        modal fit (:func:`toolpoint.polefit.fit_common_poles`), which removes the
+        modal fit (:func:`toolpoint.dynamics.polefit.fit_common_poles`), which removes the
         noise and keeps the peaks (recommended); or a Savitzky–Golay window in Hz
         applied to the result (:func:`smooth_subassembly`, ``polyorder``).
 
@@ -318,7 +318,7 @@ def subassembly_from_assembly(assembly: Assembly, freq_hz) -> Subassembly:
 
 
 def subassembly_from_files(h, l, n, p, *, smooth: float | str | None = None, polyorder: int = 3) -> Subassembly:
-    """The subassembly from four FRF files (any format :func:`~toolpoint.frfio.read_frf` reads).
+    """The subassembly from four FRF files (any format :func:`~toolpoint.io.frf_files.read_frf` reads).
 
     Each file holds one entry of SH = [[h, l], [n, p]] at the holder tip, written
     as a "receptance" FRF whose numbers are in that entry's own unit: h = y/F m/N,
@@ -350,7 +350,7 @@ def subassembly_from_files(h, l, n, p, *, smooth: float | str | None = None, pol
 
 # --------------------------------------------------------------------------- smoothing
 def modal_smooth_subassembly(sub: Subassembly) -> Subassembly:
-    """h, l, n, p replaced by one common-pole modal fit (:mod:`toolpoint.polefit`).
+    """h, l, n, p replaced by one common-pole modal fit (:mod:`toolpoint.dynamics.polefit`).
 
     For a subassembly that is already noisy (e.g. four measured files). With a
     blank, ``subassembly_from_blank(..., smooth="modal")`` fits the measured

@@ -23,7 +23,7 @@ scaled by ``weights`` (default: 1 / its peak magnitude, i.e. noise assumed
 proportional to each FRF's level), so the criterion sees comparable noise.
 
 Why: inverse RCSA amplifies measurement noise 100–500× into the spindle–holder
-receptance (:mod:`toolpoint.inverse_rcsa`). Savitzky–Golay smoothing trades
+receptance (:mod:`toolpoint.dynamics.inverse_rcsa`). Savitzky–Golay smoothing trades
 that noise for rounded peaks (a 100 Hz window cut the sharpest peak of the
 synthetic campaign's h to a quarter); fitting the three measured blank FRFs
 with common poles first removes the noise without touching the peaks

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import t as student_t
 
-from .objective import PARAMS, UNITS
+from .params import PARAMS, UNITS
 
 
 def confidence_intervals(problem, x_log, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:

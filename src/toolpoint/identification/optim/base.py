@@ -1,6 +1,6 @@
 """What the optimisers share: termination criteria, progress tracking, result.
 
-In pymoo's spirit the *problem* (:class:`toolpoint.objective.JointProblem`:
+In pymoo's spirit the *problem* (:class:`toolpoint.identification.objective.JointProblem`:
 ``evaluate(X)``, bounds ``xl``/``xu``, ``nfev``), the *algorithm* (GA, PSO, SA,
 DE, hybrid; options in ``__init__``) and the *termination* are separate. Every
 algorithm works on the unit cube internally and reports a scipy-style

@@ -19,7 +19,7 @@
 Every reader returns a receptance :class:`~toolpoint.frf.FRF` in m/N (a
 mobility or accelerance file is converted with :meth:`FRF.to_receptance`) and
 raises :class:`~toolpoint.errors.InputError` naming the file and field for bad
-input. Every writer writes receptance, through :mod:`toolpoint.atomic`, so a
+input. Every writer writes receptance, through :mod:`toolpoint.io.atomic`, so a
 failure never leaves a half-written file.
 """
 
@@ -33,8 +33,8 @@ import numpy as np
 import pyuff
 
 from .atomic import atomic_open, atomic_path
-from .errors import InputError
-from .frf import FRF, QUANTITIES
+from ..errors import InputError
+from ..frf import FRF, QUANTITIES
 
 __all__ = [
     "read_frf", "write_frf", "read_csv_frf", "write_csv_frf", "read_uff58", "read_uff58_all",
