@@ -4,7 +4,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-stamp
 OUT ?= toolpoint-out
 
-.PHONY: demo test bench clean
+.PHONY: demo test lint browser bench clean
 
 $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
@@ -15,8 +15,20 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(VENV)/bin/toolpoint reproduce --out $(OUT)
 
-test: $(STAMP)
+# ruff (pyflakes + pycodestyle), the one-way import layers (import-linter), then the tests and doctests
+test: lint browser
 	$(PY) -m pytest -q
+
+# The report's browser test needs Chromium (Debian's package); installed here when this user may.
+browser:
+	@command -v chromium >/dev/null 2>&1 || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; \
+	  else echo "note: Chromium is not installed and cannot be installed here; the browser test will be skipped"; fi; }
+
+lint: $(STAMP)
+	$(VENV)/bin/ruff check src tests benchmarks
+	$(VENV)/bin/lint-imports
 
 bench: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[test,bench]"

@@ -41,7 +41,8 @@ def main(argv=None):
         times.append(time.perf_counter() - t0)
     best = min(times)
     print(f"ANFIS fit: 2 inputs, 3x7 gauss MFs (21 rules, order 1), {X.shape[0]} samples, 100 epochs")
-    print(f"  best of {args.repeat}: {best:.3f} s   median: {np.median(times):.3f} s   ({1e3 * best / 100:.2f} ms/epoch)")
+    print(f"  best of {args.repeat}: {best:.3f} s   median: {np.median(times):.3f} s   "
+          f"({1e3 * best / 100:.2f} ms/epoch)")
     print(f"  final training RMSE {model.history_['train_rmse'].min():.4g} N/m (target std {y.std():.4g})")
     t0 = time.perf_counter()
     for _ in range(100):

@@ -22,11 +22,19 @@ from toolpoint.dynamics.assembly import load_assembly
 from toolpoint.campaign.config import load_campaign
 from toolpoint.campaign.learn import learn
 from toolpoint.campaign.predict import predict_frf
+from toolpoint.campaign.results import read_identified
 from toolpoint.campaign.run import run_campaign
 from toolpoint.campaign.synth import synthesise, truth_joint
+from toolpoint.cli.campaign import report_lines
 from toolpoint.errors import InputError
 from toolpoint.dynamics.model import ToolPointModel
 from toolpoint.dynamics.subassembly import Subassembly
+
+
+def _read_csv(path: Path) -> dict:
+    """Rows of a CSV with an ``id`` column, by id."""
+    with open(path, newline="") as fh:
+        return {x["id"]: x for x in csv.DictReader(fh)}
 
 
 def main() -> None:
@@ -48,20 +56,22 @@ def main() -> None:
         print(f"run (hybrid, {a.workers} workers): {r['ok']} ok, {r['failed']} failed in {r['seconds']:.1f} s "
               f"(target < 60 s for 178 on 2 cores)")
 
-    ident = {x["id"]: x for x in csv.DictReader(open(res / "identified.csv"))}
-    truth = {x["id"]: x for x in csv.DictReader(open(camp / "truth" / "truth.csv"))}
+    ident = {x["id"]: x for _, x in read_identified(res / "identified.csv").rows}
+    truth = _read_csv(camp / "truth" / "truth.csv")
     print("\nidentified vs truth law (all tools): median / 90th percentile |relative error|")
     for p in ("kt", "ct", "kr", "cr"):
         e = np.array([abs(float(ident[i][p]) / float(truth[i][p]) - 1) for i in ident if ident[i]["status"] == "ok"])
         cover = np.mean([float(ident[i][f"{p}_lo"]) <= float(truth[i][p]) <= float(ident[i][f"{p}_hi"])
                          for i in ident if ident[i]["status"] == "ok"])
-        print(f"  {p}: {np.median(e) * 100:7.2f} % / {np.percentile(e, 90) * 100:7.2f} %   (truth inside 95 % CI: {cover:.0%})")
+        print(f"  {p}: {np.median(e) * 100:7.2f} % / {np.percentile(e, 90) * 100:7.2f} %   "
+              f"(truth inside 95 % CI: {cover:.0%})")
 
     print()
     mfs = tuple(int(v) for v in a.mfs.split(","))
-    learn(res, test_size=30, mfs=mfs, mf="gauss", order=1, seed=0, log_target=not a.linear_target)
+    result = learn(res, test_size=30, mfs=mfs, mf="gauss", order=1, seed=0, log_target=not a.linear_target)
+    print("\n".join(report_lines(result)))
 
-    split = {x["id"]: x["set"] for x in csv.DictReader(open(res / "models" / "split.csv"))}
+    split = {i: x["set"] for i, x in _read_csv(res / "models" / "split.csv").items()}
     c = load_campaign(camp)
     f = c.subassembly("ER40", None).freq_hz
     true_sub = Subassembly.from_assembly(load_assembly(camp / "truth" / "spindle_holder.toml", require_tool=False), f)
@@ -89,8 +99,10 @@ def main() -> None:
     for k, p in enumerate(("kt", "ct", "kr", "cr")):
         print(f"  {p}: {np.median(jerr[:, k]) * 100:6.2f} % / {jerr[:, k].max() * 100:6.2f} %")
     print(f"\npredicted FRF of the {df.size} test tools vs truth ({failed} without a prediction):")
-    print(f"  dominant peak frequency error: median {np.median(df) * 100:.2f} %, max {df.max() * 100:.2f} % (goal median < 1 %)")
-    print(f"  dominant peak magnitude error: median {np.median(dm) * 100:.1f} %, max {dm.max() * 100:.1f} % (goal median < 10 %)")
+    print(f"  dominant peak frequency error: median {np.median(df) * 100:.2f} %, max {df.max() * 100:.2f} % "
+          "(goal median < 1 %)")
+    print(f"  dominant peak magnitude error: median {np.median(dm) * 100:.1f} %, max {dm.max() * 100:.1f} % "
+          "(goal median < 10 %)")
 
 
 if __name__ == "__main__":

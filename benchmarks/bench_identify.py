@@ -48,7 +48,7 @@ from toolpoint.frf import FRF  # noqa: E402
 from toolpoint.identification.identify import identify, make_algorithm, model_for, relative_errors  # noqa: E402
 from toolpoint.identification.objective import JointProblem  # noqa: E402
 from toolpoint.identification.params import PARAMS  # noqa: E402
-from toolpoint.identification.optim import Termination  # noqa: E402
+from toolpoint.errors import IdentifiabilityWarning  # noqa: E402
 
 try:
     import pymoo
@@ -140,36 +140,21 @@ def throughput(quick: bool) -> None:
 # --------------------------------------------------------------------------- runners
 # Each returns (x_log (4,), evaluations used, seconds, objective, stop message).
 
+def quiet_identify(*args, **kwargs):
+    """identify() without printing its IdentifiabilityWarnings (the tables count ``r.warnings``)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IdentifiabilityWarning)
+        return identify(*args, **kwargs)
+
+
 def run_ours(model, measured, method, seed, budget=None):
-    """Our optimiser through ``identify``; ``budget`` None = the method's own default termination.
+    """Our optimiser through ``identify``; ``budget`` None = the method's own default stopping rules.
 
-    At a budget, the method's default stall criterion is kept and the iteration
-    count is chosen so the evaluations cannot exceed the budget (the iteration
-    count also sets PSO's inertia schedule)."""
-    term = None
-    if budget is not None:
-        term = budget_termination(method, budget)
-    r = identify(model, measured, method, seed=seed, termination=term)
+    At a budget: ``maxfev`` = budget (never exceeded; GA/PSO schedules run over what it affords),
+    no iteration cap, the method's default stall test kept."""
+    options = None if budget is None else {"maxiter": None, "maxfev": budget}
+    r = quiet_identify(model, measured, method, seed=seed, options=options)
     return r.x_log, int(r.nfev), float(r.seconds), float(r.fun), str(r.message).split(";")[0]
-
-
-def budget_termination(method: str, budget: int) -> Termination:
-    algo = make_algorithm(method)
-    base = algo.termination()
-    d = 4
-    if method == "ga":
-        P = algo.population_size
-        per_gen = P - max(1, int(round(algo.elite_fraction * P)))  # elites are not re-evaluated
-        return Termination(max_iter=max((budget - P) // per_gen, 1), max_evals=budget,
-                           stall_iter=base.stall_iter, ftol=base.ftol)
-    if method == "pso":
-        n = algo.swarm_size
-        return Termination(max_iter=max((budget - n) // n, 1), max_evals=budget,
-                           stall_iter=base.stall_iter, ftol=base.ftol)
-    if method == "sa":  # chains per iteration + at most chains × d sensitivity points at a reanneal
-        return Termination(max_iter=None, max_evals=budget - algo.chains * (1 + d),
-                           stall_iter=base.stall_iter, ftol=base.ftol)
-    raise ValueError(method)
 
 
 def run_scipy_de(prob, budget, seed):
@@ -185,7 +170,8 @@ def run_scipy_da(prob, budget, seed):
     # maxiter raised from 1000 so that the evaluation budget (maxfun) is what stops it
     t0 = time.perf_counter()
     res = dual_annealing(prob.evaluate, list(zip(prob.xl, prob.xu)), maxfun=budget, maxiter=10**7, rng=seed)
-    return res.x, time.perf_counter() - t0, "scipy: " + (" ".join(res.message) if isinstance(res.message, (list, tuple)) else str(res.message))
+    msg = " ".join(res.message) if isinstance(res.message, (list, tuple)) else str(res.message)
+    return res.x, time.perf_counter() - t0, "scipy: " + msg
 
 
 
@@ -271,7 +257,8 @@ def side_by_side(model, measured, exact, quick: bool) -> dict:
     b1 = int(np.ceil(5 * hybrid_evals / 100.0) * 100)
     b2 = 20_000 if quick else 100_000
     for label, budget in (("B", b1), ("C", b2)):
-        what = f"5 × the hybrid's median {hybrid_evals:,} evaluations, rounded up" if label == "B" else "a larger budget"
+        what = (f"5 × the hybrid's median {hybrid_evals:,} evaluations, rounded up" if label == "B"
+                else "a larger budget")
         print(f"\n   {label}. Common budget {budget:,} points ({what}); the hybrid row is its default run "
               "(budget 'own') for reference")
         print(HEAD)
@@ -291,8 +278,9 @@ def side_by_side(model, measured, exact, quick: bool) -> dict:
     print("   Notes: objective = ‖h(p) − h̄‖₂ over 3000 frequencies (exact joint → ~1e-17, round-off). Our rows: "
           "seconds include identify()'s\n"
           "   confidence-interval step; at a budget our GA/SA/PSO keep their default stall criterion (so may stop "
-          "early) and iterations\n"
-          "   are set to fit the budget. scipy DE: popsize 15 (60 members), maxiter = (budget − 60) // 60, tol "
+          "early), run with\n"
+          "   maxfev = budget and no iteration cap (GA/PSO schedules span what the budget affords).\n"
+          "   scipy DE: popsize 15 (60 members), maxiter = (budget − 60) // 60, tol "
           "0.01 (may stop early),\n"
           "   no polish. dual_annealing: maxfun = budget, maxiter raised to 1e7 so the budget binds; its "
           "L-BFGS-B local searches\n"
@@ -304,13 +292,13 @@ def side_by_side(model, measured, exact, quick: bool) -> dict:
 
 def default_caps() -> dict:
     ga, pso, sa, hy = (make_algorithm(m) for m in ("ga", "pso", "sa", "hybrid"))
-    P = ga.population_size
-    ga_cap = P + ga.generations * (P - max(1, int(round(ga.elite_fraction * P))))
+    P = ga.popsize
+    ga_cap = P + (ga.maxiter - 1) * (P - max(1, int(round(ga.elite_fraction * P))))
     de = hy.global_stage
     return {
-        "ga": f"≤ {ga_cap:,} (pop {P} × {ga.generations} gen, stall {ga.stall_generations})",
-        "sa": f"{sa.chains} chains × ≤ {sa.max_iterations} it + reanneals (stall {sa.stall_iterations})",
-        "pso": f"{pso.swarm_size * (pso.iterations + 1):,} (swarm {pso.swarm_size} × {pso.iterations} it)",
+        "ga": f"≤ {ga_cap:,} (pop {P} × {ga.maxiter} gen, stall {ga.stall_iter})",
+        "sa": f"{sa.chains} chains × ≤ {sa.maxiter} it + reanneals (stall {sa.stall_iter})",
+        "pso": f"{pso.popsize * pso.maxiter:,} (swarm {pso.popsize} × {pso.maxiter} it)",
         "hybrid": f"DE {getattr(de, 'popsize', '?')}×4 members × ≤ {getattr(de, 'maxiter', '?')} gen + "
                   f"least squares from {hy.starts} starts",
     }
@@ -337,7 +325,7 @@ def hybrid_check(model, measured, exact) -> None:
           + "  verdict")
     worst_err, worst_s, worst_n, ok_all = 0.0, 0.0, 0, True
     for s in range(10):
-        r = identify(model, measured, "hybrid", seed=s)
+        r = quiet_identify(model, measured, "hybrid", seed=s)
         e = relative_errors(r.x, exact)
         m = max(e.values())
         ok = m < 1e-4 and r.seconds < 1.0 and r.nfev < 20000
@@ -364,7 +352,7 @@ def noise_coverage(model, measured, exact, trials: int) -> None:
     for t in range(trials):
         rng = np.random.default_rng(1000 + t)
         noise = sigma * (rng.standard_normal(FREQ.size) + 1j * rng.standard_normal(FREQ.size)) / np.sqrt(2)
-        r = identify(model, FRF(FREQ, measured.values + noise), "hybrid", seed=t)
+        r = quiet_identify(model, FRF(FREQ, measured.values + noise), "hybrid", seed=t)
         for i, k in enumerate(PARAMS):
             lo, hi = r.ci95[k]
             inside[t, i] = lo <= exact[i] <= hi

@@ -1,24 +1,35 @@
 """Speed and accuracy figures of the stability-lobe solvers (prints; not a test).
 
-    .venv/bin/python benchmarks/bench_lobes.py [--quick]
+    .venv/bin/python benchmarks/bench_lobes.py [--quick] [--sdm-only]
+
+First the semi-discretisation tables (machine and date printed): default accuracy
+against a converged plain-SDM reference for the one-mode Insperger & Stépán cases
+and a 2-DOF case, CPU time per boundary, and the 4-modes-per-direction case
+(1000 speeds; 100 with --quick, ≈ 1 min). --quick --sdm-only takes ≈ 1 min.
 
 Targets: zero-order lobes over 1000 speeds from a 3001-point FRF < 0.2 s;
 semi-discretisation of one mode (100 speeds, bisection on depth; or a
-100 × 50 speed × depth grid) < 5 s.
+100 × 50 speed × depth grid) < 5 s; 4 modes per direction, 1000 speeds ≤ 20 s CPU.
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
+import os
+import platform
 import time
 
 import numpy as np
 
-from toolpoint.stability import ModalModel, sdm_lobes, sdm_spectral_radius, zoa_lobes
+from toolpoint.stability import CuttingConditions, ModalModel, sdm_lobes, sdm_spectral_radius, zoa_lobes
 
 # Insperger & Stépán (2004) benchmark: one mode in x, 2 teeth, Kt = 6e8, Kn = 2e8 N/m².
 MODE = ModalModel([922.0], [0.011], [0.03993])
-CUT = dict(teeth=2, kt=6e8, kr=1 / 3, milling="down")
+
+
+def cut(ri, teeth=2, kr=1 / 3):
+    return CuttingConditions(teeth=teeth, tangential_coeff=6e8, radial_ratio=kr, radial_immersion=ri)
 
 
 def best_of(fn, repeat):
@@ -30,10 +41,115 @@ def best_of(fn, repeat):
     return out, min(times), float(np.median(times))
 
 
+def _exact_one_mode(rpm, h, nk=10):
+    """Exact zero-order limit (m) of MODE (x only, h > 0) per speed, by bisection in ω."""
+    wn = MODE.omega_n[0]
+    T = 60.0 / (2 * rpm)
+
+    def phi(w):
+        return 1 / (MODE.mass_kg[0] * (wn**2 - w**2 + 2j * MODE.zeta[0] * wn * w))
+
+    out = np.full(T.size, np.inf)
+    for dk in range(nk):
+        k = np.maximum(np.ceil(wn * T / (2 * np.pi) - 1 - 1e-12), 0) + dk
+        lo, hi = np.full(T.size, wn * (1 + 1e-15)), np.full(T.size, 2 * np.pi * 3000.0)
+
+        def g(w):
+            mu = h * phi(w)
+            return w * T - (np.pi + 2 * np.arctan2(-mu.imag, -mu.real)) - 2 * np.pi * k
+
+        ok = (g(lo) < 0) & (g(hi) > 0)
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            neg = g(mid) < 0
+            lo, hi = np.where(neg, mid, lo), np.where(neg, hi, mid)
+        out = np.where(ok, np.minimum(out, -0.5 / (h * phi(0.5 * (lo + hi)).real)), out)
+    return out
+
+
+def _cpu(fn):
+    """(result, CPU s, wall s) of one call."""
+    c, w = time.process_time(), time.perf_counter()
+    out = fn()
+    return out, time.process_time() - c, time.perf_counter() - w
+
+
+def _reference(model_x, model_y, c, sp, ms):
+    """Converged plain SDM (every node, fixed m): Richardson extrapolation of the two finest m (error O(Δt²))."""
+    a, b = (sdm_lobes(model_x, model_y, c, rpm=sp, m=m, rtol=1e-6).depth_m for m in ms)
+    return b + (b - a) / 3
+
+
+def sdm_accuracy_table(quick: bool) -> None:
+    """Default SDM against a converged reference: one-mode Insperger cases, the 2-DOF case; time per boundary."""
+    print(f"\n== SDM default (accuracy 1) against the converged plain SDM — {platform.node()}, "
+          f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, "
+          f"{datetime.datetime.now().isoformat(timespec='minutes')}")
+    ms = (80, 160) if quick else (160, 320)
+    print(f"   reference: plain first-order SDM at m = {ms[0]} and {ms[1]} steps over the cut, Richardson-extrapolated")
+    # 2-DOF case: x 456.78/1448.89 Hz, y 516.52/1408.45 Hz; our choice: every mode k = 2e7 N/m, ζ = 0.02.
+    k2, z2 = 2e7, 0.02
+
+    def modes(fn):
+        fn = np.array(fn)
+        return ModalModel(fn, [z2] * fn.size, k2 / (2 * np.pi * fn) ** 2)
+
+    two_x, two_y = modes([456.78, 1448.89]), modes([516.52, 1408.45])
+    cases = [
+        ("1 mode, slotting, down", MODE, None, cut(1.0), [7424.0, 10051.0, 15909.0, 21000.0]),
+        ("1 mode, a/D 0.05, down", MODE, None, cut(0.05), [7500.0, 10000.0, 15800.0, 18900.0]),
+        ("1 mode, a/D 0.05, up", MODE, None,
+         CuttingConditions(teeth=2, tangential_coeff=6e8, radial_ratio=1 / 3, radial_immersion=0.05, milling="up"),
+         [7500.0, 10000.0, 15800.0, 18900.0]),
+        ("2-DOF x/y, a/D 0.5, down", two_x, two_y,
+         CuttingConditions(teeth=2, tangential_coeff=1319.4e6, radial_ratio=788.8 / 1319.4, radial_immersion=0.5),
+         [4000.0, 6000.0, 8000.0, 10000.0, 12000.0]),
+    ]
+    print(f"   {'case':28s} {'speeds':>6s} {'max |err|':>9s} {'median':>8s} {'m':>9s} "
+          f"{'CPU s/boundary (100 speeds)':>28s}")
+    for name, mx, my, c, sp in cases:
+        sp = np.array(sp)
+        ref = _reference(mx, my, c, sp, ms)
+        res = sdm_lobes(mx, my, c, rpm=sp, rtol=1e-5)
+        err = np.abs(res.depth_m / ref - 1)
+        r100 = np.linspace(sp.min(), sp.max(), 100)
+        _, cpu, wall = _cpu(lambda: sdm_lobes(mx, my, c, rpm=r100))
+        print(f"   {name:28s} {sp.size:6d} {err.max():9.2%} {np.median(err):8.2%} "
+              f"{res.params['m'].min():4d}–{res.params['m'].max():<4d} {cpu:10.2f} (wall {wall:.2f})")
+    print(f"   2-DOF modal parameters chosen: k = {k2:.0e} N/m and ζ = {z2} for every mode, "
+          f"K_r = 788.8/1319.4 = {788.8 / 1319.4:.4f}")
+
+
+def sdm_four_modes(quick: bool) -> None:
+    """CPU time of the SDM with 4 fitted modes per direction (README example assembly), 1000 speeds."""
+    from pathlib import Path
+
+    from toolpoint.dynamics.model import frf_from_toml
+    from toolpoint.stability import fit_modes
+
+    frf = frf_from_toml(Path(__file__).resolve().parents[1] / "examples" / "numerical_case.toml").to_receptance()
+    mx = fit_modes(frf, 4)
+    n = 100 if quick else 1000
+    c = cut(0.5, teeth=4, kr=0.3)
+    res, cpu, wall = _cpu(lambda: sdm_lobes(mx, mx, c, rpm=np.linspace(5000.0, 30000.0, n)))
+    note = f" (×10 ≈ {10 * cpu:.0f} s for 1000)" if quick else ""
+    print(f"\n== SDM, 4 fitted modes per direction (f_n {', '.join(f'{f:.0f}' for f in mx.fn_hz)} Hz), 4 teeth, "
+          f"a/D 0.5, {n} speeds 5000–30000 rpm: CPU {cpu:.1f} s{note}, wall {wall:.1f} s, "
+          f"{res.params['evaluations']} Floquet matrices, m = {res.params['m'].min()}–{res.params['m'].max()}  "
+          "target ≤ 20 s CPU for 1000")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="fewer repeats, skip the m = 160 reference")
-    quick = ap.parse_args().quick
+    ap.add_argument("--quick", action="store_true",
+                    help="fewer repeats, coarser references, 100 instead of 1000 speeds for the 4-mode case")
+    ap.add_argument("--sdm-only", action="store_true", help="only the semi-discretisation accuracy and cost tables")
+    args = ap.parse_args()
+    quick = args.quick
+    sdm_accuracy_table(quick)
+    sdm_four_modes(quick)
+    if args.sdm_only:
+        return
     rep = 3 if quick else 10
 
     f = np.linspace(0.0, 3000.0, 3001)
@@ -44,7 +160,7 @@ def main() -> None:
     print("== zero-order approximation (3001-point FRF, 1000 speeds 2000–25000 rpm)")
     for name, fy, ri in (("x only, slotting", "rigid", 1.0), ("symmetric x = y, a/D = 0.5", None, 0.5),
                          ("x ≠ y (3 modes / 1 mode), a/D = 0.3", two, 0.3)):
-        res, tmin, tmed = best_of(lambda: zoa_lobes(frf, fy, **CUT, radial_immersion=ri, rpm=rpm), rep)
+        res, tmin, tmed = best_of(lambda: zoa_lobes(frf, fy, cut(ri), rpm=rpm), rep)
         print(f"  {name:38s} best {1e3 * tmin:6.1f} ms  median {1e3 * tmed:6.1f} ms  "
               f"({len(res.lobes)} lobes, min {1e3 * res.min_depth_m:.4f} mm @ {res.min_rpm:.0f} rpm)  target < 200 ms")
 
@@ -53,38 +169,52 @@ def main() -> None:
     ref = 2 * k * 0.011 * 1.011 / (2 * 2e8 / 4)
     for df in (1.0, 0.1):
         fd = np.arange(0.0, 3000.0 + df / 2, df)
-        res = zoa_lobes(MODE.frf(fd), "rigid", **CUT, radial_immersion=1.0, rpm=rpm)
+        res = zoa_lobes(MODE.frf(fd), "rigid", cut(1.0), rpm=rpm)
         print(f"  FRF step {df:4.1f} Hz: ZOA {1e3 * res.min_depth_m:.6f} mm, closed form {1e3 * ref:.6f} mm, "
               f"relative error {res.min_depth_m / ref - 1:+.2e}")
+
+    print("\n== streamed: one mode, 0.01 Hz steps over 0–3000 Hz (300001 points), 1000 speeds 2000–25000 rpm")
+    fine = np.arange(0.0, 3000.005, 0.01)
+    res, t, _ = best_of(lambda: zoa_lobes(MODE.frf(fine), "rigid", cut(1.0), rpm=rpm), 1 if quick else 3)
+    print(f"  {t:5.2f} s  ({len(res.lobes)} lobes, {sum(lobe.rpm.size for lobe in res.lobes)} lobe points kept)")
+
+    print("\n== exact zero-order limit (per-speed root of ωT − ε(ω) = 2πk on the closed-form FRF), 1 Hz FRF")
+    h = 2 * 2e8 / 4
+    ref = _exact_one_mode(rpm, h)
+    for df in (1.0, 0.5, 0.1):
+        fd = np.arange(0.0, 3000.0 + df / 2, df)
+        res = zoa_lobes(MODE.frf(fd), "rigid", cut(1.0), rpm=rpm)
+        q = res.depth_m / ref - 1
+        print(f"  FRF step {df:4.1f} Hz: max limit/exact − 1 = {q.max():+.2e} (at {rpm[np.argmax(q)]:.0f} rpm), "
+              f"min {q.min():+.2e}")
 
     print("\n== semi-discretisation, one mode, 100 speeds 5000–25000 rpm (search + bisection, rtol 1e-3)")
     r100 = np.linspace(5000.0, 25000.0, 100)
     sdm = {}
     for ri in (1.0, 0.05):
-        res, t, _ = best_of(lambda: sdm_lobes(MODE, None, **CUT, radial_immersion=ri, rpm=r100), 1 if quick else 2)
+        res, t, _ = best_of(lambda: sdm_lobes(MODE, None, cut(ri), rpm=r100), 1 if quick else 2)
         sdm[ri] = res
         ms = res.params["m"]
         print(f"  a/D = {ri:4.2f}: {t:5.2f} s  (m = {ms.min()}–{ms.max()} steps over the cut; "
               f"min {1e3 * res.min_depth_m:.4f} mm @ {res.min_rpm:.0f} rpm, chatter {res.min_chatter_hz:.1f} Hz)  "
               "target < 5 s")
     depth = np.linspace(0.05e-3, 5e-3, 50)
-    rho, t, _ = best_of(lambda: sdm_spectral_radius(MODE, None, **CUT, radial_immersion=0.05,
+    rho, t, _ = best_of(lambda: sdm_spectral_radius(MODE, None, cut(0.05),
                                                     rpm=r100[None, :], depth=depth[:, None], m=20), 1)
     print(f"  a/D = 0.05, 100 × 50 speed × depth grid of ρ (m = 20): {t:5.2f} s, "
           f"{int((rho >= 1).sum())} of {rho.size} points unstable  target < 5 s")
-    rho, t, _ = best_of(lambda: sdm_spectral_radius(MODE, None, **CUT, radial_immersion=1.0,
+    rho, t, _ = best_of(lambda: sdm_spectral_radius(MODE, None, cut(1.0),
                                                     rpm=r100[None, :], depth=depth[:, None], m=40), 1)
     print(f"  a/D = 1.00, 100 × 50 speed × depth grid of ρ (m = 40): {t:5.2f} s")
 
     if not quick:
         three = ModalModel([650.0, 922.0, 2214.0], [0.03, 0.011, 0.02], [0.4, 0.03993, 0.2])
-        res, t, _ = best_of(lambda: sdm_lobes(three, three, teeth=4, kt=6e8, kr=0.3, radial_immersion=0.5,
-                                              rpm=r100), 1)
+        res, t, _ = best_of(lambda: sdm_lobes(three, three, cut(0.5, teeth=4, kr=0.3), rpm=r100), 1)
         ms = res.params["m"]
         print(f"  3 modes in x and in y, 4 teeth, a/D = 0.5: {t:5.2f} s  (m = {ms.min()}–{ms.max()}; "
               f"Floquet matrices up to {12 + 2 * (ms.max() + 1)}²)")
 
-    zoa = zoa_lobes(frf, "rigid", **CUT, radial_immersion=1.0, rpm=r100)
+    zoa = zoa_lobes(frf, "rigid", cut(1.0), rpm=r100)
     print(f"\n== slotting minima: ZOA {1e3 * zoa.min_depth_m:.4f} mm, SDM {1e3 * sdm[1.0].min_depth_m:.4f} mm "
           f"(SDM/ZOA − 1 = {sdm[1.0].min_depth_m / zoa.min_depth_m - 1:+.1%}; SDM on the 100-speed grid)")
 
@@ -93,12 +223,13 @@ def main() -> None:
     ms = (10, 20, 40, 80) if quick else (10, 20, 40, 80, 160)
     for ri, sp in speeds.items():
         sp = np.array(sp)
-        rows = [sdm_lobes(MODE, None, **CUT, radial_immersion=ri, rpm=sp, m=m, rtol=1e-6).depth_m for m in ms]
+        rows = [sdm_lobes(MODE, None, cut(ri), rpm=sp, m=m, rtol=1e-6).depth_m for m in ms]
         print(f"  a/D = {ri:4.2f}   speeds {', '.join(f'{s:.0f}' for s in sp)} rpm")
         for i, m in enumerate(ms):
-            change = "" if i == 0 else f"   max change vs m = {ms[i - 1]}: {np.max(np.abs(rows[i] / rows[i - 1] - 1)):.2%}"
+            rel = np.max(np.abs(rows[i] / rows[i - 1] - 1)) if i else 0.0
+            change = "" if i == 0 else f"   max change vs m = {ms[i - 1]}: {rel:.2%}"
             print(f"    m = {m:3d}: " + "  ".join(f"{1e3 * d:8.5f}" for d in rows[i]) + change)
-        auto = sdm_lobes(MODE, None, **CUT, radial_immersion=ri, rpm=sp, rtol=1e-6)
+        auto = sdm_lobes(MODE, None, cut(ri), rpm=sp, rtol=1e-6)
         print(f"    default (20 steps/wave, m = {', '.join(str(x) for x in auto.params['m'])}): "
               + "  ".join(f"{1e3 * d:8.5f}" for d in auto.depth_m))
 

@@ -42,8 +42,8 @@ def test_transfer_matrix_equals_matrix_exponential():
     T = transfer_matrix(sec, L, w)
     for k, om in enumerate(w):
         a = 1 / (sec.kappa * sec.G * sec.A)
-        b = 1 / (sec.E * sec.I)
-        m, j = sec.rho * sec.A * om**2, sec.rho * sec.I * om**2
+        b = 1 / (sec.E * sec.Iz)
+        m, j = sec.rho * sec.A * om**2, sec.rho * sec.Iz * om**2
         A = np.array([[0, 1, a, 0], [0, 0, 0, b], [-m, 0, 0, 0], [0, -j, -1, 0]], complex)
         E = expm(A * L)
         assert np.abs(T[k] - E).max() <= 1e-12 * np.abs(E).max()
@@ -106,7 +106,7 @@ def test_mass_line_and_reciprocity():
 def test_transfer_chain_sweep_and_dense_solve_agree(segs, with_bearings, eta):
     """Three independent ways to the same end receptances (chain, sweep, dense LAPACK)."""
     mat = Material("m", 210e9, 7800.0, 0.3, eta)
-    segments = tuple(Segment(l * 1e-3, d * 1e-3, d * r * 1e-3, mat) for l, d, r in segs)
+    segments = tuple(Segment(length * 1e-3, d * 1e-3, d * r * 1e-3, mat) for length, d, r in segs)
     total = sum(s.length for s in segments)
     bearings = (Bearing(0.2 * total, 2e8, 1000.0), Bearing(0.9 * total, 3e8, 2000.0, 1e5, 5.0)) if with_bearings else ()
     comp = Component("c", segments, bearings)
@@ -122,15 +122,40 @@ def test_transfer_chain_sweep_and_dense_solve_agree(segs, with_bearings, eta):
 
 
 def test_refinement_does_not_move_the_tool_point_frf(example):
-    """Converged: sub-dividing every piece further changes the FRF by < 1e-4 (here ~1e-12)."""
-    from toolpoint.dynamics import components
+    """The pieces are exact: an 8× finer mesh (more, shorter pieces) moves the tool-point FRF by round-off only."""
+    from toolpoint.dynamics.components import MAX_BETA_L
     from toolpoint.dynamics.model import AssemblyModel
 
-    h = AssemblyModel(example).tool_point_frf().values
-    old = components.MAX_BETA_L
-    try:
-        components.MAX_BETA_L = 0.25
-        h_fine = AssemblyModel(example).tool_point_frf().values
-    finally:
-        components.MAX_BETA_L = old
+    coarse = AssemblyModel(example)
+    fine = AssemblyModel(example, max_beta_l=MAX_BETA_L / 8)
+    # the refined model really is a different mesh (otherwise this test could not fail)
+    n_coarse, n_fine = sum(coarse.n_pieces.values()), sum(fine.n_pieces.values())
+    assert n_fine > 2 * n_coarse
+    for name in ("spindle", "holder", "tool"):
+        assert fine.n_pieces[name] > coarse.n_pieces[name]
+    h, h_fine = coarse.tool_point_frf().values, fine.tool_point_frf().values
+    assert np.array_equal(coarse.freq_hz, fine.freq_hz) and coarse.freq_hz[-1] == 3000.0
     assert np.linalg.norm(h - h_fine) / np.linalg.norm(h_fine) < 1e-9
+
+
+def test_fe_frequency_error_falls_as_h_squared():
+    """The FE check element converges to the exact Timoshenko free–free frequencies with order ≈ 2 in h."""
+    from scipy.linalg import eigh
+
+    from toolpoint.dynamics.fe import FEModel
+
+    seg = Segment(0.3, 0.05, 0.0, STEEL)  # stocky: 2399.2 and 5976.0 Hz exact (see above)
+    exact = np.array(free_free_frequencies(seg, 2, 7000))
+    assert exact == pytest.approx([2399.2, 5976.0], abs=0.06)
+    hs = np.array([0.03, 0.015, 0.0075, 0.00375])
+    errors = []
+    for h in hs:
+        K, _, M = FEModel([Component("bar", (seg,))], [], max_element_m=h).matrices()
+        lam = eigh(K.real, M, eigvals_only=True)
+        f_fe = np.sqrt(np.abs(lam[2:4])) / (2 * np.pi)  # skip the two rigid-body modes (λ = 0)
+        assert np.all(np.abs(lam[:2]) < 1e-6 * lam[2])
+        errors.append((f_fe - exact) / exact)
+    errors = np.array(errors)
+    assert np.all(errors > 0)  # consistent mass: an upper bound (Rayleigh–Ritz)
+    order = np.log2(errors[:-1] / errors[1:])
+    assert np.all((order > 1.8) & (order < 2.2)), order

@@ -7,8 +7,9 @@ import json
 import numpy as np
 import pytest
 
-from toolpoint.learning.anfis import ANFIS
-from toolpoint.campaign.learn import PAPER, add_arguments, learn, run_cli
+from toolpoint.learning.anfis import ANFIS, predict_quietly
+from toolpoint.campaign.learn import PAPER, learn
+from toolpoint.cli.campaign import add_arguments, report_lines, run_cli
 from toolpoint.errors import InputError
 
 HEADER = [
@@ -75,16 +76,15 @@ def campaign(tmp_path_factory):
     the seed — see test_paper_grid_3x7), so the accuracy check uses 9 rules.
     """
     folder = write_identified(tmp_path_factory.mktemp("campaign") / "results", identified_rows())
-    lines = []
-    result = learn(folder, mfs=(3, 3), epochs=60, out=lines.append)
-    return folder, result, "\n".join(lines)
+    result = learn(folder, mfs=(3, 3), epochs=60)
+    return folder, result, "\n".join(report_lines(result))
 
 
 def test_models_split_metrics_and_plots(campaign):
     folder, result, text = campaign
-    assert result["n_rows"] == 180 and result["n_ok"] == 178
-    assert (result["n_train"], result["n_test"]) == (148, 30)
-    assert result["targets"] == ["kt", "ct", "kr"]
+    assert result.n_rows == 180 and result.n_ok == 178
+    assert (result.n_train, result.n_test) == (148, 30)
+    assert result.targets == ["kt", "ct", "kr"]
 
     split = read_split(folder)
     assert split[0] == ("id", "set")
@@ -101,16 +101,16 @@ def test_models_split_metrics_and_plots(campaign):
 
     # smooth law + 2 % noise: ANFIS predicts the test set well
     for t in ("kt", "kr"):
-        test = result["metrics"][t]["anfis"]["test"]
+        test = result.metrics[t]["anfis"]["test"]
         assert test["n"] == 30
         assert test["mape"] < 5 and test["max_ape"] < 25  # max: small-D kr, fitted in absolute terms
         assert test["nrmse"] < 0.3 and test["afv"] > 0.99
-        assert not result["metrics"][t]["anfis"]["overfit"]
+        assert not result.metrics[t]["anfis"]["overfit"]
         for key in ("gpr", "gbr"):  # baselines on the same split
-            assert result["metrics"][t][key]["test"]["n"] == 30
-            assert np.isfinite(result["metrics"][t][key]["test"]["mape"])
+            assert result.metrics[t][key]["test"]["n"] == 30
+            assert np.isfinite(result.metrics[t][key]["test"]["mape"])
     # the GP sees exactly this kind of smooth law: it must do well too
-    assert result["metrics"]["kt"]["gpr"]["test"]["mape"] < 5
+    assert result.metrics["kt"]["gpr"]["test"]["mape"] < 5
 
     # printed table: ours, the baselines and the paper's test numbers side by side
     for word in ("NRMSE", "AFV", "MAPE %", "max APE %", "ANFIS", "GP regression", "gradient boosting", "Čiča et al."):
@@ -119,7 +119,7 @@ def test_models_split_metrics_and_plots(campaign):
     assert len(paper_kt) == 2 and "0.09427" in paper_kt[0] and "0.08993" in paper_kt[1]
 
     doc = json.loads((folder / "models" / "metrics.json").read_text())
-    assert doc["metrics"]["kr"]["anfis"]["test"]["mape"] == pytest.approx(result["metrics"]["kr"]["anfis"]["test"]["mape"])
+    assert doc["metrics"]["kr"]["anfis"]["test"]["mape"] == pytest.approx(result.metrics["kr"]["anfis"]["test"]["mape"])
     assert doc["paper"]["kt"]["afv"] == PAPER["kt"]["afv"]
     with open(folder / "models" / "metrics.csv", newline="") as fh:
         table = list(csv.DictReader(fh))
@@ -128,43 +128,44 @@ def test_models_split_metrics_and_plots(campaign):
     }  # fmt: skip
 
     pngs = sorted(p.name for p in (folder / "plots").iterdir())
-    assert pngs == sorted(f"anfis_{t}_{kind}.png" for t in ("kt", "ct", "kr") for kind in ("test", "regression", "membership"))
+    kinds = ("test", "regression", "membership")
+    assert pngs == sorted(f"anfis_{t}_{kind}.png" for t in ("kt", "ct", "kr") for kind in kinds)
     assert all((folder / "plots" / n).read_bytes()[:4] == b"\x89PNG" for n in pngs)
 
 
 def test_paper_grid_3x7(tmp_path):
     """The defaults are the paper's: 3x7 Gaussian MFs, 21 rules, linear consequents, 200 epochs."""
     folder = write_identified(tmp_path, identified_rows())
-    lines = []
-    r = learn(folder, targets=["kt", "kr"], baselines=False, plots=False, out=lines.append)
-    assert r["settings"]["mfs"] == [3, 7] and r["settings"]["epochs"] == 200 and r["settings"]["mf"] == "gauss"
+    r = learn(folder, targets=["kt", "kr"], baselines=False, plots=False)
+    lines = report_lines(r)
+    assert r.settings["mfs"] == [3, 7] and r.settings["epochs"] == 200 and r.settings["mf"] == "gauss"
     assert any("3x7 gauss MFs (21 rules), order 1, 200 epochs" in s for s in lines)
     for t in ("kt", "kr"):
         m = ANFIS.load(folder / "models" / f"{t}.json")
         assert m.consequents_.shape == (21, 3) and m.epochs == 200
-        res = r["metrics"][t]["anfis"]
+        res = r.metrics[t]["anfis"]
         assert res["train"]["n"] == 148 and res["test"]["n"] == 30
         assert res["train"]["mape"] < 3  # it fits the training data closely …
         # … and any over-fitting is flagged, not hidden
         ratio = res["test"]["nrmse"] / res["train"]["nrmse"]
         assert res["overfit"] == (ratio > 2)
     n_warned = sum(s.startswith("warning: ANFIS test NRMSE") for s in lines)
-    assert n_warned == sum(r["metrics"][t]["anfis"]["overfit"] for t in ("kt", "kr"))
+    assert n_warned == sum(r.metrics[t]["anfis"]["overfit"] for t in ("kt", "kr"))
 
 
 def test_cr_left_out_with_reason(campaign):
     """Identified in 15 of 178 rows: fewer than MIN_RELIABLE training rows to learn or score it."""
     _, result, text = campaign
-    assert "cr" not in result["targets"] and "cr" in result["excluded"]
-    assert result["identifiable_share"]["cr"] == pytest.approx(15 / 178)
-    assert result["identifiable_share"]["ct"] == pytest.approx(1.0)
+    assert "cr" not in result.targets and "cr" in result.excluded
+    assert result.identifiable_share["cr"] == pytest.approx(15 / 178)
+    assert result.identifiable_share["ct"] == pytest.approx(1.0)
     assert "cr left out" in text and "too few identified rows" in text
 
 
 def test_split_reproducible_with_seed(tmp_path):
     rows = identified_rows(n=60, n_failed=0)
     a, b, c = (write_identified(tmp_path / name, rows) for name in "abc")
-    quick = dict(test_size=12, mfs=(2, 2), epochs=3, targets=["kt"], baselines=False, plots=False, out=lambda s: None)
+    quick = dict(test_size=12, mfs=(2, 2), epochs=3, targets=["kt"], baselines=False, plots=False)
     learn(a, seed=7, **quick)
     learn(b, seed=7, **quick)
     learn(c, seed=8, **quick)
@@ -175,12 +176,13 @@ def test_split_reproducible_with_seed(tmp_path):
 
 def test_explicit_targets_and_log_target(tmp_path):
     folder = write_identified(tmp_path, identified_rows(n=60, n_failed=0))
-    lines = []
-    r = learn(folder, test_size=15, mfs=3, epochs=5, targets=["kr", "cr"], log_target=True, baselines=False, plots=False, out=lines.append)
-    assert r["targets"] == ["kr"] and list(r["excluded"]) == ["cr"]  # asked for, but identified in 5 rows
+    r = learn(folder, test_size=15, mfs=3, epochs=5, targets=["kt", "kr", "cr"], log_target=True, baselines=False,
+              plots=False)
+    lines = report_lines(r)
+    assert r.targets == ["kt", "kr"] and list(r.excluded) == ["cr"]  # asked for, but identified in 5 rows
     assert any("cr left out" in s for s in lines)
     assert ANFIS.load(folder / "models" / "kr.json").log_target and not (folder / "models" / "cr.json").exists()
-    assert r["metrics"]["kr"]["anfis"]["test"]["n"] == 15 and "gpr" not in r["metrics"]["kr"]
+    assert r.metrics["kr"]["anfis"]["test"]["n"] == 15 and "gpr" not in r.metrics["kr"]
 
 
 def test_run_cli(tmp_path, capsys):
@@ -188,7 +190,8 @@ def test_run_cli(tmp_path, capsys):
     parser = argparse.ArgumentParser()
     parser.add_argument("results_dir")
     add_arguments(parser)
-    args = parser.parse_args([str(folder), "--test-size", "10", "--mfs", "2,3", "--epochs", "4", "--no-baselines", "--seed", "3"])
+    args = parser.parse_args([str(folder), "--test-size", "10", "--mfs", "2,3", "--epochs", "4", "--no-baselines",
+                              "--seed", "3"])
     assert args.mf == "gauss" and args.order == 1 and args.step_size == 0.01 and args.log_target
     assert run_cli(args) == 0
     assert "kt [N/m]" in capsys.readouterr().out
@@ -205,7 +208,7 @@ def test_run_cli(tmp_path, capsys):
 
 
 def test_bad_input(tmp_path):
-    quiet = dict(baselines=False, plots=False, epochs=2, out=lambda s: None)
+    quiet = dict(baselines=False, plots=False, epochs=2)
     with pytest.raises(InputError) as err:  # no identified.csv
         learn(tmp_path / "nothing", **quiet)
     assert err.value.file.endswith("identified.csv") and "not found" in str(err.value)
@@ -220,7 +223,9 @@ def test_bad_input(tmp_path):
     with pytest.raises(InputError) as err:  # 39 ok rows < 30 + 10
         learn(few, **quiet)
     assert err.value.field == "status" and "39" in str(err.value)
-    learn(few, test_size=29, mfs=2, **quiet)  # exactly test_size + 10 is enough
+    with pytest.raises(InputError) as err:  # exactly test_size + 10 rows pass the row check ...
+        learn(few, test_size=29, mfs=2, **quiet)
+    assert err.value.field == "kt" and "no kt model could be learned" in str(err.value)  # ... but predict needs kt
 
     for bad in (0, -1):
         with pytest.raises(InputError) as err:
@@ -241,10 +246,9 @@ def test_rows_where_a_target_was_not_identified_weigh_little_and_are_not_scored(
     for k in (3, 7, 11):  # absurd kt with a wide interval, as a fit stuck at the upper bound gives
         rows[k]["kt"], rows[k]["kt_lo"], rows[k]["kt_hi"] = "1e9", "1e7", "1e11"
     folder = write_identified(tmp_path, rows)
-    lines = []
-    r = learn(folder, test_size=20, mfs=(2, 2), epochs=20, targets=["kt"], baselines=False, plots=False,
-              out=lines.append)
-    m = r["metrics"]["kt"]["anfis"]
+    r = learn(folder, test_size=20, mfs=(2, 2), epochs=20, targets=["kt"], baselines=False, plots=False)
+    lines = report_lines(r)
+    m = r.metrics["kt"]["anfis"]
     assert m["train"]["n"] + m["test"]["n"] == 77
     assert any(s.startswith("kt: trained on 60 rows weighted") for s in lines)
     assert m["test"]["mape"] < 10  # the outliers did not poison the fit
@@ -256,7 +260,8 @@ def test_rows_where_a_target_was_not_identified_weigh_little_and_are_not_scored(
                      np.array([float(x["kt"]) for x in rs]))
     plain = ANFIS(n_mfs=(2, 2), epochs=20).fit(*xy(train))
     Xt, yt = xy(test)
-    assert np.mean(abs(plain.predict(Xt) / yt - 1)) * 100 > 3 * m["test"]["mape"]
+    p_plain, _ = predict_quietly(plain, Xt)  # some test rows lie outside the training range, as in learn()
+    assert np.mean(abs(p_plain / yt - 1)) * 100 > 3 * m["test"]["mape"]
 
 
 def test_split_does_not_depend_on_row_order(tmp_path):
@@ -264,17 +269,42 @@ def test_split_does_not_depend_on_row_order(tmp_path):
     rows = identified_rows(n=60, n_failed=0)
     a = write_identified(tmp_path / "a", rows)
     b = write_identified(tmp_path / "b", list(np.random.default_rng(5).permutation(rows)))
-    quick = dict(test_size=12, mfs=(2, 2), epochs=5, targets=["kt"], baselines=False, plots=False, out=lambda s: None)
+    quick = dict(test_size=12, mfs=(2, 2), epochs=5, targets=["kt"], baselines=False, plots=False)
     ra, rb = learn(a, seed=7, **quick), learn(b, seed=7, **quick)
     assert read_split(a) == read_split(b)
-    assert ra["metrics"]["kt"]["anfis"]["test"]["mape"] == rb["metrics"]["kt"]["anfis"]["test"]["mape"]
+    assert ra.metrics["kt"]["anfis"]["test"]["mape"] == rb.metrics["kt"]["anfis"]["test"]["mape"]
 
 
 def test_more_parameters_than_identified_rows_is_said(tmp_path):
     folder = write_identified(tmp_path, identified_rows(n=60, n_failed=0))
-    lines = []
-    learn(folder, test_size=12, mfs=(3, 7), epochs=2, targets=["kt"], baselines=False, plots=False, out=lines.append)
+    quick = dict(test_size=12, epochs=2, targets=["kt"], baselines=False, plots=False)
+    lines = report_lines(learn(folder, mfs=(3, 7), **quick))
     assert any(s.startswith("note: kt was identified in 48 training rows, fewer than the 63") for s in lines)
-    lines.clear()
-    learn(folder, test_size=12, mfs=(3, 3), epochs=2, targets=["kt"], baselines=False, plots=False, out=lines.append)
+    lines = report_lines(learn(folder, mfs=(3, 3), **quick))
     assert not any("consequent parameters" in s for s in lines)
+
+
+def test_learn_leaves_exactly_the_models_predict_will_use(tmp_path):
+    from toolpoint.campaign.predict import load_models
+
+    folder = write_identified(tmp_path, identified_rows(n=60, n_failed=0))
+    quick = dict(test_size=12, mfs=(2, 2), epochs=3, baselines=False, plots=False)
+    learn(folder, targets=["kt", "kr"], **quick)
+    assert set(load_models(folder / "models")) == {"kt", "kr"}
+    learn(folder, targets=["kt"], **quick)  # fewer targets: the older kr model must not be used stale
+    assert set(load_models(folder / "models")) == {"kt"} and not (folder / "models" / "kr.json").exists()
+    before = sorted(p.name for p in (folder / "models").iterdir())
+    with pytest.raises(InputError, match="must include kt"):  # predict could not run on what it would write
+        learn(folder, targets=["kr"], **quick)
+    assert sorted(p.name for p in (folder / "models").iterdir()) == before
+
+
+def test_a_learn_that_fails_writes_nothing(tmp_path):
+    rows = identified_rows(n=60, n_failed=0)
+    for r in rows:  # kt identified nowhere: no kt model can be learned
+        r["kt_lo"], r["kt_hi"] = repr(float(r["kt"]) / 10), repr(float(r["kt"]) * 10)
+    folder = write_identified(tmp_path, rows)
+    with pytest.raises(InputError, match="no kt model could be learned"):
+        learn(folder, test_size=12, mfs=(2, 2), epochs=3, baselines=False, plots=True)
+    assert not (folder / "models").exists() or not any((folder / "models").iterdir())
+    assert not (folder / "plots").exists() or not any((folder / "plots").iterdir())

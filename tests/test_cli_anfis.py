@@ -9,14 +9,8 @@ import toolpoint.cli.main as cli_main
 from toolpoint.learning.anfis import ANFIS
 
 
-@pytest.fixture(autouse=True)
-def only_anfis(monkeypatch):
-    # run through the real dispatcher (InputError → exit 2) without needing the
-    # other sub-command modules to exist yet
-    monkeypatch.setattr(cli_main, "COMMANDS", ("anfis",))
-
-
 def run(argv, capsys):
+    """Through the real dispatcher (InputError → exit 2); it imports only the command it runs."""
     code = cli_main.main([str(a) for a in argv])
     out, err = capsys.readouterr()
     return code, out, err
@@ -39,7 +33,8 @@ def stiffness_rows(n, seed):
 
 
 HEADER = ["tool", "diameter_mm", "overhang_mm", "kt"]
-TRAIN = ["anfis", "train", None, "--inputs", "diameter_mm,overhang_mm", "--target", "kt", "--mfs", "3,4", "--mf", "gauss"]
+TRAIN = ["anfis", "train", None, "--inputs", "diameter_mm,overhang_mm", "--target", "kt", "--mfs", "3,4",
+         "--mf", "gauss"]
 
 
 @pytest.fixture
@@ -70,7 +65,8 @@ def test_train_and_predict(tmp_path, data, capsys):
     pred = tmp_path / "pred.csv"
     code, out, err = run(["anfis", "predict", model, new, "--out", pred], capsys)
     assert code == 0, err
-    rows = list(csv.reader(open(pred)))
+    with open(pred, newline="") as fh:
+        rows = list(csv.reader(fh))
     assert rows[0] == ["diameter_mm", "overhang_mm", "kt"]
     got = np.array(rows[1:], dtype=float)
     np.testing.assert_array_equal(got[:, :2], [[10.0, 50.0], [20.0, 80.0]])
@@ -80,7 +76,8 @@ def test_train_and_predict(tmp_path, data, capsys):
 def test_separate_test_file_and_log_target(tmp_path, data, capsys):
     test = write_csv(tmp_path / "test.csv", HEADER, stiffness_rows(10, 5))
     model = tmp_path / "m.json"
-    code, out, err = run(TRAIN[:2] + [data] + TRAIN[3:] + ["--epochs", 5, "--test", test, "--log-target", "--out", model], capsys)
+    argv = TRAIN[:2] + [data] + TRAIN[3:] + ["--epochs", 5, "--test", test, "--log-target", "--out", model]
+    code, out, err = run(argv, capsys)
     assert code == 0, err
     assert "log10" in out
     test_line = [line for line in out.splitlines() if line.startswith("test")][0]
@@ -90,7 +87,8 @@ def test_separate_test_file_and_log_target(tmp_path, data, capsys):
 
 def test_missing_column_exit_2_nothing_written(tmp_path, data, capsys):
     model, plots = tmp_path / "model.json", tmp_path / "plots"
-    argv = ["anfis", "train", data, "--inputs", "diameter_mm,length", "--target", "kt", "--out", model, "--plots", plots]
+    argv = ["anfis", "train", data, "--inputs", "diameter_mm,length", "--target", "kt", "--out", model,
+            "--plots", plots]
     code, out, err = run(argv, capsys)
     assert code == 2
     assert len(err.strip().splitlines()) == 1

@@ -89,3 +89,18 @@ def test_output_format_follows_the_extension(tmp_path, example_path, capsys):
     bad = tmp_path / "frf.xyz"
     assert main(["frf", str(example_path), "--out", str(bad)]) == 2
     assert "--out" in capsys.readouterr().err and not bad.exists()
+
+
+def test_grids_and_segment_counts_are_bounded_before_allocating(tmp_path, example_path):
+    from toolpoint.dynamics.assembly import MAX_FREQUENCIES, MAX_SEGMENTS, parse_assembly
+    from toolpoint.errors import InputError
+    from toolpoint.io.toml import load_toml
+
+    doc = load_toml(example_path)
+    doc["frequency"]["step_hz"] = 3000.0 / (MAX_FREQUENCIES + 10)
+    with pytest.raises(InputError, match="frequency.step_hz: .*at most 1,000,000"):
+        parse_assembly(doc, "a.toml")
+    doc = load_toml(example_path)
+    doc["tool"]["segments"] = [{"length_mm": 0.01, "od_mm": 16}] * (MAX_SEGMENTS + 1)
+    with pytest.raises(InputError, match="tool.segments: .* at most"):
+        parse_assembly(doc, "a.toml")

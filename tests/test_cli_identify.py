@@ -29,18 +29,22 @@ def test_identify_writes_result_and_plot(tmp_path, example_path, measured_csv, c
         assert key in doc
     assert doc["kt"] == pytest.approx(2.1e7, rel=1e-6) and doc["cr"] == pytest.approx(3.0, rel=1e-4)
     assert doc["method"] == "hybrid" and doc["seed"] == 3 and doc["evaluations"] > 0
+    assert doc["success"] is True and doc["status"] == 0
     assert set(doc["ci95"]) == {"kt", "ct", "kr", "cr"}
     assert png.read_bytes()[:4] == b"\x89PNG"
     assert "ignored" in capsys.readouterr().err  # the file's holder_tool joint is not used
 
 
-def test_bounds_from_the_command_line_are_used(tmp_path, example_path, measured_csv):
+def test_bounds_from_the_command_line_are_used(tmp_path, example_path, measured_csv, capsys):
     out = tmp_path / "r.json"
     assert main(["identify", str(example_path), str(measured_csv), "--bounds", "kt=1e6:1e7", "--out", str(out)]) == 0
     doc = json.loads(out.read_text())
     assert doc["bounds"]["kt"] == [1e6, 1e7]
     assert doc["kt"] <= 1e7 * (1 + 1e-12)
     assert any("upper search bound" in w for w in doc["warnings"])
+    err = capsys.readouterr().err.splitlines()
+    for w in doc["warnings"]:  # each identifiability warning printed once, as "warning: …"
+        assert err.count(f"warning: {w}") == 1, (w, err)
 
 
 def _bad(tmp_path, name, text):
@@ -98,3 +102,6 @@ def test_reproduce_quick(tmp_path):
     assert (tmp_path / "fig4.png").exists() and (tmp_path / "table1.csv").exists()
     doc = json.loads((tmp_path / "result_hybrid.json").read_text())
     assert max(doc["relative_error"].values()) < 1e-4
+    assert doc["success"] is True and doc["status"] == 0
+    pso = json.loads((tmp_path / "result_pso.json").read_text())  # the paper's PSO runs its 280 iterations
+    assert pso["success"] is False and pso["status"] == 1 and pso["iterations"] == 280

@@ -9,7 +9,8 @@ from toolpoint.cli.main import main
 from toolpoint.stability import ModalModel
 
 MODE = ModalModel([922.0], [0.011], [0.03993])
-BASE = ["--teeth", "2", "--kt", "6e8", "--kr", "0.3333333333333333", "--immersion", "1", "--rpm", "5000:25000"]
+BASE = ["--teeth", "2", "--tangential-coeff", "6e8", "--radial-ratio", "0.3333333333333333", "--immersion", "1",
+        "--rpm", "5000:25000"]
 
 
 def write_csv(path, freq, values, header="freq_hz,real,imag"):
@@ -40,8 +41,11 @@ def test_zoa_end_to_end(tmp_path, frf_files, capsys):
                  "--out", str(out), "--lobes-out", str(all_), "--plot", str(png)])
     assert code == 0
     header, data = read(out)
-    assert header[:2] == ["rpm", "depth_mm"] and header == ["rpm", "depth_mm", "chatter_hz"]
-    assert data.shape == (400, 3)
+    assert header == ["rpm", "depth_mm", "chatter_hz", "lobe"]
+    assert data.shape == (400, 4)
+    # The lobe column is k = floor(f_c T) of the limiting lobe: f_c T = k + ε/2π.
+    waves = data[:, 2] * 60.0 / (2 * data[:, 0])
+    assert np.all((waves >= data[:, 3] - 1e-6) & (waves < data[:, 3] + 1 + 1e-6))
     assert data[0, 0] == 5000 and data[-1, 0] == 25000
     assert data[:, 1].min() == pytest.approx(0.298, abs=0.001)  # mm: the benchmark's closed form
     header, lobes = read(all_)
@@ -59,7 +63,7 @@ def test_symmetric_default_and_up_milling(tmp_path, frf_files, capsys):
     assert main(["lobes", str(x), *BASE[:-4], "--immersion", "0.5", "--up", "--rpm", "3000:9000",
                  "--rpm-points", "50", "--out", str(out)]) == 0
     header, data = read(out)
-    assert data.shape == (50, 3) and np.all(data[:, 1] > 0)
+    assert data.shape == (50, 4) and np.all(data[:, 1] > 0)
 
 
 def test_sdm_end_to_end(tmp_path, frf_files, capsys):
@@ -71,14 +75,14 @@ def test_sdm_end_to_end(tmp_path, frf_files, capsys):
     text = capsys.readouterr().out
     assert "922.00" in text and "fit error" in text  # the fitted modes are printed
     header, data = read(out)
-    assert header == ["rpm", "depth_mm", "chatter_hz"] and data.shape == (25, 3)
+    assert header == ["rpm", "depth_mm", "chatter_hz", "lobe"] and data.shape == (25, 4)
     assert png.read_text().lstrip().startswith("<?xml")
 
 
 def test_assembly_toml_input(tmp_path, example_path, capsys):
     out = tmp_path / "t.csv"
-    code = main(["lobes", str(example_path), "--teeth", "4", "--kt", "8e8", "--kr", "0.3", "--immersion", "0.5",
-                 "--rpm", "5000:30000", "--rpm-points", "200", "--out", str(out)])
+    code = main(["lobes", str(example_path), "--teeth", "4", "--tangential-coeff", "8e8", "--radial-ratio", "0.3",
+                 "--immersion", "0.5", "--rpm", "5000:30000", "--rpm-points", "200", "--out", str(out)])
     assert code == 0
     _, data = read(out)
     assert np.all(np.isfinite(data[:, 1])) and data[:, 1].min() > 0
@@ -90,8 +94,13 @@ def test_assembly_toml_input(tmp_path, example_path, capsys):
         ["--teeth", "0"],
         ["--teeth", "-2"],
         ["--teeth", "two"],
+        ["--tangential-coeff", "0"],
+        ["--tangential-coeff", "-6e8"],
+        ["--tangential-coeff", "nan"],
+        ["--radial-ratio", "-1"],
         ["--kt", "0"],
-        ["--kt", "-6e8"],
+        ["--kr", "-0.3"],
+        ["--rpm-points", "100001"],
         ["--immersion", "0"],
         ["--immersion", "1.5"],
         ["--rpm", "20000:2000"],
@@ -103,6 +112,8 @@ def test_assembly_toml_input(tmp_path, example_path, capsys):
 def test_bad_options(tmp_path, frf_files, capsys, change):
     x, _ = frf_files
     args = dict(zip(BASE[::2], BASE[1::2]))
+    renamed = {"--kt": "--tangential-coeff", "--kr": "--radial-ratio"}
+    args.pop(renamed.get(change[0]), None)  # a deprecated flag replaces its new name
     args[change[0]] = change[1]
     out, png = tmp_path / "o.csv", tmp_path / "o.png"
     argv = ["lobes", str(x), *[f"{k}={v}" for k, v in args.items()], "--out", str(out), "--plot", str(png)]
@@ -130,3 +141,172 @@ def test_wrong_frf_file(tmp_path, capsys, make):
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and str(bad.name) in err
     assert not out.exists() and not (tmp_path / "a.csv").exists()
+
+
+def test_readme_command_with_deprecated_flags(tmp_path, example_path, capsys):
+    """README's command keeps working for one release; each old flag prints one deprecation line."""
+    out, png = tmp_path / "lobes.csv", tmp_path / "lobes.png"
+    code = main(["lobes", str(example_path), "--teeth", "2", "--kt", "6e8", "--kr", "0.3", "--immersion", "0.5",
+                 "--rpm", "5000:30000", "--rpm-points", "200", "--out", str(out), "--plot", str(png)])
+    assert code == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["warning: --kt is deprecated, use --tangential-coeff (cutting coefficient, N/m²)",
+                   "warning: --kr is deprecated, use --radial-ratio (force ratio Kn/Kt, dimensionless)"]
+    new = tmp_path / "new.csv"
+    assert main(["lobes", str(example_path), "--teeth", "2", "--tangential-coeff", "6e8", "--radial-ratio", "0.3",
+                 "--immersion", "0.5", "--rpm", "5000:30000", "--rpm-points", "200", "--out", str(new)]) == 0
+    assert capsys.readouterr().err == ""
+    assert read(out)[1] == pytest.approx(read(new)[1], nan_ok=True)
+
+
+def test_old_and_new_flag_together_is_refused(tmp_path, frf_files, capsys):
+    x, _ = frf_files
+    assert main(["lobes", str(x), *BASE, "--kt", "6e8", "--out", str(tmp_path / "o.csv")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--kt" in err[0]
+
+
+@pytest.mark.parametrize("what", ["zero", "nan"])
+def test_unusable_x_frf_is_refused_not_reported_stable(tmp_path, frf_files, capsys, what):
+    """An all-zero x FRF must not come out as 'no chatter'; a NaN in the file is refused."""
+    _, rigid = frf_files
+    f = np.linspace(0.0, 3000.0, 3001)
+    v = MODE.frf(f).values
+    v[100] = np.nan
+    bad = rigid if what == "zero" else write_csv(tmp_path / "nan.csv", f, v)
+    out = tmp_path / "o.csv"
+    assert main(["lobes", str(bad), *BASE, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and bad.name in err[0]
+    assert not out.exists()
+
+
+def test_pocket_is_an_interior_maximum_and_markers_lie_in_the_axes(tmp_path, frf_files, capsys):
+    from toolpoint.stability import CuttingConditions, zoa_lobes
+
+    x, rigid = frf_files
+    out = tmp_path / "o.csv"
+    assert main(["lobes", str(x), "--frf-y", str(rigid), *BASE, "--rpm-points", "400", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    _, data = read(out)
+    d = data[:, 1]
+    peaks = np.flatnonzero((d[1:-1] > d[:-2]) & (d[1:-1] > d[2:])) + 1  # strict interior local maxima
+    assert peaks.size >= 2 and d[-1] > d[peaks].max()  # the limit is highest at the range end: not a pocket
+    j = peaks[np.argmax(d[peaks])]
+    assert f"best stable pocket: {data[j, 1]:.4g} mm at {data[j, 0]:.0f} rpm" in text
+    # A range where the limit only rises: no pocket, and the CLI says so.
+    assert main(["lobes", str(x), "--frf-y", str(rigid), *BASE[:-2], "--rpm", "15500:17000", "--rpm-points", "50",
+                 "--out", str(out)]) == 0
+    assert "best stable pocket: none inside the speed range" in capsys.readouterr().out
+    # Every marker of the chart lies inside its axes (README's figure had the pocket above them).
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    f = np.linspace(0.0, 3000.0, 3001)
+    cut = CuttingConditions(teeth=2, tangential_coeff=6e8, radial_ratio=0.3, radial_immersion=0.5)
+    res = zoa_lobes(MODE.frf(f), None, cut, rpm=np.linspace(5000, 30000, 400))
+    ax = res.plot()
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    markers = [ln for ln in ax.get_lines() if ln.get_marker() not in ("None", None, "")]
+    assert len(markers) == 2  # the minimum and the best pocket
+    for ln in markers:
+        (xm,), (ym,) = ln.get_xdata(), ln.get_ydata()
+        assert x0 <= xm <= x1 and y0 <= ym <= y1
+    plt.close("all")
+
+
+# ----------------------------------------------------------------- semi-discretisation options
+SDM = ["--teeth", "2", "--tangential-coeff", "6e8", "--radial-ratio", "0.3333333333333333", "--immersion", "1",
+       "--rpm", "5000:25000", "--rpm-points", "20", "--method", "sdm"]
+
+
+def _refused(argv, capsys, out):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and not out.exists()
+    return err[0]
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_sdm_on_noise_only_is_refused(tmp_path, capsys, seed):
+    """White noise, no resonance: one line naming the file, quickly (the probe fit, not the 8-mode search)."""
+    f = np.linspace(0.0, 3000.0, 3001)
+    rng = np.random.default_rng(seed)
+    values = 1e-7 * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size))
+    noise = write_csv(tmp_path / "noise.csv", f, values)
+    out = tmp_path / "o.csv"
+    err = _refused(["lobes", str(noise), *SDM, "--out", str(out)], capsys, out)
+    assert "noise.csv" in err and "no resonance" in err
+    # With a fixed number of modes the fit is made, and refused for not describing the FRF.
+    err = _refused(["lobes", str(noise), *SDM, "--modes", "2", "--out", str(out)], capsys, out)
+    assert "noise.csv" in err and "unexplained" in err
+
+
+def test_sdm_on_all_zero_frf_is_refused(tmp_path, frf_files, capsys):
+    x, rigid = frf_files
+    out = tmp_path / "o.csv"
+    err = _refused(["lobes", str(rigid), *SDM, "--out", str(out)], capsys, out)
+    assert "rigid.csv" in err and "not all zero" in err
+    err = _refused(["lobes", str(x), "--frf-y", str(rigid), *SDM, "--out", str(out)], capsys, out)
+    assert "rigid.csv" in err and "--frf-y" in err
+
+
+def test_sdm_with_no_mode_in_the_band_is_refused(tmp_path, capsys):
+    """The FRF covers 1000–3000 Hz, the only resonance is at 500 Hz: the fit can only put a mode on the band edge."""
+    f = np.linspace(1000.0, 3000.0, 2001)
+    tail = write_csv(tmp_path / "tail.csv", f, ModalModel([500.0], [0.02], [0.1]).frf(f).values)
+    out = tmp_path / "o.csv"
+    err = _refused(["lobes", str(tail), *SDM, "--out", str(out)], capsys, out)
+    assert "tail.csv" in err and "no mode inside the FRF's band 1000–3000 Hz" in err
+
+
+@pytest.mark.parametrize("value", ["0.1", "17", "fast"])
+def test_bad_accuracy(tmp_path, frf_files, capsys, value):
+    x, _ = frf_files
+    out = tmp_path / "o.csv"
+    err = _refused(["lobes", str(x), *SDM, "--accuracy", value, "--out", str(out)], capsys, out)
+    assert "--accuracy" in err
+
+
+def test_sdm_accuracy_and_progress(tmp_path, frf_files, capsys):
+    """--accuracy reaches the SDM (more steps over the cut); the progress report ends with every speed done."""
+    x, _ = frf_files
+    steps = {}
+    for acc in ("1", "2"):
+        out = tmp_path / f"o{acc}.csv"
+        assert main(["lobes", str(x), *SDM[:-6], "--immersion", "0.05", "--rpm", "9000:11000", "--rpm-points", "4",
+                     "--method", "sdm", "--modes", "1", "--accuracy", acc, "--out", str(out)]) == 0
+        cap = capsys.readouterr()
+        steps[acc] = int(cap.out.split("semi-discretisation: ")[1].split()[0].split("–")[-1])
+        assert cap.err.strip().splitlines()[-1].startswith("semi-discretisation: 4/4 speeds (100 %)")
+    assert steps["2"] >= 2 * steps["1"] - 4  # the step ladder is ≈ 2^(1/4) apart
+
+
+def test_sdm_with_cross_frfs_matches_the_exact_model(tmp_path, capsys):
+    """Orthotropic tool, principal axes turned 35°: the four receptance files → common-pole fits → 2×2
+    state-space model must give the lobes of the exact model (built from its poles and residue matrices,
+    independently of the fit); dropping the cross FRFs changes them by > 5 %."""
+    from test_stability_sdm_statespace import rotated_by_poles
+
+    from toolpoint.stability import CuttingConditions, sdm_lobes
+
+    exact = rotated_by_poles(np.deg2rad(35.0))
+    f = np.linspace(0.0, 3000.0, 3001)
+    phi = exact.frf(f)
+    files = {k: write_csv(tmp_path / f"{k}.csv", f, phi[:, i, j])
+             for k, (i, j) in dict(x=(0, 0), y=(1, 1), xy=(0, 1), yx=(1, 0)).items()}
+    args = ["--teeth", "3", "--tangential-coeff", "6e8", "--radial-ratio", "0.3", "--immersion", "0.5",
+            "--rpm", "6000:20000", "--rpm-points", "6", "--method", "sdm"]
+    out, plain = tmp_path / "o.csv", tmp_path / "plain.csv"
+    assert main(["lobes", str(files["x"]), "--frf-y", str(files["y"]), "--frf-xy", str(files["xy"]),
+                 "--frf-yx", str(files["yx"]), *args, "--out", str(out)]) == 0
+    assert "common-pole fit, force y" in capsys.readouterr().out
+    c = CuttingConditions(teeth=3, tangential_coeff=6e8, radial_ratio=0.3, radial_immersion=0.5)
+    ref = sdm_lobes(exact, cutting=c, rpm=np.linspace(6000.0, 20000.0, 6))
+    _, data = read(out)
+    assert data[:, 1] == pytest.approx(1e3 * ref.depth_m, rel=2e-3)
+    assert main(["lobes", str(files["x"]), "--frf-y", str(files["y"]), *args, "--out", str(plain)]) == 0
+    _, no_cross = read(plain)
+    assert np.max(np.abs(no_cross[:, 1] / data[:, 1] - 1)) > 0.05

@@ -164,8 +164,12 @@ def test_failed_write_keeps_old_file(tmp_path):
     p = tmp_path / "keep.csv"
     write_csv_frf(p, tool_frf(n=5))
     before = p.read_bytes()
-    with pytest.raises(InputError, match="keep.csv: values.real: non-finite"):
-        write_csv_frf(p, FRF([1.0, 2.0], [np.nan, 1.0]))
+    # an FRF cannot hold non-finite values any more; a mobility at 0 Hz has no receptance to write
+    with pytest.raises(InputError, match="keep.csv: values: .*cannot convert mobility at 0 Hz"):
+        write_csv_frf(p, FRF([0.0, 2.0], [1.0, 1.0], "mobility"))
+    assert p.read_bytes() == before
+    with pytest.raises(InputError, match="keep.csv: values: .*one response"):
+        write_frf(p, FRF([1.0, 2.0], np.ones((2, 2, 2))))
     assert p.read_bytes() == before
 
 
@@ -271,7 +275,13 @@ def test_uff_several_datasets(tmp_path):
     write_uff_raw(p, f, sdof(f))
     write_uff_raw(p, f, 2 * sdof(f), rsp_node=2)
     assert n_datasets(p) == 3
-    np.testing.assert_allclose(read_uff58(p).values, sdof(f), rtol=UFF_ASCII_RTOL)  # first FRF
+    # two FRFs: ambiguous without a choice (issue 11: no silent pick of the first), the error lists both
+    with pytest.raises(InputError, match=r"response: 2 FRFs match.*#1: response 1:1 reference 1:1; #2: response 2:1"):
+        read_uff58(p)
+    np.testing.assert_allclose(read_frf(p, response=1).values, sdof(f), rtol=UFF_ASCII_RTOL)
+    np.testing.assert_allclose(read_frf(p, response="2:1", reference=1).values, 2 * sdof(f), rtol=UFF_ASCII_RTOL)
+    with pytest.raises(InputError, match=r"response: no FRF with response 3"):
+        read_frf(p, response=3)
     second = read_uff58(p, index=2)
     assert second.meta["rsp_node"] == 2 and second.meta["index"] == 2
     np.testing.assert_allclose(second.values, 2 * sdof(f), rtol=UFF_ASCII_RTOL)
@@ -292,9 +302,10 @@ CSV_ERRORS = [
     ("freq_hz,real,imag\n1,2,3\n2,3\n", "columns", "line 3: expected 3 columns"),
     ("freq_hz,real,imag\n1,2,3\n2,nan,3\n", "real", "non-finite value nan at line 3"),
     ("freq_hz,real,imag\n1,2,inf\n", "imag", "non-finite value inf at line 2"),
-    ("freq_hz,real,imag\n1,2,3\n5,2,3\n5,2,3\n", "freq_hz", "duplicate frequency 5 Hz at line 4"),
-    ("freq_hz,real,imag\n1,2,3\n5,2,3\n4,2,3\n", "freq_hz", "non-increasing"),
-    ("freq_hz,real,imag\n-1,2,3\n5,2,3\n", "freq_hz", "negative frequency -1 Hz at line 2"),
+    ("freq_hz,real,imag\n1,2,3\n5,2,3\n5,2,3\n", "freq_hz", "strictly increasing (5 Hz repeated) at line 4"),
+    ("freq_hz,real,imag\n1,2,3\n5,2,3\n4,2,3\n", "freq_hz", "(5 Hz is followed by 4 Hz) at line 4"),
+    ("freq_hz,real,imag\n-1,2,3\n5,2,3\n", "freq_hz", "must be ≥ 0 Hz, got -1 at line 2"),
+    ("freq_hz,real,imag\n1,2,3\nnan,2,3\n", "freq_hz", "must be finite, got nan at line 3"),
 ]
 
 
@@ -317,8 +328,8 @@ def test_min_points_and_missing_file(tmp_path):
         read_frf(tmp_path / "nothere.csv")
     with pytest.raises(InputError, match=r"nothere\.uff: file not found"):
         read_frf(tmp_path / "nothere.uff")
-    with pytest.raises(InputError, match="extension: unknown FRF file extension '.txt'"):
-        read_frf(tmp_path / "x.txt")
+    with pytest.raises(InputError, match="extension: unknown FRF file extension '.xyz'"):
+        read_frf(tmp_path / "x.xyz")
 
 
 def test_truncated_uff_refused(tmp_path):

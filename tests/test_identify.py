@@ -1,14 +1,16 @@
 """Joint identification on the paper's numerical case (noise-free and noisy)."""
 
+import dataclasses
+import warnings
+
 import numpy as np
 import pytest
 
-from toolpoint.errors import InputError
+from toolpoint.errors import IdentifiabilityWarning, InputError
 from toolpoint.frf import FRF
-from toolpoint.identification.identify import identify, model_for, relative_errors
+from toolpoint.identification.identify import IdentificationResult, identify, make_algorithm, model_for, relative_errors
 from toolpoint.identification.objective import JointProblem
 from toolpoint.identification.params import Bounds
-from toolpoint.identification.optim import Termination
 
 F = np.arange(1.0, 3001.0)
 
@@ -33,23 +35,49 @@ def test_objective_is_the_norm_of_the_complex_difference(case):
 
 def test_hybrid_recovers_the_exact_joint(case):
     model, exact, meas = case
-    r = identify(model, meas, "hybrid", seed=3)
+    r = identify(model, meas, "hybrid", seed=3)  # no IdentifiabilityWarning (they are errors here)
     errs = relative_errors(r.x, exact)
     assert max(errs.values()) < 1e-4  # all four within 0.01 %
     assert r.nfev < 20000
-    assert r.warnings == []
+    assert r.warnings == ()
+    assert r.success and r.status == 0 and r.nit == r.optimizer.global_stage.nit
     for k, v in r.params.items():
         lo, hi = r.ci95[k]
         assert lo <= v <= hi
 
 
+def test_result_is_frozen_and_forwards_the_optimiser(case):
+    model, exact, meas = case
+    r = identify(model, meas, "hybrid", seed=0)
+    assert isinstance(r, IdentificationResult)
+    assert np.allclose(10.0**r.optimizer.x, r.x, rtol=1e-14) and np.array_equal(r.x_log, r.optimizer.x)
+    assert [r.params[k] for k in ("kt", "ct", "kr", "cr")] == list(r.x)
+    assert (r.fun, r.nfev, r.nit, r.success, r.message) == (
+        r.optimizer.fun, r.optimizer.nfev, r.optimizer.nit, r.optimizer.success, r.optimizer.message)
+    assert r.history is r.optimizer.history
+    assert r.method == "hybrid" and r.seed == 0 and r.bounds == Bounds.from_dict().as_dict() and r.seconds > 0
+    assert np.allclose(r.model_frf.values, model.tool_point(r.x), rtol=1e-12)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        r.seed = 1
+
+
+def test_unknown_method_is_an_input_error(case):
+    model, _, meas = case
+    with pytest.raises(InputError, match="^method: unknown method 'magic'"):
+        identify(model, meas, "magic")
+    with pytest.raises(InputError):
+        make_algorithm("GA")
+
+
 def test_same_seed_same_result(case):
     model, _, meas = case
-    term = Termination(max_iter=30)
     for method in ("ga", "pso", "sa", "de"):
-        a = identify(model, meas, method, seed=7, termination=term)
-        b = identify(model, meas, method, seed=7, termination=term)
+        with warnings.catch_warnings():  # 30 iterations: wide intervals, not what is tested here
+            warnings.simplefilter("ignore", IdentifiabilityWarning)
+            a = identify(model, meas, method, seed=7, options={"maxiter": 30})
+            b = identify(model, meas, method, seed=7, options={"maxiter": 30})
         assert np.array_equal(a.x, b.x) and a.nfev == b.nfev, method
+        assert a.nit == 30 and not a.success and a.status == 1, method  # a capped run is not a success
 
 
 def test_pso_beats_the_paper(case):
@@ -65,10 +93,13 @@ def test_bad_cr_is_flagged_when_the_fit_cannot_see_it(case, example):
     model, exact, meas = case
     rng = np.random.default_rng(11)
     peak = np.abs(meas.values).max()
-    noisy = FRF(F, meas.values + 0.05 * peak * (rng.standard_normal(F.size) + 1j * rng.standard_normal(F.size)) / np.sqrt(2))
-    r = identify(model, noisy, "hybrid", seed=0)
+    noise = (rng.standard_normal(F.size) + 1j * rng.standard_normal(F.size)) / np.sqrt(2)
+    noisy = FRF(F, meas.values + 0.05 * peak * noise)
+    with pytest.warns(IdentifiabilityWarning) as rec:
+        r = identify(model, noisy, "hybrid", seed=0)
     assert any(w.startswith("cr ") for w in r.warnings)
     assert not any(w.startswith("kt ") for w in r.warnings)
+    assert [str(w.message) for w in rec] == list(r.warnings)  # each emitted once, as in the result
 
 
 @pytest.mark.slow
@@ -80,7 +111,10 @@ def test_confidence_intervals_cover_the_truth(case):
     for seed in range(20):
         rng = np.random.default_rng(1000 + seed)
         noise = 0.01 * peak * (rng.standard_normal(F.size) + 1j * rng.standard_normal(F.size)) / np.sqrt(2)
-        r = identify(model, FRF(F, meas.values + noise), "hybrid", seed=seed)
+        with warnings.catch_warnings(record=True) as rec:
+            warnings.simplefilter("always")
+            r = identify(model, FRF(F, meas.values + noise), "hybrid", seed=seed)
+        assert [str(w.message) for w in rec] == list(r.warnings)  # nothing else, each once
         inside = [lo <= t <= hi for t, (lo, hi) in zip(exact, r.ci95.values())]
         hits += sum(inside)
         trials += len(inside)

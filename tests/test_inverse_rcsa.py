@@ -104,7 +104,7 @@ def test_blank_receptances_rigid_body_limit(blank80):
     R = blank_receptances(blank80, 0.03, f)
     sec = blank80.segments[0].section()
     L, m = blank80.length, sec.rho * sec.A * blank80.length
-    J = m * L**2 / 12 + sec.rho * sec.I * L  # about the centre, incl. rotary inertia
+    J = m * L**2 / 12 + sec.rho * sec.Iz * L  # about the centre, incl. rotary inertia
     xs = {TIP: L / 2, POINT2: L / 2 - 0.03, ROOT: -L / 2}  # positions from the centre
     w2 = (2 * np.pi * f[0]) ** 2
     for a, xa in xs.items():

@@ -1,9 +1,9 @@
 """One BLAS thread for small dense linear algebra.
 
 The least-squares solves, SVDs and matrix exponentials in toolpoint are small
-(tens to hundreds of rows). On a 2-core machine a threaded BLAS only adds
-synchronisation (and oversubscribes when worker processes run side by side):
-the modal fit measured 6× slower with two threads (``docs/design.md``).
+(tens to hundreds of rows): a threaded BLAS only adds synchronisation there
+(and oversubscribes when worker processes run side by side). Measurements:
+``docs/design/dynamics.md``.
 """
 
 from __future__ import annotations
@@ -11,6 +11,11 @@ from __future__ import annotations
 
 def single_thread_blas():
     """Context manager limiting BLAS to one thread (threadpoolctl).
+
+    Returns
+    -------
+    threadpoolctl.threadpool_limits
+        Use in a ``with`` statement; the previous limits come back on exit.
 
     Examples
     --------

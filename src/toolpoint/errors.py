@@ -10,10 +10,24 @@ from os import PathLike
 
 
 class InputError(ValueError):
-    """Bad input, located by file and field.
+    """Bad input, located by file and field (a ``ValueError``).
 
     ``str(err)`` is a single line: ``"<file>: <field>: <message>"`` (parts that
     are unknown are left out).
+
+    Parameters
+    ----------
+    message : str
+        What is wrong; whitespace (newlines included) is collapsed to single spaces.
+    file : str or PathLike, optional
+        The file the input came from.
+    field : str, optional
+        The field inside it, e.g. ``spindle.segments[1].od_mm`` or ``freq_hz``.
+
+    Examples
+    --------
+    >>> str(InputError("must be > 0,   got -1", file="a.toml", field="tool.segments[0].od_mm"))
+    'a.toml: tool.segments[0].od_mm: must be > 0, got -1'
     """
 
     def __init__(self, message: str, *, file: str | PathLike | None = None, field: str | None = None):

@@ -14,6 +14,7 @@
     flute_length_ratio = 2.0        # flute length = ratio × D, capped at the overhang
     [holders.ER40]                  # one entry per holder/collet; the subassembly comes from
     model = "spindle_holder.toml"   #   a model (spindle + holder + spindle–holder joint), or
+    # joint = "sh_identified.json"  #   with the joint of `toolpoint identify --joint spindle_holder`, or
     # blank = { segments = [{ length_mm = 50, od_mm = 20 }], x2_mm = 40,
     #           G11 = "sh/G11.csv", G12 = "sh/G12.csv", G22 = "sh/G22.csv", smooth = "modal" }
     # files = { h = "h.csv", l = "l.csv", n = "n.csv", p = "p.csv" }
@@ -31,7 +32,7 @@ from __future__ import annotations
 
 import csv
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +40,7 @@ import numpy as np
 from ..dynamics.assembly import (
     MM,
     Component,
+    Joint,
     Material,
     Segment,
     parse_materials,
@@ -49,6 +51,7 @@ from ..errors import InputError
 from ..io.toml import TomlReader, load_toml
 from ..io.frf_files import read_frf
 from ..dynamics.inverse_rcsa import subassembly_from_blank, subassembly_from_files
+from ..identification.optim import check_method
 from ..identification.params import Bounds
 from ..dynamics.subassembly import Subassembly
 
@@ -100,6 +103,7 @@ class Campaign:
 
     @property
     def toml(self) -> Path:
+        """Path of the campaign's ``campaign.toml``."""
         return self.folder / "campaign.toml"
 
     def subassembly(self, name: str, freq_hz=None) -> Subassembly:
@@ -108,7 +112,11 @@ class Campaign:
         src = self.holders[name]
         where = f"holders.{name}.{src.kind}"
         if src.kind == "model":
-            a = load_assembly(self.folder / src.spec["path"], require_tool=False)
+            joint = src.spec.get("joint")
+            a = load_assembly(self.folder / src.spec["path"], require_tool=False,
+                              require_spindle_holder=joint is None)
+            if joint is not None:
+                a = replace(a, spindle_holder=_identified_joint(self.folder / joint, f"holders.{name}.joint"))
             return Subassembly.from_assembly(a, np.asarray(freq_hz, float))
         sub = self._measured_subassembly(name)
         if freq_hz is None:
@@ -149,6 +157,23 @@ def _stamp(path: Path):
     except OSError:
         return None  # read_frf raises the one-line error
     return st.st_mtime_ns, st.st_size
+
+
+def _identified_joint(path: Path, field: str, source=None) -> Joint:
+    """The spindle–holder joint of a ``toolpoint identify --joint spindle_holder`` result JSON (SI)."""
+    import json
+
+    try:
+        doc = json.loads(Path(path).read_text())
+    except (OSError, ValueError) as e:
+        raise InputError(f"cannot read identification result {path}: {e}", file=source, field=field) from None
+    if not isinstance(doc, dict) or doc.get("joint", "spindle_holder") != "spindle_holder":
+        raise InputError(f"{path} is not a spindle–holder joint identification (toolpoint identify --joint "
+                         "spindle_holder)", file=source, field=field)
+    vals = [doc.get(k) for k in ("kt", "ct", "kr", "cr")]
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v < math.inf for v in vals):
+        raise InputError(f"{path} needs kt, ct, kr, cr > 0", file=source, field=field)
+    return Joint(*map(float, vals))
 
 
 def _smooth(r: TomlReader, spec: dict, path: str):
@@ -192,6 +217,15 @@ def _family(r: TomlReader, doc: dict, mats: dict) -> ToolFamily:
     return ToolFamily(mats[name], ratio, length)
 
 
+def _file_key(r: TomlReader, spec: dict, key: str, path: str, folder: Path) -> None:
+    """``spec[key]`` must name an existing file (relative to the campaign folder)."""
+    v = spec[key]
+    if not isinstance(v, str) or not v:
+        raise r.err(f"{path}.{key}", f"must be a file name (text), got {v!r}")
+    if not (folder / v).is_file():
+        raise r.err(f"{path}.{key}", f"file not found: {folder / v}")
+
+
 def _holders(r: TomlReader, doc: dict, folder: Path) -> dict[str, HolderSource]:
     hs = r.table(doc, "holders", "holders")
     if not hs:
@@ -209,11 +243,18 @@ def _holders(r: TomlReader, doc: dict, folder: Path) -> dict[str, HolderSource]:
             p = folder / str(spec["model"])
             if not p.is_file():
                 raise r.err(f"{path}.model", f"file not found: {p}")
-            out[name] = HolderSource(name, kind, {"path": str(spec["model"])})
+            r.unknown_keys(spec, {"model", "joint"}, path)
+            js = spec.get("joint")
+            if js is not None:
+                _identified_joint(folder / str(js), f"{path}.joint", source=r.file)
+            out[name] = HolderSource(name, kind, {"path": str(spec["model"]),
+                                                  "joint": None if js is None else str(js)})
         elif kind == "files":
             f = spec["files"]
             if not isinstance(f, dict) or set(f) - {"smooth", "smooth_hz"} != set("hlnp"):
                 raise r.err(f"{path}.files", 'must be {h = …, l = …, n = …, p = …} (optionally smooth = "modal")')
+            for k in "hlnp":
+                _file_key(r, f, k, f"{path}.files", folder)
             out[name] = HolderSource(name, kind, {**{k: f[k] for k in "hlnp"},
                                                   "smooth": _smooth(r, f, f"{path}.files")})
         else:
@@ -223,6 +264,11 @@ def _holders(r: TomlReader, doc: dict, folder: Path) -> dict[str, HolderSource]:
             for k in ("segments", "x2_mm", "G11", "G12", "G22"):
                 if k not in b:
                     raise r.err(f"{path}.blank.{k}", "missing value")
+            # checked here, once, so that a bad holder stops the run with its config field instead of
+            # failing every tool that uses it
+            r.number(b, "x2_mm", f"{path}.blank", positive=True)
+            for k in ("G11", "G12", "G22"):
+                _file_key(r, b, k, f"{path}.blank", folder)
             sm = _smooth(r, b, f"{path}.blank")
             out[name] = HolderSource(name, kind, {**{k: v for k, v in b.items() if k not in ("smooth", "smooth_hz")},
                                                   "smooth": sm})
@@ -293,11 +339,7 @@ def load_campaign(folder: str | Path) -> Campaign:
     family = _family(r, doc, mats)
     holders = _holders(r, doc, folder)
     ident = r.table(doc, "identify", "identify", required=False) or {}
-    method = ident.get("method", "hybrid")
-    from ..identification.optim import METHODS
-
-    if method not in METHODS:
-        raise r.err("identify.method", f"unknown method {method!r} (one of {', '.join(METHODS)})")
+    method = check_method(ident.get("method", "hybrid"), file=r.file, field="identify.method")
     bounds = Bounds.from_dict(ident.get("bounds"), source=str(toml), section="identify.bounds")
     return Campaign(folder, band, family, holders, _measurements(folder / "measurements.csv", holders), method,
                     bounds, mats)

@@ -1,205 +1,264 @@
-r"""``toolpoint campaign learn`` — ANFIS joint-parameter models from a campaign.
+r"""ANFIS models of the holder–tool joint parameters from a campaign's ``identified.csv``.
 
-Reads ``RESULTS_DIR/identified.csv`` (written by ``toolpoint campaign run``:
-one identified holder–tool joint per tool assembly), splits the successfully
-identified assemblies at random into training and test data, and fits one
-:class:`~toolpoint.learning.anfis.ANFIS` model per joint parameter with the inputs
-(tool diameter D, overhang L), as in Čiča et al., section 5 (3×7 Gaussian MFs,
-linear consequents, 21 rules, 148 training / 30 test sets).
+:func:`learn` reads ``RESULTS_DIR/identified.csv`` (:mod:`.results`), splits
+the ``ok`` rows at random into training and test data, and fits one
+:class:`~toolpoint.learning.anfis.ANFIS` model per joint parameter on the inputs
+(tool diameter D mm, overhang L mm), as in Čiča et al., section 5 (3×7
+Gaussian MFs, linear consequents, 148 training / 30 test sets), plus two
+baselines on the same split: a Gaussian process and gradient boosting.
 
-Targets
-    All four joint parameters, each if at least :data:`MIN_RELIABLE` training
-    rows and one test row identified it (95 % interval with hi/lo ≤
-    :data:`IDENTIFIABLE_RATIO`); otherwise it is left out with a message, and
-    ``toolpoint predict`` takes that parameter's campaign median instead. In
-    the synthetic campaign cr is left out (identified for 2 % of the tools).
-    An explicit ``targets`` list is checked the same way.
+* Targets: kt, ct, kr, cr, each if at least :data:`MIN_RELIABLE` training rows
+  and one test row *identified* it (:func:`~toolpoint.identification.params.is_identified`);
+  otherwise it is left out with the reason.
+* Weighting: every model is trained by weighted least squares with weights
+  1/σ², σ the relative standard error of each row's value from its 95 %
+  interval (:func:`~toolpoint.identification.params.sigma_ln_from_interval`,
+  floored at :data:`SIGMA_FLOOR`); rows without a finite interval are left out.
+* Metrics: the paper's four (:data:`~toolpoint.learning.metrics.PAPER_METRICS`)
+  on the training and test rows where the target was identified, in the
+  target's own SI unit.
+* ANFIS fits log10 of the target by default (``log_target``); the baselines
+  fit log10 whenever the target is positive.
 
-Weighting
-    Identified values differ in precision by orders of magnitude: kr is pinned
-    to a few % for slender tools and hardly at all for stubby ones, whose FRF
-    is dominated by the holder. Each row's relative standard error σ follows
-    from its 95 % interval, σ = ln(hi/lo)/(2·1.96) (floored at
-    :data:`SIGMA_FLOOR`), and every model is trained by weighted least squares
-    with weights 1/σ² (ANFIS ``sample_weight``; gradient boosting likewise; the
-    GP takes σ² as each row's noise variance). Rows without a finite interval
-    are left out. Training only on the identified rows instead leaves whole
-    regions of the (D, L) plane empty (kr: no row with D ≥ 20 mm in the
-    synthetic campaign) and the model extrapolates there — measured: a 3×7
-    ANFIS predicting kr ≤ 0 for 17 of 30 test tools. The metrics are computed
-    on the identified rows only (interval within :data:`IDENTIFIABLE_RATIO`),
-    the only targets worth comparing with.
-
-Target scale
-    By default ANFIS fits log10 of each target (``--linear-target`` for the
-    paper's linear fit). Joint parameters are positive and span decades over
-    the family; a linear fit can go ≤ 0 between sparse data — measured on the
-    synthetic campaign (seed 0, with the rows still split in file order) with
-    the paper's 3×7 grid: one of 30 test tools got a negative ct and no FRF,
-    none with log10 (and kt test MAPE 0.32 % against 0.28 %, the same).
-
-Metrics
-    The paper's four on the training and the test data: NRMSE, AFV, MAPE %
-    and max APE % (:mod:`toolpoint.learning.metrics`), always in the target's own unit
-    (with ``log_target`` the predictions are transformed back first). The
-    paper's test numbers for kt and kr are printed beside ours.
-
-Baselines (same split, same metrics)
-    * ``gpr`` — :class:`~sklearn.gaussian_process.GaussianProcessRegressor`,
-      kernel C·RBF(ℓ_D, ℓ_L) + White (one length scale per input, fitted
-      noise), ``normalize_y``, inputs standardised, 3 optimiser restarts.
-    * ``gbr`` — :class:`~sklearn.ensemble.GradientBoostingRegressor`
-      (scikit-learn defaults, ``random_state=seed``).
-
-    Both fit log10 of the target (stiffnesses span decades, and the metrics
-    that matter most here are relative); if a target has a value ≤ 0 they fit
-    it as is. They show whether ANFIS is the right choice for the data at hand.
-
-Over-fitting
-    A 3×7 grid has 21 rules × 3 linear consequents = 63 parameters plus the
-    MFs; on ~150 scattered (D, L) points some rules see few samples, and the
-    hybrid learning keeps the epoch with the lowest *training* error (the test
-    data are never used for model selection). When the ANFIS test NRMSE
-    exceeds :data:`OVERFIT_RATIO` × its training NRMSE a warning is printed and
-    ``metrics[target]["anfis"]["overfit"]`` is true; the baselines show what
-    the data allow.
-
-Outputs (every file written atomically)
-    ``models/split.csv``      id, set (train/test) of each ok row, ordered by id
-    ``models/<target>.json``  the ANFIS model (:meth:`ANFIS.load`)
-    ``models/metrics.json``   everything :func:`learn` returns
-    ``models/metrics.csv``    one row per target × model × data set
-    ``plots/anfis_<target>_test.png``        target and prediction per test sample (Figs. 6/7)
-    ``plots/anfis_<target>_regression.png``  prediction vs target, fitted line, R (Fig. 8)
-    ``plots/anfis_<target>_membership.png``  the trained membership functions
+The pipeline: read rows → split → per target fit ANFIS and baselines → metrics
+→ write models, ``split.csv``, ``metrics.json``/``.csv`` and plots. It returns a
+:class:`LearnResult`; ``toolpoint campaign learn`` prints it. Why these choices
+(weighting, log targets, over-fitting of the 3×7 grid) and what they measured:
+``docs/design/campaign.md``.
 """
 
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..learning.anfis import ANFIS, MF_PARAMS
-from ..io.atomic import atomic_open
-from ..cli.anfis import PAPER_METRICS, _plot_membership, _plot_per_sample, _plot_regression, _predict_quietly
+from ..blas import single_thread_blas
 from ..errors import InputError
+from ..identification.params import IDENTIFIED_RATIO, PARAMS, UNITS
+from ..io.atomic import atomic_open
+from ..learning.anfis import ANFIS, predict_quietly
+from ..learning.figures import membership_figure, per_sample_figure, regression_figure, save_png
+from ..learning.metrics import PAPER_METRICS, paper_metrics
+from .results import FILE_NAME, IdentifiedRows, read_identified
 
-__all__ = ["learn", "add_arguments", "run_cli", "PAPER", "IDENTIFIABLE_RATIO", "IDENTIFIABLE_SHARE"]
+__all__ = [
+    "learn", "LearnResult", "overfit_ratio", "PAPER", "PAPER_N_TEST", "INPUTS", "IDENTIFIABLE_SHARE",
+    "OVERFIT_RATIO", "MIN_TRAIN", "MIN_RELIABLE", "SIGMA_FLOOR",
+]
 
+#: Model inputs: columns of identified.csv, mm.
 INPUTS = ("diameter_mm", "overhang_mm")
-ALL_TARGETS = ("kt", "ct", "kr", "cr")
+#: The joint parameter ``toolpoint predict`` cannot do without (the others fall back to a campaign median).
+REQUIRED_FOR_PREDICT = "kt"
+#: The file in the models folder naming the models one ``learn`` wrote.
+MANIFEST = "manifest.json"
+#: Damping parameters: learned by default only where the file has their intervals.
 DAMPING = ("ct", "cr")
-UNITS = {"kt": "N/m", "ct": "N s/m", "kr": "N m/rad", "cr": "N m s/rad"}
-#: A 95 % interval is "narrow" if hi/lo ≤ this ratio …
-IDENTIFIABLE_RATIO = 2.0
-#: … and below this share of ok rows with one, learn() says how little of the data pins it down.
+#: Below this share of ok rows with an identified value, a note says how little of the data pins a target down.
 IDENTIFIABLE_SHARE = 0.8
 #: ANFIS test NRMSE above this multiple of its training NRMSE is reported as over-fitting.
 OVERFIT_RATIO = 2.0
 #: Extra ok rows needed beyond the test set (the training set must support the grid).
 MIN_TRAIN = 10
-#: A target needs this many training rows where it was identified (narrow interval).
+#: A target needs this many training rows where it was identified.
 MIN_RELIABLE = 20
 #: Floor of a row's relative standard error in the training weights: below ~1 % the
 #: model's own error dominates, and a few very tight rows would otherwise outweigh the rest.
 SIGMA_FLOOR = 0.01
 
-#: Keys of the metrics (JSON/CSV/return value) → (column title, function). MAPE and max APE in %.
-METRICS = {key: (title, fn) for key, (title, fn) in zip(("nrmse", "afv", "mape", "max_ape"), PAPER_METRICS)}
-
-#: Čiča et al., section 5: ANFIS test-set results (30 sets).
+#: Čiča et al., section 5: ANFIS test-set results (30 sets); MAPE and max APE in %.
 PAPER = {
     "kt": {"nrmse": 0.09427, "afv": 0.99541, "mape": 4.5, "max_ape": 11.8},
     "kr": {"nrmse": 0.08993, "afv": 0.99591, "mape": 0.7, "max_ape": 3.2},
 }
+#: Number of test sets behind :data:`PAPER`.
 PAPER_N_TEST = 30
 
-MODEL_LABELS = {"anfis": "ANFIS", "gpr": "GP regression", "gbr": "gradient boosting", "paper": "Čiča et al. ANFIS"}
+# learn() keyword of an ANFIS setting whose name differs
+_KEYWORD = {"n_mfs": "mfs"}
 
 
-# -------------------------------------------------------------------- input
-def _read_identified(path: Path, required: list[str]):
-    """Rows of identified.csv as dicts (plus their line numbers); InputError on trouble."""
-    if not path.is_file():
-        raise InputError("file not found (run 'toolpoint campaign run' first)", file=path)
+@dataclass(frozen=True)
+class LearnResult:
+    """What :func:`learn` did: settings, split, per-target metrics, files written, notes.
+
+    All but the last four attributes are the content of ``models/metrics.json``
+    (:meth:`to_dict`; NaN there is ``null``).
+
+    Attributes
+    ----------
+    source : str
+        The ``identified.csv`` read.
+    settings : dict
+        ``test_size``, ``mfs`` (per input), ``mf``, ``order``, ``epochs``,
+        ``step_size``, ``seed``, ``log_target``, ``baselines``, ``identifiable_ratio``,
+        ``identifiable_share``.
+    inputs : list of str
+        Input columns (mm).
+    n_rows, n_ok, n_train, n_test : int
+        Rows in the file, ok rows, training and test rows of the split.
+    n_test_outside_training_range : int
+        Test rows outside the training range of D or L.
+    targets : list of str
+        Targets learned.
+    excluded : dict
+        Target → why it was left out.
+    identifiable_share : dict
+        Parameter → share of ok rows where it was identified.
+    units : dict
+        Target → SI unit.
+    metrics : dict
+        ``metrics[target][model][set][metric]``: model ``anfis``/``gpr``/``gbr``,
+        set ``train``/``test``, metric ``nrmse``, ``afv``, ``mape`` (%), ``max_ape`` (%)
+        and ``n``; ``metrics[target]["anfis"]`` also has ``kept_epoch`` and ``overfit``.
+    baseline_settings : dict
+        Target → baseline → ``log10_target`` and the fitted hyper-parameters.
+    best_test_model : dict
+        Target → the model with the lowest test MAPE.
+    paper : dict
+        Target → the paper's test metrics (:data:`PAPER`) and ``n``.
+    files : dict
+        What was written: ``split``, ``<target>`` (model JSON), ``<target>_plots``,
+        ``metrics_json``, ``metrics_csv``.
+    notes : list of str
+        Lines for the user about the data as a whole.
+    target_notes : dict
+        Target → lines about that target (every target considered, in order).
+    models_dir : str
+        Folder of the models.
+    plots_dir : str or None
+        Folder of the plots (None without plots).
+    """
+
+    source: str
+    settings: dict
+    inputs: list
+    n_rows: int
+    n_ok: int
+    n_train: int
+    n_test: int
+    n_test_outside_training_range: int
+    targets: list
+    excluded: dict
+    identifiable_share: dict
+    units: dict
+    metrics: dict
+    baseline_settings: dict
+    best_test_model: dict
+    paper: dict
+    files: dict
+    notes: list = field(default_factory=list)
+    target_notes: dict = field(default_factory=dict)
+    models_dir: str = ""
+    plots_dir: str | None = None
+
+    def to_dict(self) -> dict:
+        """The content of ``models/metrics.json`` (NaN kept; :func:`json.dump` of it needs ``_jsonable``)."""
+        skip = {"notes", "target_notes", "models_dir", "plots_dir"}
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name not in skip}
+
+
+@dataclass(frozen=True)
+class _Data:
+    """The ok rows of identified.csv as arrays."""
+
+    path: Path
+    n_rows: int
+    ids: list
+    X: np.ndarray  # (n, 2) D, L in mm
+    values: dict  # target → (n,) SI, NaN where not a number
+    share: dict  # parameter → share of rows where identified
+    identified: dict  # parameter → (n,) bool
+    sigma: dict  # parameter → (n,) relative standard error (floored), inf without an interval
+
+
+@dataclass(frozen=True)
+class _Fit:
+    """One target's models and scores (or why it was left out)."""
+
+    notes: list
+    excluded: str | None = None
+    model: ANFIS | None = None
+    metrics: dict | None = None
+    baseline_settings: dict | None = None
+    y_test: np.ndarray | None = None
+    p_test: np.ndarray | None = None
+
+
+# --------------------------------------------------------------- settings
+def _anfis_settings(mfs, mf, order, epochs, step_size, log_target, seed) -> dict:
+    """ANFIS keyword arguments, validated by ANFIS itself (InputError naming learn()'s keyword)."""
     try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            reader = csv.DictReader(fh)
-            header = [h.strip() for h in (reader.fieldnames or [])]
-            reader.fieldnames = header
-            rows = [(reader.line_num, row) for row in reader]
-    except (OSError, UnicodeDecodeError, csv.Error) as err:
-        raise InputError(f"cannot read CSV: {err}", file=path) from None
-    if not header:
-        raise InputError("empty file (no header row)", file=path)
-    for name in required:
-        if name not in header:
-            raise InputError(f"no such column (columns: {', '.join(header)})", file=path, field=name)
-    return rows
+        ANFIS(n_mfs=mfs, mf=mf, order=order, epochs=epochs, step_size=step_size).check_params(len(INPUTS))
+    except InputError as err:
+        raise InputError(err.message, field=_KEYWORD.get(err.field, err.field)) from None
+    m = [int(v) for v in np.atleast_1d(mfs)]
+    n_mfs = m[0] if len(m) == 1 else tuple(m)
+    return dict(n_mfs=n_mfs, mf=mf, order=int(order), epochs=int(epochs), step_size=float(step_size),
+                log_target=bool(log_target), input_names=list(INPUTS), random_state=int(seed))
 
 
-def _number(path, line, row, name, *, required=True) -> float:
-    cell = (row.get(name) or "").strip()
-    try:
-        v = float(cell)
-    except ValueError:
-        if required:
-            raise InputError(f"line {line}: {cell!r} is not a number (status ok)", file=path, field=name) from None
-        return math.nan
-    if not math.isfinite(v):
-        if required:
-            raise InputError(f"line {line}: {cell!r} is not a finite number (status ok)", file=path, field=name)
-        return math.nan
-    return v
-
-
-def _check_settings(test_size, mfs, mf, order, epochs, step_size, targets):
+def _check_test_size(test_size) -> None:
     if isinstance(test_size, bool) or not isinstance(test_size, (int, np.integer)) or test_size < 1:
         raise InputError(f"must be a whole number ≥ 1, got {test_size!r}", field="test_size")
-    m = [mfs] if isinstance(mfs, (int, np.integer)) else list(mfs)
-    if len(m) not in (1, len(INPUTS)) or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in m):
-        raise InputError(f"expected one whole number or one per input ({', '.join(INPUTS)}), got {mfs!r}", field="mfs")
-    if min(m) < 2:
-        raise InputError("each input needs at least 2 membership functions", field="mfs")
-    if mf not in MF_PARAMS:
-        raise InputError(f"must be one of {', '.join(MF_PARAMS)}, got {mf!r}", field="mf")
-    if isinstance(order, bool) or order not in (0, 1):
-        raise InputError(f"must be 0 (constant) or 1 (linear), got {order!r}", field="order")
-    if isinstance(epochs, bool) or not isinstance(epochs, (int, np.integer)) or epochs < 1:
-        raise InputError(f"must be a whole number ≥ 1, got {epochs!r}", field="epochs")
-    if not (isinstance(step_size, (int, float)) and math.isfinite(step_size) and step_size > 0):
-        raise InputError(f"must be a positive number, got {step_size!r}", field="step_size")
-    n_mfs = int(m[0]) if len(m) == 1 else tuple(int(v) for v in m)
+
+
+def _check_targets(targets) -> list[str] | None:
     if targets is None:
-        return n_mfs, None
+        return None
     names = [targets] if isinstance(targets, str) else list(targets)
     for t in names:
-        if t not in ALL_TARGETS:
-            raise InputError(f"unknown target {t!r} (one of {', '.join(ALL_TARGETS)})", field="targets")
+        if t not in PARAMS:
+            raise InputError(f"unknown target {t!r} (one of {', '.join(PARAMS)})", field="targets")
     if not names or len(set(names)) != len(names):
-        raise InputError(f"expected distinct targets from {', '.join(ALL_TARGETS)}, got {targets!r}", field="targets")
-    return n_mfs, names
+        raise InputError(f"expected distinct targets from {', '.join(PARAMS)}, got {targets!r}", field="targets")
+    return names
 
 
-# ---------------------------------------------------------------- baselines
-def _one_thread():
-    """Single-threaded BLAS while fitting: the matrices are ~150 × 150, where
-    threads only cost (and oversubscribe a machine running several jobs)."""
-    from threadpoolctl import threadpool_limits
+# ------------------------------------------------------------------- input
+def _read(path: Path, candidates: list[str], explicit: bool, test_size: int) -> _Data:
+    """The ok rows (ordered by id) with inputs, targets and their precision; InputError on trouble."""
+    required = ["id", *INPUTS, "status", *candidates]
+    if not explicit:
+        required += [f"{t}_{b}" for t in DAMPING for b in ("lo", "hi")]
+    table = read_identified(path, list(dict.fromkeys(required)))
+    ok: IdentifiedRows = table.ok()
+    if len(ok) < test_size + MIN_TRAIN:
+        raise InputError(f"{len(ok)} rows with status ok, need at least test_size + {MIN_TRAIN} = "
+                         f"{test_size + MIN_TRAIN}", file=path, field="status")
+    ids = ok.ids()
+    X = np.column_stack([ok.column(c) for c in INPUTS])
+    values = {t: ok.column(t, required=False) for t in candidates}
+    share, identified, sigma = {}, {}, {}
+    for t in PARAMS:
+        if table.has_interval(t):
+            identified[t] = ok.identified(t)
+            share[t] = float(np.mean(identified[t])) if len(ok) else 0.0
+            sigma[t] = np.maximum(ok.sigma_ln(t), SIGMA_FLOOR)
+    for t in candidates:  # a target that is learned must be a number in every ok row
+        ok.check_numbers(t)
+    return _Data(path, len(table), ids, X, values, share, identified, sigma)
 
-    return threadpool_limits(limits=1, user_api="blas")
+
+def _split(n: int, test_size: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Seeded random split of n rows: sorted (train, test) indices."""
+    perm = np.random.default_rng(seed).permutation(n)
+    return np.sort(perm[test_size:]), np.sort(perm[:test_size])
 
 
+# --------------------------------------------------------------- baselines
 def _exp10(v):
     return np.power(10.0, v)
 
 
-def _baselines(seed: int, log: bool):
+def _baselines(seed: int, log: bool) -> dict:
     """Unfitted baseline regressors {key: estimator} (target in log10 if ``log``)."""
     from sklearn.compose import TransformedTargetRegressor
     from sklearn.ensemble import GradientBoostingRegressor
@@ -208,9 +267,8 @@ def _baselines(seed: int, log: bool):
     from sklearn.pipeline import make_pipeline
     from sklearn.preprocessing import StandardScaler
 
-    kernel = ConstantKernel(1.0, (1e-3, 1e3)) * RBF(length_scale=[1.0] * len(INPUTS), length_scale_bounds=(1e-2, 1e2)) + WhiteKernel(
-        1e-3, (1e-10, 1.0)
-    )
+    rbf = RBF(length_scale=[1.0] * len(INPUTS), length_scale_bounds=(1e-2, 1e2))
+    kernel = ConstantKernel(1.0, (1e-3, 1e3)) * rbf + WhiteKernel(1e-3, (1e-10, 1.0))
     gpr = make_pipeline(
         StandardScaler(),
         GaussianProcessRegressor(kernel=kernel, normalize_y=True, n_restarts_optimizer=3, random_state=seed),
@@ -224,7 +282,10 @@ def _baselines(seed: int, log: bool):
 
 
 def _weights(y, sigma, log: bool) -> np.ndarray:
-    """1/variance of each target value (relative standard errors σ), up to a common factor."""
+    """1/variance of each target value (relative standard errors σ), up to a common factor.
+
+    σ is relative: the absolute error of y is y·σ, that of log10 y is σ/ln 10 (a common factor).
+    """
     return 1.0 / sigma**2 if log else 1.0 / (y * sigma) ** 2
 
 
@@ -251,20 +312,32 @@ def _describe_baseline(key, est) -> str:
     return f"{inner.n_estimators_} trees, depth {inner.max_depth}, learning rate {inner.learning_rate}"
 
 
-# ------------------------------------------------------------------ metrics
-def _metrics(y, pred) -> dict[str, float]:
-    out = {}
-    for key, (_, fn) in METRICS.items():
-        try:
-            out[key] = float(fn(y, pred))
-        except ValueError:  # e.g. MAPE of a zero target
-            out[key] = math.nan
+# ----------------------------------------------------------------- metrics
+def _metrics(y, pred) -> dict:
+    out = paper_metrics(y, pred)
     out["n"] = int(len(y))
     return out
 
 
-def _ratio(test: float, train: float) -> float:
-    """test / train error (inf if the test error is not finite, 1 if it cannot be judged)."""
+def overfit_ratio(test: float, train: float) -> float:
+    """Test error / training error, as judged for over-fitting (:data:`OVERFIT_RATIO`).
+
+    Parameters
+    ----------
+    test, train : float
+        The same error measure (e.g. NRMSE) on the test and the training data.
+
+    Returns
+    -------
+    float
+        test/train; inf if the test error is not finite (or the training error is
+        0 and the test error is not), 1 if it cannot be judged.
+
+    Examples
+    --------
+    >>> overfit_ratio(0.3, 0.1), overfit_ratio(float("nan"), 0.1), overfit_ratio(0.2, float("nan"))
+    (2.9999999999999996, inf, 1.0)
+    """
     if not math.isfinite(test):
         return math.inf
     if not math.isfinite(train):
@@ -274,8 +347,140 @@ def _ratio(test: float, train: float) -> float:
     return test / train
 
 
+def _best_model(scores: dict) -> str | None:
+    """The model with the lowest finite test MAPE."""
+    scored = {k: v["test"]["mape"] for k, v in scores.items() if math.isfinite(v["test"]["mape"])}
+    return min(scored, key=scored.get) if scored else None
+
+
+# --------------------------------------------------------------- per target
+def _fit_target(t: str, data: _Data, train_idx, test_idx, anfis: dict, *, baselines: bool, seed: int) -> _Fit:
+    """ANFIS (and the baselines) of one target, and their scores on the rows where it was identified."""
+    n_ok = len(data.ids)
+    y = data.values[t]
+    keep = data.identified.get(t, np.ones(n_ok, bool))
+    sig = data.sigma.get(t, np.full(n_ok, SIGMA_FLOOR))
+    usable = np.isfinite(sig) & np.isfinite(y)
+    # Training: every row with a finite interval, weighted by 1/σ²; scores: only rows where the
+    # parameter was identified (the others are not trustworthy targets). See docs/design/campaign.md.
+    t_fit = train_idx[usable[train_idx]]
+    t_tr, t_te = train_idx[keep[train_idx]], test_idx[keep[test_idx]]
+    notes = []
+    if keep.sum() < n_ok:
+        notes.append(f"{t}: trained on {t_fit.size} rows weighted by 1/σ² from their 95 % intervals "
+                     f"({len(train_idx) - t_fit.size} without a finite interval left out); metrics on the "
+                     f"{t_tr.size} training and {t_te.size} test rows where it was identified "
+                     f"(interval within a factor {IDENTIFIED_RATIO:g})")
+    if t_tr.size < MIN_RELIABLE or t_te.size == 0:
+        return _Fit(notes, excluded=f"{t}: too few identified rows ({t_tr.size} train, {t_te.size} test)")
+    rules = int(np.prod(np.broadcast_to(anfis["n_mfs"], (len(INPUTS),))))
+    n_par = rules * (len(INPUTS) + 1 if anfis["order"] == 1 else 1)
+    if t_tr.size < n_par:
+        notes.append(f"note: {t} was identified in {t_tr.size} training rows, fewer than the {n_par} consequent "
+                     f"parameters of {rules} rules: where it was not identified, the model rests on weak rows only")
+    Xfit, yfit, sfit = data.X[t_fit], y[t_fit], sig[t_fit]
+    Xtr, Xte, ytr, yte = data.X[t_tr], data.X[t_te], y[t_tr], y[t_te]
+    if anfis["log_target"] and np.any(yfit <= 0):
+        raise InputError("log_target needs positive values", file=data.path, field=t)
+
+    model = ANFIS(**anfis, target_name=t)
+    try:
+        with single_thread_blas():  # ~150 × 150 matrices: threads only cost
+            model.fit(Xfit, yfit, sample_weight=_weights(yfit, sfit, anfis["log_target"]))
+    except ValueError as err:
+        raise InputError(f"ANFIS training failed: {err}", file=data.path, field=t) from None
+    p_tr, _ = predict_quietly(model, Xtr)
+    p_te, _ = predict_quietly(model, Xte)  # extrapolation is reported once, as a note
+    scores = {"anfis": {"train": _metrics(ytr, p_tr), "test": _metrics(yte, p_te)}}
+    scores["anfis"]["kept_epoch"] = int(model.best_epoch_)
+    ratio = overfit_ratio(scores["anfis"]["test"]["nrmse"], scores["anfis"]["train"]["nrmse"])
+    scores["anfis"]["overfit"] = bool(ratio > OVERFIT_RATIO)
+
+    settings = None
+    if baselines:
+        log = bool(np.all(y > 0))
+        settings = {}
+        for key, est in _baselines(seed, log).items():
+            with warnings.catch_warnings(), single_thread_blas():
+                warnings.simplefilter("ignore")  # GP optimiser convergence chatter
+                _fit_weighted(key, est, Xfit, yfit, sfit, log)
+                b_tr, b_te = est.predict(Xtr), est.predict(Xte)
+            scores[key] = {"train": _metrics(ytr, b_tr), "test": _metrics(yte, b_te)}
+            settings[key] = {"log10_target": log, "fitted": _describe_baseline(key, est)}
+    return _Fit(notes, model=model, metrics=scores, baseline_settings=settings, y_test=yte, p_test=p_te)
+
+
+# ------------------------------------------------------------------ output
+def _writing(path: Path, what: str = "cannot write"):
+    """InputError for an OSError while writing ``path``."""
+
+    def error(err: OSError) -> InputError:
+        return InputError(f"{what}: {err.strerror or err}", file=path)
+
+    return error
+
+
+def _check_folders(models_dir: Path, plots_dir: Path | None) -> None:
+    for d in (models_dir, plots_dir):
+        if d is not None and d.exists() and not d.is_dir():
+            raise InputError("exists and is not a folder", file=d)
+
+
+def _write_manifest(models_dir: Path, learned: list[str]) -> None:
+    """``manifest.json``: the models this run wrote (what ``predict`` uses); model files of other
+    parameters, left by an earlier run on other data or targets, are removed so none is used stale."""
+    with atomic_open(models_dir / MANIFEST, "w", encoding="utf-8") as fh:
+        json.dump({"format": "toolpoint.models", "version": 1, "models": {t: f"{t}.json" for t in learned}}, fh,
+                  indent=1)
+    for t in PARAMS:
+        if t not in learned:
+            (models_dir / f"{t}.json").unlink(missing_ok=True)
+
+
+def _write_split(path: Path, ids: list, test_idx) -> None:
+    is_test = np.zeros(len(ids), dtype=bool)
+    is_test[test_idx] = True
+    try:
+        with atomic_open(path, "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(["id", "set"])
+            for i, t in zip(ids, is_test):
+                w.writerow([i, "test" if t else "train"])
+    except OSError as err:
+        raise _writing(path)(err) from None
+
+
+def _save_model(model: ANFIS, path: Path) -> None:
+    try:
+        model.save(path)
+    except OSError as err:
+        raise _writing(path)(err) from None
+
+
+def _plot_paths(t: str, plots_dir: Path) -> tuple[Path, Path, Path]:
+    """Per-sample, regression and membership figure paths of target ``t``."""
+    return tuple(plots_dir / f"anfis_{t}_{kind}.png" for kind in ("test", "regression", "membership"))
+
+
+def _write_plots(t: str, fit: _Fit, plots_dir: Path) -> list[str]:
+    """The test-set figures of one target (Čiča et al. Figs. 6/7 and 8) and its MFs."""
+    label = f"{t} [{UNITS[t]}]"
+    test, regression, membership = _plot_paths(t, plots_dir)
+    figures = {
+        test: per_sample_figure(fit.y_test, fit.p_test, label, f"{t}: experimental vs ANFIS, test data"),
+        regression: regression_figure(fit.y_test, fit.p_test, label, f"{t}, test data"),
+        membership: membership_figure(fit.model),
+    }
+    try:
+        for path, fig in figures.items():
+            save_png(fig, path)
+    except OSError as err:
+        raise _writing(plots_dir, "cannot write plots")(err) from None
+    return [str(p) for p in figures]
+
+
 def _jsonable(obj):
-    """NaN → None, NumPy → Python, recursively."""
+    """NaN → None, NumPy → Python, tuples → lists, recursively."""
     if isinstance(obj, dict):
         return {str(k): _jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -287,11 +492,31 @@ def _jsonable(obj):
     return obj
 
 
-def _fmt(v) -> str:
-    return f"{v:>10.4g}" if v is not None and math.isfinite(v) else f"{'—':>10}"
+def _write_metrics(result: LearnResult, json_path: Path, csv_path: Path) -> None:
+    """``metrics.json`` (everything but the notes) and ``metrics.csv`` (target × model × set)."""
+    keys = list(PAPER_METRICS)
+
+    def cell(v):
+        return repr(v) if math.isfinite(v) else ""
+
+    try:
+        with atomic_open(json_path, "w", encoding="utf-8") as fh:
+            json.dump(_jsonable(result.to_dict()), fh, indent=1, ensure_ascii=False, allow_nan=False)
+            fh.write("\n")
+        with atomic_open(csv_path, "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(["target", "unit", "model", "set", "n", *keys])
+            for t, res in result.metrics.items():
+                for key, sets in res.items():
+                    for s in ("train", "test"):
+                        w.writerow([t, UNITS[t], key, s, sets[s]["n"], *(cell(sets[s][k]) for k in keys)])
+                if t in PAPER:
+                    w.writerow([t, UNITS[t], "paper", "test", PAPER_N_TEST, *(repr(PAPER[t][k]) for k in keys)])
+    except OSError as err:
+        raise _writing(json_path.parent)(err) from None
 
 
-# --------------------------------------------------------------------- main
+# -------------------------------------------------------------------- main
 def learn(
     results_dir,
     *,
@@ -306,383 +531,144 @@ def learn(
     log_target=True,
     baselines=True,
     plots=True,
-    out=print,
-) -> dict:
+) -> LearnResult:
     """Train ANFIS (and baseline) models of the joint parameters on a campaign's results.
 
     Parameters
     ----------
-    results_dir : folder holding ``identified.csv``; models go to
-        ``results_dir/models``, plots to ``results_dir/plots``.
-    test_size : number of ok rows held out for testing (paper: 30 of 178).
-    mfs, mf, order, epochs, step_size, log_target : ANFIS settings
-        (:class:`~toolpoint.learning.anfis.ANFIS` ``n_mfs``, ``mf``, …).
-    seed : seed of the random split (``numpy.random.default_rng``) and of the baselines.
-    targets : None (kt, kr, and ct/cr where identifiable) or a list of names.
-    baselines : also fit the GP and gradient-boosting baselines.
-    plots : write the PNG plots.
-    out : callable taking one line of text (default :func:`print`).
+    results_dir : path-like
+        Folder holding ``identified.csv``; models go to ``results_dir/models``,
+        plots to ``results_dir/plots``.
+    test_size : int, default 30
+        Ok rows held out for testing (paper: 30 of 178).
+    mfs : int or (int, int), default (3, 7)
+        MFs per input (D, L): ANFIS ``n_mfs``.
+    mf, order, epochs, step_size : ANFIS settings
+        :class:`~toolpoint.learning.anfis.ANFIS` ``mf``, ``order``, ``epochs``,
+        ``step_size`` (mm, the inputs' unit).
+    seed : int, default 0
+        Seed of the random split (``numpy.random.default_rng``) and of the baselines.
+    targets : list of str, optional
+        Parameters to learn (default: kt, ct, kr, cr where identifiable).
+    log_target : bool, default True
+        ANFIS fits log10 of each target (False: the target itself, as the paper).
+    baselines : bool, default True
+        Also fit the GP and gradient-boosting baselines.
+    plots : bool, default True
+        Write the PNG plots.
 
     Returns
     -------
-    dict, the content of ``models/metrics.json`` (NaN where a metric is undefined;
-    ``null`` in the JSON file). The numbers are under
-    ``result["metrics"][target][model][set][metric]`` with model in
-    ``anfis``/``gpr``/``gbr``, set in ``train``/``test`` and metric in
-    ``nrmse``, ``afv``, ``mape`` (%), ``max_ape`` (%), plus ``n``.
+    LearnResult
+        Metrics in the targets' SI units (NaN where undefined), files written, notes.
 
     Raises
     ------
-    InputError : missing identified.csv or column, a non-number in an ok row,
-        fewer than ``test_size + 10`` ok rows, a bad setting, or an output that
-        cannot be written.
+    InputError
+        Missing ``identified.csv`` or column, a non-number in an ok row, fewer
+        than ``test_size + 10`` ok rows, a bad setting (``field`` is the
+        keyword), or an output that cannot be written.
+
+    Examples
+    --------
+    >>> r = learn("results", mfs=(3, 3))  # doctest: +SKIP
+    >>> r.metrics["kt"]["anfis"]["test"]["mape"]  # doctest: +SKIP
     """
-    n_mfs, explicit = _check_settings(test_size, mfs, mf, order, epochs, step_size, targets)
+    _check_test_size(test_size)
+    anfis = _anfis_settings(mfs, mf, order, epochs, step_size, log_target, seed)
+    explicit = _check_targets(targets)
     results_dir = Path(results_dir)
-    path = results_dir / "identified.csv"
-    models_dir, plots_dir = results_dir / "models", results_dir / "plots"
+    path = results_dir / FILE_NAME
+    models_dir, plots_dir = results_dir / "models", (results_dir / "plots" if plots else None)
+    candidates = explicit if explicit is not None else list(PARAMS)
 
-    candidates = explicit if explicit is not None else list(ALL_TARGETS)
-    required = ["id", *INPUTS, "status"] + candidates
-    if explicit is None:
-        required += [f"{t}_{b}" for t in DAMPING for b in ("lo", "hi")]
-    required = list(dict.fromkeys(required))
-    rows = _read_identified(path, required)
-
-    ok = [(line, row) for line, row in rows if (row.get("status") or "").strip().lower() == "ok"]
-    # campaign run appends rows as items finish (worker timing): order by id so the seeded
-    # split, and the training itself, do not depend on which identification finished first
-    ok.sort(key=lambda lr: (lr[1].get("id") or "").strip())
-    n_failed = len(rows) - len(ok)
-    if len(ok) < test_size + MIN_TRAIN:
-        raise InputError(
-            f"{len(ok)} rows with status ok, need at least test_size + {MIN_TRAIN} = {test_size + MIN_TRAIN}",
-            file=path,
-            field="status",
-        )
-    ids = [(row.get("id") or "").strip() for _, row in ok]
-    seen = set()
-    for (line, _), i in zip(ok, ids):
-        if not i:
-            raise InputError(f"line {line}: empty id", file=path, field="id")
-        if i in seen:
-            raise InputError(f"line {line}: id {i!r} appears more than once", file=path, field="id")
-        seen.add(i)
-    X = np.array([[_number(path, line, row, c) for c in INPUTS] for line, row in ok])
-    # lenient here (NaN); a target that is learned must be a number in every ok row (checked below)
-    values = {t: np.array([_number(path, line, row, t, required=False) for line, row in ok]) for t in candidates}
-
-    # identifiability: share of ok rows with a narrow 95 % interval, per parameter
-    share, narrow, sigma = {}, {}, {}
-    for t in ALL_TARGETS:
-        lo_c, hi_c = f"{t}_lo", f"{t}_hi"
-        if rows and lo_c in rows[0][1] and hi_c in rows[0][1]:
-            lo = np.array([_number(path, line, row, lo_c, required=False) for line, row in ok])
-            hi = np.array([_number(path, line, row, hi_c, required=False) for line, row in ok])
-            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-                r = np.where((lo > 0) & np.isfinite(hi), hi / np.where(lo > 0, lo, 1.0), np.inf)
-            narrow[t] = r <= IDENTIFIABLE_RATIO
-            share[t] = float(np.mean(narrow[t])) if len(ok) else 0.0
-            # relative standard error from the 95 % interval (log-symmetric): σ = ln(hi/lo) / (2·1.96)
-            sigma[t] = np.maximum(np.log(r) / (2 * 1.96), SIGMA_FLOOR)
-
-    excluded = {}
-    chosen = []
-    for t in candidates:
-        chosen.append(t)
-        bad = np.flatnonzero(~np.isfinite(values[t]))
-        if bad.size:
-            line, row = ok[bad[0]]
-            _number(path, line, row, t)  # raises, naming the line
-    for t in chosen:
-        if t in share and share[t] < IDENTIFIABLE_SHARE:
-            out(f"note: only {100 * share[t]:.0f} % of the ok rows have a narrow 95 % interval for {t} "
-                "(the FRF hardly depends on it elsewhere); weighted training keeps the rest from "
-                "dominating, and the test metrics use the identified rows only")
-
-    # seeded random split
-    perm = np.random.default_rng(seed).permutation(len(ok))
-    test_idx, train_idx = np.sort(perm[:test_size]), np.sort(perm[test_size:])
-    is_test = np.zeros(len(ok), dtype=bool)
-    is_test[test_idx] = True
-    Xtr, Xte = X[train_idx], X[test_idx]
+    data = _read(path, candidates, explicit is not None, test_size)
+    train_idx, test_idx = _split(len(data.ids), test_size, seed)
+    Xtr, Xte = data.X[train_idx], data.X[test_idx]
     for i, name in enumerate(INPUTS):
         if np.ptp(Xtr[:, i]) == 0:
             raise InputError("constant in the training data; a grid partition needs a range", file=path, field=name)
+    _check_folders(models_dir, plots_dir)
+    if explicit is not None and REQUIRED_FOR_PREDICT not in explicit:
+        raise InputError(f"must include {REQUIRED_FOR_PREDICT}: `toolpoint predict` needs a {REQUIRED_FOR_PREDICT} "
+                         f"model (got {', '.join(explicit)})", field="targets")
+    files = {"split": str(models_dir / "split.csv")}
 
-    if models_dir.exists() and not models_dir.is_dir():
-        raise InputError("exists and is not a folder", file=models_dir)
-    if plots and plots_dir.exists() and not plots_dir.is_dir():
-        raise InputError("exists and is not a folder", file=plots_dir)
-    try:
-        with atomic_open(models_dir / "split.csv", "w", newline="", encoding="utf-8") as fh:
-            w = csv.writer(fh)
-            w.writerow(["id", "set"])
-            for i, t in zip(ids, is_test):
-                w.writerow([i, "test" if t else "train"])
-    except OSError as err:
-        raise InputError(f"cannot write: {err.strerror or err}", file=models_dir / "split.csv") from None
-
-    rules = int(np.prod(np.broadcast_to(n_mfs, (len(INPUTS),))))
-    mfs_text = "x".join(map(str, np.broadcast_to(n_mfs, (len(INPUTS),))))
-    out(
-        f"{path}: {len(rows)} rows, {len(ok)} ok"
-        + (f", {n_failed} failed/other (ignored)" if n_failed else "")
-        + f"; split (seed {seed}): {len(train_idx)} train / {len(test_idx)} test"
-        + (" (paper: 148 / 30)" if (len(train_idx), len(test_idx)) != (148, 30) else " (as in the paper)")
-    )
-    out(
-        f"ANFIS: inputs {', '.join(INPUTS)}; {mfs_text} {mf} MFs ({rules} rules), order {order}, "
-        f"{epochs} epochs, step size {step_size:g}" + (", target fitted as log10" if log_target else "")
-    )
-
-    lo, hi = Xtr.min(axis=0), Xtr.max(axis=0)
-    outside = int(np.sum(np.any((Xte < lo) | (Xte > hi), axis=1)))
+    notes = [f"note: only {100 * data.share[t]:.0f} % of the ok rows have a narrow 95 % interval for {t} "
+             "(the FRF hardly depends on it elsewhere); weighted training keeps the rest from dominating, "
+             "and the test metrics use the identified rows only"
+             for t in candidates if t in data.share and data.share[t] < IDENTIFIABLE_SHARE]
+    outside = int(np.sum(np.any((Xte < Xtr.min(axis=0)) | (Xte > Xtr.max(axis=0)), axis=1)))
     if outside:
-        out(f"note: {outside} of {len(test_idx)} test samples lie outside the training range of D, L (models extrapolate there)")
+        notes.append(f"note: {outside} of {len(test_idx)} test samples lie outside the training range of D, L "
+                     "(models extrapolate there)")
 
-    result = {
-        "source": str(path),
-        "settings": {
+    target_notes, excluded, metrics, baseline_settings, best = {}, {}, {}, {}, {}
+    fits: dict[str, _Fit] = {}
+    for t in candidates:
+        fit = _fit_target(t, data, train_idx, test_idx, anfis, baselines=baselines, seed=int(seed))
+        target_notes[t] = fit.notes
+        if fit.excluded is not None:
+            excluded[t] = fit.excluded
+            continue
+        fits[t] = fit
+        files[t] = str(models_dir / f"{t}.json")
+        if fit.baseline_settings is not None:
+            baseline_settings[t] = fit.baseline_settings
+        metrics[t] = fit.metrics
+        if plots:  # written below, with everything else
+            files[f"{t}_plots"] = [str(p) for p in _plot_paths(t, plots_dir)]
+        if _best_model(fit.metrics) is not None:
+            best[t] = _best_model(fit.metrics)
+
+    learned = [t for t in candidates if t in metrics]
+    if REQUIRED_FOR_PREDICT not in learned:
+        why = excluded.get(REQUIRED_FOR_PREDICT, "not among the targets")
+        raise InputError(f"no {REQUIRED_FOR_PREDICT} model could be learned ({why}); `toolpoint predict` needs one, "
+                         "so nothing was written", file=path, field=REQUIRED_FOR_PREDICT)
+    files["metrics_json"] = str(models_dir / "metrics.json")
+    files["metrics_csv"] = str(models_dir / "metrics.csv")
+    result = LearnResult(
+        source=str(path),
+        settings={
             "test_size": int(test_size),
-            "mfs": list(np.broadcast_to(n_mfs, (len(INPUTS),)).tolist()),
+            "mfs": list(np.broadcast_to(anfis["n_mfs"], (len(INPUTS),)).tolist()),
             "mf": mf,
-            "order": int(order),
-            "epochs": int(epochs),
-            "step_size": float(step_size),
+            "order": anfis["order"],
+            "epochs": anfis["epochs"],
+            "step_size": anfis["step_size"],
             "seed": int(seed),
-            "log_target": bool(log_target),
+            "log_target": anfis["log_target"],
             "baselines": bool(baselines),
-            "identifiable_ratio": IDENTIFIABLE_RATIO,
+            "identifiable_ratio": IDENTIFIED_RATIO,
             "identifiable_share": IDENTIFIABLE_SHARE,
         },
-        "inputs": list(INPUTS),
-        "n_rows": len(rows),
-        "n_ok": len(ok),
-        "n_train": int(len(train_idx)),
-        "n_test": int(len(test_idx)),
-        "n_test_outside_training_range": outside,
-        "targets": list(chosen),
-        "excluded": excluded,
-        "identifiable_share": share,
-        "units": {t: UNITS[t] for t in chosen},
-        "metrics": {},
-        "baseline_settings": {},
-        "best_test_model": {},
-        "paper": {t: dict(PAPER[t], n=PAPER_N_TEST) for t in chosen if t in PAPER},
-        "files": {"split": str(models_dir / "split.csv")},
-    }
-
-    for t in chosen:
-        y = values[t]
-        # Rows whose identification did not pin this parameter down (95 % interval wider
-        # than a factor IDENTIFIABLE_RATIO, e.g. a fit that ran to a bound) are not data
-        # about the joint: they are left out of this target's training and test sets.
-        keep = narrow.get(t, np.ones(len(ok), bool))
-        sig = sigma.get(t, np.full(len(ok), SIGMA_FLOOR))
-        usable = np.isfinite(sig) & np.isfinite(y)
-        # Training: every row with a finite interval, weighted by 1/σ² (weighted least squares);
-        # where the FRF barely depends on the parameter the weights are small but the model still
-        # sees plausible values there instead of extrapolating from a corner of the (D, L) plane.
-        # Metrics: only rows where the parameter was identified (interval within a factor
-        # IDENTIFIABLE_RATIO): the others are not trustworthy targets.
-        t_fit = train_idx[usable[train_idx]]
-        t_tr, t_te = train_idx[keep[train_idx]], test_idx[keep[test_idx]]
-        if keep.sum() < len(ok):
-            out(f"{t}: trained on {t_fit.size} rows weighted by 1/σ² from their 95 % intervals "
-                f"({len(train_idx) - t_fit.size} without a finite interval left out); metrics on the "
-                f"{t_tr.size} training and {t_te.size} test rows where it was identified "
-                f"(interval within a factor {IDENTIFIABLE_RATIO:g})")
-        if t_tr.size < MIN_RELIABLE or t_te.size == 0:
-            excluded[t] = f"{t}: too few identified rows ({t_tr.size} train, {t_te.size} test)"
-            out(f"{t} left out: {excluded[t]}")
-            continue
-        n_par = rules * (len(INPUTS) + 1 if order == 1 else 1)
-        if t_tr.size < n_par:
-            out(f"note: {t} was identified in {t_tr.size} training rows, fewer than the {n_par} consequent "
-                f"parameters of {rules} rules: where it was not identified, the model rests on weak rows only")
-        Xfit, yfit, sfit = X[t_fit], y[t_fit], sig[t_fit]
-        Xtr, Xte = X[t_tr], X[t_te]
-        ytr, yte = y[t_tr], y[t_te]
-        if log_target and np.any(yfit <= 0):
-            raise InputError("log_target needs positive values", file=path, field=t)
-        model = ANFIS(
-            n_mfs=n_mfs,
-            mf=mf,
-            order=order,
-            epochs=int(epochs),
-            step_size=float(step_size),
-            log_target=bool(log_target),
-            input_names=list(INPUTS),
-            target_name=t,
-            random_state=int(seed),
-        )
-        try:
-            with _one_thread():
-                # σ is relative: the absolute error of y is y·σ, of log10 y it is σ/ln 10
-                model.fit(Xfit, yfit, sample_weight=_weights(yfit, sfit, log_target))
-        except ValueError as err:
-            raise InputError(f"ANFIS training failed: {err}", file=path, field=t) from None
-        model_path = models_dir / f"{t}.json"
-        try:
-            model.save(model_path)
-        except OSError as err:
-            raise InputError(f"cannot write: {err.strerror or err}", file=model_path) from None
-        result["files"][t] = str(model_path)
-
-        p_tr, _ = _predict_quietly(model, Xtr)
-        p_te, _ = _predict_quietly(model, Xte)  # extrapolation reported once, above
-        res = {"anfis": {"train": _metrics(ytr, p_tr), "test": _metrics(yte, p_te)}}
-        res["anfis"]["kept_epoch"] = int(model.best_epoch_)
-        ratio = _ratio(res["anfis"]["test"]["nrmse"], res["anfis"]["train"]["nrmse"])
-        res["anfis"]["overfit"] = bool(ratio > OVERFIT_RATIO)
-
-        if baselines:
-            log = bool(np.all(y > 0))
-            settings = {}
-            for key, est in _baselines(int(seed), log).items():
-                with warnings.catch_warnings(), _one_thread():
-                    warnings.simplefilter("ignore")  # GP optimiser convergence chatter
-                    _fit_weighted(key, est, Xfit, yfit, sfit, log)
-                    b_tr, b_te = est.predict(Xtr), est.predict(Xte)
-                res[key] = {"train": _metrics(ytr, b_tr), "test": _metrics(yte, b_te)}
-                settings[key] = {"log10_target": log, "fitted": _describe_baseline(key, est)}
-            result["baseline_settings"][t] = settings
-        result["metrics"][t] = res
-
+        inputs=list(INPUTS),
+        n_rows=data.n_rows,
+        n_ok=len(data.ids),
+        n_train=int(len(train_idx)),
+        n_test=int(len(test_idx)),
+        n_test_outside_training_range=outside,
+        targets=learned,
+        excluded=excluded,
+        identifiable_share=data.share,
+        units={t: UNITS[t] for t in learned},
+        metrics=metrics,
+        baseline_settings=baseline_settings,
+        best_test_model=best,
+        paper={t: dict(PAPER[t], n=PAPER_N_TEST) for t in candidates if t in PAPER},
+        files=files,
+        notes=notes,
+        target_notes=target_notes,
+        models_dir=str(models_dir),
+        plots_dir=None if plots_dir is None else str(plots_dir),
+    )
+    # everything is fitted: only now write, so that a failure above leaves the folder as it was
+    _write_split(models_dir / "split.csv", data.ids, test_idx)
+    for t, fit in fits.items():
+        _save_model(fit.model, models_dir / f"{t}.json")
         if plots:
-            label = f"{t} [{UNITS[t]}]"
-            files = {
-                "test": plots_dir / f"anfis_{t}_test.png",
-                "regression": plots_dir / f"anfis_{t}_regression.png",
-                "membership": plots_dir / f"anfis_{t}_membership.png",
-            }
-            try:
-                _plot_per_sample(files["test"], yte, p_te, label, f"{t}: experimental vs ANFIS, test data")
-                _plot_regression(files["regression"], yte, p_te, label, f"{t}, test data")
-                _plot_membership(files["membership"], model)
-            except OSError as err:
-                raise InputError(f"cannot write plots: {err.strerror or err}", file=plots_dir) from None
-            result["files"][f"{t}_plots"] = [str(p) for p in files.values()]
-
-        # table
-        out("")
-        out(f"{t} [{UNITS[t]}]   (ANFIS kept epoch {model.best_epoch_})")
-        out(f"{'model':<20} {'set':<5} {'n':>4} " + " ".join(f"{title:>10}" for title, _ in METRICS.values()))
-        for key in ("anfis", "gpr", "gbr"):
-            if key in res:
-                for s in ("train", "test"):
-                    m = res[key][s]
-                    out(f"{MODEL_LABELS[key]:<20} {s:<5} {m['n']:>4} " + " ".join(_fmt(m[k]) for k in METRICS))
-        if t in PAPER:
-            out(f"{MODEL_LABELS['paper']:<20} {'test':<5} {PAPER_N_TEST:>4} " + " ".join(_fmt(PAPER[t][k]) for k in METRICS))
-        if res["anfis"]["overfit"]:
-            out(
-                f"warning: ANFIS test NRMSE is {ratio:.3g}× its training NRMSE — {rules} rules over-fit "
-                f"{len(train_idx)} samples; try fewer MFs (e.g. --mfs 3,3), fewer --epochs, "
-                "and compare the baselines"
-            )
-        scored = {k: v["test"]["mape"] for k, v in res.items() if math.isfinite(v["test"]["mape"])}
-        if scored:
-            best = min(scored, key=scored.get)
-            result["best_test_model"][t] = best
-            if len(scored) > 1:
-                line = f"lowest test MAPE: {MODEL_LABELS[best]} {scored[best]:.3g} %"
-                if best != "anfis" and "anfis" in scored:
-                    line += f" (ANFIS {scored['anfis']:.3g} %)"
-                    if scored["anfis"] > 1.5 * scored[best]:
-                        line += f" — {MODEL_LABELS[best]} suits these data better than this ANFIS"
-                out(line)
-
-    result["targets"] = [t for t in chosen if t in result["metrics"]]  # minus those left out above
-    result["units"] = {t: UNITS[t] for t in result["targets"]}
-    # files
-    metrics_json, metrics_csv = models_dir / "metrics.json", models_dir / "metrics.csv"
-    result["files"]["metrics_json"] = str(metrics_json)
-    result["files"]["metrics_csv"] = str(metrics_csv)
-    try:
-        with atomic_open(metrics_json, "w", encoding="utf-8") as fh:
-            json.dump(_jsonable(result), fh, indent=1, ensure_ascii=False, allow_nan=False)
-            fh.write("\n")
-        with atomic_open(metrics_csv, "w", newline="", encoding="utf-8") as fh:
-            w = csv.writer(fh)
-            w.writerow(["target", "unit", "model", "set", "n", *METRICS])
-            for t, res in result["metrics"].items():
-                for key, sets in res.items():
-                    for s in ("train", "test"):
-                        m = sets[s]
-                        w.writerow([t, UNITS[t], key, s, m["n"], *("" if not math.isfinite(m[k]) else repr(m[k]) for k in METRICS)])
-                if t in PAPER:
-                    w.writerow([t, UNITS[t], "paper", "test", PAPER_N_TEST, *(repr(PAPER[t][k]) for k in METRICS)])
-    except OSError as err:
-        raise InputError(f"cannot write: {err.strerror or err}", file=models_dir) from None
-    out("")
-    out(f"models and metrics in {models_dir}" + (f"; plots in {plots_dir}" if plots else ""))
+            _write_plots(t, fit, plots_dir)
+    _write_metrics(result, models_dir / "metrics.json", models_dir / "metrics.csv")
+    _write_manifest(models_dir, learned)
     return result
-
-
-# ---------------------------------------------------------------------- CLI
-#: learn() keyword → CLI option, to name the option in an InputError.
-_OPTIONS = {
-    "test_size": "--test-size",
-    "mfs": "--mfs",
-    "mf": "--mf",
-    "order": "--order",
-    "epochs": "--epochs",
-    "step_size": "--step-size",
-    "targets": "--targets",
-}
-
-
-def add_arguments(parser) -> None:
-    """Add the options of ``toolpoint campaign learn`` (not the positional RESULTS_DIR)."""
-    parser.add_argument("--test-size", type=int, default=30, help="ok rows held out for testing (default 30, as in the paper)")
-    parser.add_argument("--mfs", default="3,7", help="MFs per input (diameter, overhang): one number or two, e.g. 3,7 (default)")
-    parser.add_argument("--mf", default="gauss", choices=tuple(MF_PARAMS), help="membership function type (default gauss)")
-    parser.add_argument("--order", type=int, default=1, choices=(0, 1), help="consequent order: 0 constant, 1 linear (default 1)")
-    parser.add_argument("--epochs", type=int, default=200, help="ANFIS training epochs (default 200)")
-    parser.add_argument("--step-size", type=float, default=0.01, help="ANFIS initial step size, in input units (default 0.01)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the random train/test split and the baselines (default 0)")
-    parser.add_argument("--linear-target", dest="log_target", action="store_false",
-                        help="ANFIS fits the target itself, as the paper (default: its log10, which keeps predictions "
-                             "positive; metrics are in SI units either way)")
-    parser.add_argument("--no-baselines", action="store_true", help="skip the GP and gradient-boosting comparison models")
-    parser.add_argument("--targets", help="comma-separated targets from kt,ct,kr,cr (default: kt,kr and identifiable dampings)")
-    parser.add_argument("--no-plots", action="store_true", help="do not write PNG plots")
-
-
-def run_cli(args) -> int:
-    """Run :func:`learn` from parsed arguments (``args.results_dir`` plus :func:`add_arguments`' options)."""
-    text = str(getattr(args, "mfs", "3,7"))
-    try:
-        mfs = tuple(int(s) for s in text.split(","))
-    except ValueError:
-        raise InputError(f"expected an integer or comma-separated integers, got {text!r}", field="--mfs") from None
-    targets = getattr(args, "targets", None)
-    if targets is not None:
-        targets = [s.strip() for s in targets.split(",")]
-    plots = not getattr(args, "no_plots", False)
-    if plots:
-        import matplotlib
-
-        matplotlib.use("Agg")
-    try:
-        learn(
-            args.results_dir,
-            test_size=args.test_size,
-            mfs=mfs[0] if len(mfs) == 1 else mfs,
-            mf=args.mf,
-            order=args.order,
-            epochs=args.epochs,
-            step_size=args.step_size,
-            seed=args.seed,
-            targets=targets,
-            log_target=getattr(args, "log_target", True),
-            baselines=not args.no_baselines,
-            plots=plots,
-        )
-    except InputError as err:
-        if err.file is None and err.field in _OPTIONS:
-            raise InputError(err.message, field=_OPTIONS[err.field]) from None
-        raise
-    return 0

@@ -3,13 +3,13 @@
 ANFIS models (one JSON per target, from ``toolpoint campaign learn``) give
 kt, kr — and ct, cr where they were identifiable — from (diameter_mm,
 overhang_mm). A parameter without a model takes its campaign median
-(:func:`_median_identified`, from ``identified.csv`` beside the models
-folder), which is said in the returned notes. RCSA then couples the tool to the subassembly.
+(from ``identified.csv`` beside the models folder, :mod:`.results`), which is
+said in the returned notes. RCSA then couples the tool to the subassembly.
 """
 
 from __future__ import annotations
 
-import csv
+import json
 import warnings
 from pathlib import Path
 
@@ -23,54 +23,86 @@ from ..dynamics.model import ToolPointModel
 from ..identification.params import PARAMS
 from ..dynamics.subassembly import Subassembly
 from .config import ToolFamily, load_campaign
+from .learn import MANIFEST, REQUIRED_FOR_PREDICT
+from .results import FILE_NAME, read_identified
+
+__all__ = ["load_models", "predict_joint", "predict_frf"]
 
 
 def load_models(models_dir) -> dict[str, ANFIS]:
+    """The ANFIS models in a ``campaign learn`` models folder.
+
+    Parameters
+    ----------
+    models_dir : path-like
+        Folder with ``<parameter>.json`` per learned parameter and the ``manifest.json``
+        naming them (kt required; the others fall back to campaign medians in :func:`predict_joint`).
+
+    Returns
+    -------
+    dict
+        Parameter name → :class:`~toolpoint.learning.anfis.ANFIS`.
+
+    Raises
+    ------
+    InputError
+        Missing folder or kt model, a file that is not a model, a bad manifest.
+    """
     d = Path(models_dir)
     if not d.is_dir():
         raise InputError("models folder not found", file=d, field="--models")
+    names = _manifest(d)
     models = {}
-    for p in PARAMS:
+    for p in names:
         f = d / f"{p}.json"
-        if f.exists():
-            try:
-                models[p] = ANFIS.load(f)
-            except (ValueError, KeyError, OSError) as e:
-                raise InputError(f"not a toolpoint ANFIS model ({e})", file=f) from None
-    for p in ("kt", "kr"):
-        if p not in models:
-            raise InputError(f"no model for {p} ({p}.json)", file=d, field="--models")
+        if not f.exists():
+            raise InputError(f"{MANIFEST} names {p}.json, which is missing (re-run `toolpoint campaign learn`)",
+                             file=d, field="--models")
+        try:
+            models[p] = ANFIS.load(f)
+        except (ValueError, KeyError, OSError) as e:
+            raise InputError(f"not a toolpoint ANFIS model ({e})", file=f) from None
+    if REQUIRED_FOR_PREDICT not in models:
+        raise InputError(f"no model for {REQUIRED_FOR_PREDICT} ({REQUIRED_FOR_PREDICT}.json)", file=d,
+                         field="--models")
     return models
+
+
+def _manifest(d: Path) -> list[str]:
+    """The parameters whose models the last ``learn`` wrote (its manifest); every model file present
+    when there is no manifest (a folder written before manifests existed)."""
+    path = d / MANIFEST
+    if not path.exists():
+        return [p for p in PARAMS if (d / f"{p}.json").exists()]
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        names = list(doc["models"])
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError) as e:
+        raise InputError(f"not a models manifest ({type(e).__name__})", file=path) from None
+    unknown = [n for n in names if n not in PARAMS]
+    if unknown:
+        raise InputError(f"unknown parameter {unknown[0]!r} (one of {', '.join(PARAMS)})", file=path, field="models")
+    return names
 
 
 def _median_identified(models_dir: Path) -> dict[str, tuple[float, str]]:
     """Per parameter: (median, what it is the median of) over the campaign's ok rows —
-    the rows where the parameter was identified (95 % interval within a factor 2) if
-    there are at least 3, else all ok rows."""
-    path = models_dir.parent / "identified.csv"
+    the rows where the parameter was identified if there are at least 3, else all ok rows."""
+    path = models_dir.parent / FILE_NAME
     if not path.exists():
         return {}
-    with open(path, newline="") as fh:
-        rows = [r for r in csv.DictReader(fh) if r.get("status") == "ok"]
+    ok = read_identified(path).ok()
     out = {}
     for p in PARAMS:
-        v = np.array([_float(r.get(p)) for r in rows])
-        lo = np.array([_float(r.get(f"{p}_lo")) for r in rows])
-        hi = np.array([_float(r.get(f"{p}_hi")) for r in rows])
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            ident = np.isfinite(v) & (lo > 0) & (hi / lo <= 2.0)
+        if not ok.has(p):
+            continue
+        v = ok.column(p, required=False)
+        ident = np.isfinite(v) & (ok.identified(p) if ok.has_interval(p) else False)
         if ident.sum() >= 3:
             out[p] = (float(np.median(v[ident])), f"median of the {int(ident.sum())} tools where it was identified")
         elif np.isfinite(v).any():
             out[p] = (float(np.median(v[np.isfinite(v)])), f"median of all {int(np.isfinite(v).sum())} ok tools")
     return out
-
-
-def _float(cell) -> float:
-    try:
-        return float(cell)
-    except (TypeError, ValueError):
-        return float("nan")
 
 
 def _training_range(model: ANFIS):
@@ -79,7 +111,32 @@ def _training_range(model: ANFIS):
 
 
 def predict_joint(models_dir, diameter_mm: float, overhang_mm: float) -> tuple[np.ndarray, list[str]]:
-    """[kt, ct, kr, cr] (SI) for one tool, and notes (fallbacks, extrapolation)."""
+    """The joint of one tool from the ANFIS models (campaign medians for parameters without one).
+
+    Parameters
+    ----------
+    models_dir : path-like
+        ``campaign learn`` models folder (``identified.csv`` beside it for medians).
+    diameter_mm, overhang_mm : float
+        Tool diameter D and overhang L, mm.
+
+    Returns
+    -------
+    joint : ndarray, shape (4,)
+        [kt N/m, ct N s/m, kr N m/rad, cr N m s/rad].
+    notes : list of str
+        Fallbacks used and extrapolation.
+
+    Warns
+    -----
+    ExtrapolationWarning
+        (D, L) outside the range a model was trained on (also in ``notes``).
+
+    Raises
+    ------
+    InputError
+        Missing models, a model predicting a value ≤ 0, no median to fall back on.
+    """
     d = Path(models_dir)
     models = load_models(d)
     notes = []
@@ -119,9 +176,30 @@ def predict_frf(source, diameter_mm: float, overhang_mm: float, models_dir, *, h
                 freq_hz=None) -> tuple[FRF, np.ndarray, list[str]]:
     """Tool-point receptance of a tool (D, L in mm) on a campaign's holder or an assembly's spindle–holder.
 
-    ``source``: a campaign folder (tool family and subassembly from it) or an
-    assembly TOML (spindle, holder and spindle–holder joint from it; the tool a
-    cylinder of D with 0.8 D flutes over 2 D, in the file's tool material).
+    Parameters
+    ----------
+    source : path-like
+        A campaign folder (tool family and subassembly from it) or an assembly
+        TOML (spindle, holder and spindle–holder joint from it; the tool a
+        cylinder of D with 0.8 D flutes over 2 D, in the file's tool material).
+    diameter_mm, overhang_mm : float
+        Tool diameter D and overhang L, mm.
+    models_dir : path-like
+        ``campaign learn`` models folder.
+    holder : str, optional
+        Holder name (campaigns with several; default the first).
+    freq_hz : array_like, optional
+        Frequencies, Hz (default: the campaign band at 1 Hz, the subassembly's
+        measured grid, or the assembly's frequency range).
+
+    Returns
+    -------
+    frf : FRF
+        Tool-point receptance, m/N.
+    joint : ndarray, shape (4,)
+        The predicted joint (SI), as :func:`predict_joint`.
+    notes : list of str
+        As :func:`predict_joint`.
     """
     joint, notes = predict_joint(models_dir, diameter_mm, overhang_mm)
     src = Path(source)

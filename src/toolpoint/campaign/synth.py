@@ -78,11 +78,27 @@ BLANK = {"od_mm": 20.0, "length_mm": 50.0, "x2_mm": 45.0}
 
 
 def truth_joint(diameter_mm, overhang_mm) -> np.ndarray:
-    """[kt, ct, kr, cr] (SI) of the truth law; broadcasts over arrays."""
+    """The joint of the truth law (module docstring); broadcasts over arrays.
+
+    Parameters
+    ----------
+    diameter_mm, overhang_mm : array_like
+        Tool diameter D and overhang L, mm.
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        [kt N/m, ct N s/m, kr N m/rad, cr N m s/rad].
+
+    Examples
+    --------
+    >>> truth_joint(16, 50).tolist()  # the paper's Table 1 joint
+    [21000000.0, 15.0, 1400000.0, 3.0]
+    """
     d = np.asarray(diameter_mm, float) / D0
-    l = np.asarray(overhang_mm, float) / L0
+    lr = np.asarray(overhang_mm, float) / L0
     return np.stack(
-        np.broadcast_arrays(2.1e7 * d**1.5 * l**-0.15, 15.0 * d**1.0, 1.4e6 * d**2.5 * l**-0.10, 3.0 * d**2.0), -1
+        np.broadcast_arrays(2.1e7 * d**1.5 * lr**-0.15, 15.0 * d**1.0, 1.4e6 * d**2.5 * lr**-0.10, 3.0 * d**2.0), -1
     )
 
 
@@ -96,27 +112,31 @@ def _noisy(frf: FRF, level: float, rng: np.random.Generator) -> FRF:
 
 def synthesise(out: str | Path, n: int = 178, seed: int = 0, noise: float = 0.01, blank_noise: float = 5e-5,
                smooth: str | float = "modal", fmt: str = "csv") -> dict:
-    """Write a campaign folder; returns a summary. ``noise``/``blank_noise`` are
-    complex Gaussian standard deviations relative to each FRF's peak.
+    """Write a synthetic campaign folder (the truth law of the module docstring).
 
-    The blank FRFs get less noise by default (5e-5 of the peak: many averaged
-    impacts on a stiff spindle) because inverse RCSA amplifies it ~100–400×
-    into the subassembly (see :mod:`toolpoint.dynamics.inverse_rcsa`). ``smooth`` is
-    written to campaign.toml: ``"modal"`` (common-pole fit of the blank FRFs,
-    the default) or a Savitzky–Golay window in Hz. Measured on this holder,
-    median error of h, l, p over 20–4000 Hz (exp. seed 1):
+    Parameters
+    ----------
+    out : path-like
+        Folder to write (``campaign.toml``, ``measurements.csv``, ``frf/``, ``sh/``, ``truth/``).
+    n : int, default 178
+        Number of tool assemblies.
+    seed : int, default 0
+        Seed of the overhangs and the noise.
+    noise, blank_noise : float
+        Complex Gaussian noise of the tool-point and the blank FRFs, standard
+        deviation relative to each FRF's peak. The blank's is lower by default
+        because inverse RCSA amplifies it ~100–400× into the subassembly
+        (measurements: ``docs/design/campaign.md``).
+    smooth : "modal" or float, default "modal"
+        Written to campaign.toml: common-pole fit of the blank FRFs, or a
+        Savitzky–Golay window in Hz.
+    fmt : {"csv", "uff"}, default "csv"
+        FRF file format.
 
-    ============  ===================  ====================================
-    blank noise   modal fit            Savitzky–Golay 100 Hz
-    ============  ===================  ====================================
-    5e-5          0.06, 0.30, 0.45 %   0.43, 1.9, 1.9 %, peak of |h| × 0.25
-    2e-4          0.24, 1.2, 1.2 %     1.3, 5.8, 7.0 %
-    1e-3          0.85, 5.9, 8.3 %     5.2, 25, 35 %
-    ============  ===================  ====================================
-
-    With the 100 Hz window the campaign's joint fits compensated the rounded
-    spindle peak with a wrong joint (kr to 64 %, predicted peak magnitudes
-    30–50 % off); with the modal fit kt comes to 0.15 % and kr to 16 %.
+    Returns
+    -------
+    dict
+        ``n``, ``seed``, ``noise``, ``blank_noise``, ``band_hz`` (Hz), ``step_hz`` (Hz), ``law`` (text).
     """
     out = Path(out)
     rng = np.random.default_rng(seed)
@@ -150,7 +170,8 @@ def synthesise(out: str | Path, n: int = 178, seed: int = 0, noise: float = 0.01
                            **dict(zip(("kt", "ct", "kr", "cr"), joints[i]))})
 
     with atomic_open(out / "campaign.toml") as fh:
-        fh.write(CAMPAIGN_TOML.format(lo=BAND_HZ[0], hi=BAND_HZ[1], smooth=(f'smooth = "{smooth}"' if isinstance(smooth, str) else f'smooth_hz = {smooth:g}'), **BLANK, **CARBIDE))
+        smooth_line = f'smooth = "{smooth}"' if isinstance(smooth, str) else f"smooth_hz = {smooth:g}"
+        fh.write(CAMPAIGN_TOML.format(lo=BAND_HZ[0], hi=BAND_HZ[1], smooth=smooth_line, **BLANK, **CARBIDE))
     _write_csv(out / "measurements.csv", rows)
     _write_csv(out / "truth" / "truth.csv", truth_rows)
     summary = {"n": n, "seed": seed, "noise": noise, "blank_noise": blank_noise, "band_hz": list(BAND_HZ),
@@ -183,7 +204,8 @@ flute_ratio = 0.8          # equivalent diameter of the flutes / D
 flute_length_ratio = 2.0   # flute length = 2 D, capped at the overhang
 
 [holders.ER40]             # subassembly measured with a blank (inverse RCSA, Park et al.)
-blank = {{ segments = [{{ length_mm = {length_mm}, od_mm = {od_mm} }}], x2_mm = {x2_mm}, G11 = "sh/G11.csv", G12 = "sh/G12.csv", G22 = "sh/G22.csv", {smooth} }}
+blank = {{ segments = [{{ length_mm = {length_mm}, od_mm = {od_mm} }}], x2_mm = {x2_mm}, \
+G11 = "sh/G11.csv", G12 = "sh/G12.csv", G22 = "sh/G22.csv", {smooth} }}
 
 [identify]
 method = "hybrid"

@@ -25,20 +25,23 @@ target with the predictions.
 from __future__ import annotations
 
 import csv
-import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..learning.anfis import ANFIS, MF_PARAMS, plot_membership
-from ..io.atomic import atomic_open, atomic_path
-from ..errors import ExtrapolationWarning, InputError
-from ..learning.metrics import afv, mape, max_ape, nrmse
+from .common import out_path
+from ..errors import InputError
+from ..io.atomic import atomic_open
+from ..learning.anfis import ANFIS, MF_PARAMS, predict_quietly
+from ..learning.figures import membership_figure, per_sample_figure, regression_figure, save_png
+from ..learning.metrics import PAPER_METRICS, paper_metrics
 
-PAPER_METRICS = (("NRMSE", nrmse), ("AFV", afv), ("MAPE %", mape), ("max APE %", max_ape))
+#: ANFIS parameter → the option that sets it (to name the option in an InputError).
+_OPTIONS = {"n_mfs": "--mfs", "mf": "--mf", "order": "--order", "epochs": "--epochs", "step_size": "--step-size"}
 
 
 def register(subparsers) -> None:
+    """Add ``toolpoint anfis train|predict`` to the ``toolpoint`` sub-command parsers."""
     p = subparsers.add_parser(
         "anfis",
         help="train / apply an ANFIS (Sugeno fuzzy) regression model",
@@ -52,14 +55,16 @@ def register(subparsers) -> None:
     t.add_argument("--target", required=True, help="target column name, e.g. kt")
     t.add_argument("--mfs", default="3", help="MFs per input: one number or one per input, e.g. 3,7 (default 3)")
     t.add_argument("--mf", default="gauss", choices=tuple(MF_PARAMS), help="membership function type (default gauss)")
-    t.add_argument("--order", type=int, default=1, choices=(0, 1), help="consequent order: 0 constant, 1 linear (default 1)")
+    t.add_argument("--order", type=int, default=1, choices=(0, 1),
+                   help="consequent order: 0 constant, 1 linear (default 1)")
     t.add_argument("--epochs", type=int, default=100, help="training epochs (default 100)")
     t.add_argument("--step-size", type=float, default=0.01, help="initial step size, in input units (default 0.01)")
     split = t.add_mutually_exclusive_group()
     split.add_argument("--test-fraction", type=float, help="hold out this random fraction of DATA as test data")
     split.add_argument("--test", help="separate test CSV with the same columns")
     t.add_argument("--seed", type=int, default=0, help="seed of the random test split (default 0)")
-    t.add_argument("--log-target", action="store_true", help="fit log10(target) (target > 0); predictions are transformed back")
+    t.add_argument("--log-target", action="store_true",
+                   help="fit log10(target) (target > 0); predictions are transformed back")
     t.add_argument("--out", required=True, help="model JSON to write")
     t.add_argument("--plots", help="directory for PNG plots")
     t.set_defaults(func=train)
@@ -114,16 +119,16 @@ def read_columns(path, names) -> dict[str, np.ndarray]:
     return out
 
 
-def _check_out(path, option: str, *, folder: bool = False) -> None:
-    """Fail before any work if an output path cannot be what it must be."""
+def _check_plots_folder(path, option: str) -> None:
+    """Fail before any work if the plots folder cannot be made or written."""
     p = Path(path)
-    if folder and p.exists() and not p.is_dir():
+    if p.exists() and not p.is_dir():
         raise InputError("exists and is not a folder", file=p, field=option)
-    if not folder and p.is_dir():
-        raise InputError("is a folder, expected a file name", file=p, field=option)
+    out_path(str(p / "anfis_plot.png"), option)  # an ancestor that is a file, or not writable
 
 
 def _names(text: str, option: str) -> list[str]:
+    """Comma-separated column names (non-empty, distinct)."""
     names = [s.strip() for s in text.split(",")]
     if not names or any(not s for s in names):
         raise InputError(f"expected comma-separated column names, got {text!r}", field=option)
@@ -133,6 +138,7 @@ def _names(text: str, option: str) -> list[str]:
 
 
 def _write_csv(path, header, columns) -> None:
+    """Write columns of floats under ``header``, atomically."""
     with atomic_open(path, "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(header)
@@ -140,82 +146,9 @@ def _write_csv(path, header, columns) -> None:
             w.writerow([repr(float(v)) for v in row])  # shortest exact float text
 
 
-# ----------------------------------------------------------------- metrics
-def paper_metrics(y_true, y_pred) -> dict[str, float]:
-    """NRMSE, AFV, MAPE %, max APE % (NaN where undefined, e.g. a zero target)."""
-    out = {}
-    for name, fn in PAPER_METRICS:
-        try:
-            out[name] = fn(y_true, y_pred)
-        except ValueError:
-            out[name] = float("nan")
-    return out
-
-
-def _predict_quietly(model, X):
-    """Predict; return (prediction, whether any sample lay outside the training range)."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", ExtrapolationWarning)
-        y = model.predict(X)
-    return y, any(issubclass(w.category, ExtrapolationWarning) for w in caught)
-
-
-# ------------------------------------------------------------------- plots
-def _savefig(fig, path) -> None:
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
-
-
-def _plot_per_sample(path, y, o, label, title) -> None:
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(7.0, 4.0))
-    ax = fig.subplots()
-    k = np.arange(1, y.size + 1)
-    ax.plot(k, y, "o", mfc="none", label="target")
-    ax.plot(k, o, "x", label="ANFIS prediction")
-    ax.set_xlabel("sample number")
-    ax.set_ylabel(label)
-    ax.set_title(title)
-    ax.legend()
-    fig.tight_layout()
-    _savefig(fig, path)
-
-
-def _plot_regression(path, y, o, label, title) -> None:
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(5.0, 5.0))
-    ax = fig.subplots()
-    lo, hi = float(min(y.min(), o.min())), float(max(y.max(), o.max()))
-    ax.plot(y, o, "o", mfc="none", label="data")
-    ax.plot([lo, hi], [lo, hi], ":", color="grey", label="output = target")
-    if y.size >= 2 and np.ptp(y) > 0:
-        m, b = np.polyfit(y, o, 1)
-        r = np.corrcoef(y, o)[0, 1]
-        sign = "+" if b >= 0 else "−"
-        ax.plot([lo, hi], [m * lo + b, m * hi + b], "-", label=f"fit: output = {m:.3g}·target {sign} {abs(b):.3g}")
-        title = f"{title}: R = {r:.4f}"
-    ax.set_xlabel(f"target {label}")
-    ax.set_ylabel(f"output {label}")
-    ax.set_title(title)
-    ax.legend(loc="upper left", fontsize="small")
-    fig.tight_layout()
-    _savefig(fig, path)
-
-
-def _plot_membership(path, model) -> None:
-    from matplotlib.figure import Figure
-
-    d = model.n_features_in_
-    fig = Figure(figsize=(6.0, 2.2 * d))
-    axes = fig.subplots(d, 1, squeeze=False)[:, 0]
-    plot_membership(model, ax=axes)
-    _savefig(fig, path)
-
-
 # ---------------------------------------------------------------- commands
 def train(args) -> int:
+    """``toolpoint anfis train``: fit, report the paper's metrics, write the model (and plots); exit code."""
     inputs = _names(args.inputs, "--inputs")
     target = args.target.strip()
     if not target:
@@ -226,19 +159,26 @@ def train(args) -> int:
         mfs = [int(s) for s in args.mfs.split(",")]
     except ValueError:
         raise InputError(f"expected an integer or comma-separated integers, got {args.mfs!r}", field="--mfs") from None
-    if len(mfs) not in (1, len(inputs)):
-        raise InputError(f"{len(mfs)} numbers for {len(inputs)} inputs", field="--mfs")
-    if min(mfs) < 2:
-        raise InputError("each input needs at least 2 membership functions", field="--mfs")
-    if args.epochs < 1:
-        raise InputError("must be at least 1", field="--epochs")
-    if not (np.isfinite(args.step_size) and args.step_size > 0):
-        raise InputError("must be a positive number", field="--step-size")
+    model = ANFIS(
+        n_mfs=mfs[0] if len(mfs) == 1 else tuple(mfs),
+        mf=args.mf,
+        order=args.order,
+        epochs=args.epochs,
+        step_size=args.step_size,
+        log_target=args.log_target,
+        input_names=inputs,
+        target_name=target,
+        random_state=args.seed,
+    )
+    try:  # before reading any data: the model's own checks, reported under the option's name
+        model.check_params(len(inputs))
+    except InputError as err:
+        raise InputError(err.message, field=_OPTIONS.get(err.field, err.field)) from None
     if args.test_fraction is not None and not 0 < args.test_fraction < 1:
         raise InputError("must be between 0 and 1", field="--test-fraction")
-    _check_out(args.out, "--out")
+    out_path(args.out, "--out", inputs=[args.data])
     if args.plots:
-        _check_out(args.plots, "--plots", folder=True)
+        _check_plots_folder(args.plots, "--plots")
 
     cols = read_columns(args.data, inputs + [target])
     X, y = np.column_stack([cols[c] for c in inputs]), cols[target]
@@ -255,21 +195,11 @@ def train(args) -> int:
         X, y, Xt, yt = X[train_idx], y[train_idx], X[test_idx], y[test_idx]
     for i, name in enumerate(inputs):
         if np.ptp(X[:, i]) == 0:
-            raise InputError("constant in the training data; a grid partition needs a range", file=args.data, field=name)
+            raise InputError("constant in the training data; a grid partition needs a range", file=args.data,
+                             field=name)
     if args.log_target and np.any(y <= 0):
         raise InputError("--log-target needs positive target values", file=args.data, field=target)
 
-    model = ANFIS(
-        n_mfs=mfs[0] if len(mfs) == 1 else tuple(mfs),
-        mf=args.mf,
-        order=args.order,
-        epochs=args.epochs,
-        step_size=args.step_size,
-        log_target=args.log_target,
-        input_names=inputs,
-        target_name=target,
-        random_state=args.seed,
-    )
     try:
         model.fit(X, y)
     except ValueError as err:
@@ -278,7 +208,7 @@ def train(args) -> int:
     sets = [("train", X, y)] + ([("test", Xt, yt)] if Xt is not None else [])
     results = []
     for name, Xs, ys in sets:
-        pred, outside = _predict_quietly(model, Xs)
+        pred, outside = predict_quietly(model, Xs)
         results.append((name, ys, pred, paper_metrics(ys, pred), outside))
 
     try:
@@ -289,9 +219,9 @@ def train(args) -> int:
         plots = Path(args.plots)
         try:
             for name, ys, pred, _, _ in results:
-                _plot_per_sample(plots / f"predicted_vs_target_{name}.png", ys, pred, target, f"{name} data")
-                _plot_regression(plots / f"regression_{name}.png", ys, pred, target, f"{name} data")
-            _plot_membership(plots / "membership_functions.png", model)
+                save_png(per_sample_figure(ys, pred, target, f"{name} data"), plots / f"predicted_vs_target_{name}.png")
+                save_png(regression_figure(ys, pred, target, f"{name} data"), plots / f"regression_{name}.png")
+            save_png(membership_figure(model), plots / "membership_functions.png")
         except OSError as err:
             raise InputError(f"cannot write plots: {err.strerror or err}", file=plots, field="--plots") from None
 
@@ -301,9 +231,9 @@ def train(args) -> int:
         f"order {args.order}, {len(model.history_['train_rmse'])} epochs, kept epoch {model.best_epoch_}"
         + (", target fitted as log10" if args.log_target else "")
     )
-    print(f"{'data':<6} {'n':>5} " + " ".join(f"{m:>10}" for m, _ in PAPER_METRICS))
+    print(f"{'data':<6} {'n':>5} " + " ".join(f"{title:>10}" for title, _ in PAPER_METRICS.values()))
     for name, ys, _, met, outside in results:
-        print(f"{name:<6} {len(ys):>5} " + " ".join(f"{met[m]:>10.4g}" for m, _ in PAPER_METRICS))
+        print(f"{name:<6} {len(ys):>5} " + " ".join(f"{met[k]:>10.4g}" for k in PAPER_METRICS))
         if outside:
             print(f"note: some {name} samples lie outside the training input range (extrapolation)")
     print(f"model written to {args.out}" + (f"; plots in {args.plots}" if args.plots else ""))
@@ -311,9 +241,10 @@ def train(args) -> int:
 
 
 def predict(args) -> int:
+    """``toolpoint anfis predict``: apply a saved model to a CSV table; exit code."""
     if not Path(args.model).is_file():
         raise InputError("file not found", file=args.model)
-    _check_out(args.out, "--out")
+    out_path(args.out, "--out", inputs=[args.data, args.model])
     try:
         model = ANFIS.load(args.model)
     except (ValueError, OSError, UnicodeDecodeError) as err:
@@ -328,7 +259,7 @@ def predict(args) -> int:
         raise InputError(f"the model has {model.n_features_in_} inputs, {len(inputs)} names given", field="--inputs")
     cols = read_columns(args.data, inputs)
     X = np.column_stack([cols[c] for c in inputs])
-    pred, outside = _predict_quietly(model, X)
+    pred, outside = predict_quietly(model, X)
     out_name = model.target_name_ or "prediction"
     if out_name in inputs:
         out_name += "_predicted"

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+import os
 import warnings
 from contextlib import contextmanager
 from pathlib import Path
@@ -10,12 +12,61 @@ from ..io.atomic import atomic_path
 from ..errors import InputError
 
 
-def out_path(value: str, flag: str) -> Path:
-    """An output path whose folder exists or can be made."""
+def out_path(value: str, flag: str, *, inputs=()) -> Path:
+    """An output file path, checked before any work is done.
+
+    Refused (:class:`~toolpoint.errors.InputError` naming the path and ``flag``):
+    an existing folder; a path under a file; a folder that cannot be written;
+    one of the command's ``inputs`` (it would be overwritten); for a figure
+    (``flag`` ``--plot``/``--plots``), an extension matplotlib cannot write.
+    """
     p = Path(value)
-    if p.exists() and p.is_dir():
+    if p.is_dir():
         raise InputError("is a folder, expected a file name", file=p, field=flag)
+    for q in inputs:
+        if q is not None and Path(q).exists() and p.exists() and p.resolve() == Path(q).resolve():
+            raise InputError("is one of this command's inputs: choose another output file", file=p, field=flag)
+    parent = p.parent
+    while not parent.exists():  # the first existing ancestor must be a writable folder
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InputError(f"cannot write under {parent}: it is a file, not a folder", file=p, field=flag)
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InputError(f"folder {parent} is not writable", file=p, field=flag)
+    if flag in ("--plot", "--plots"):
+        check_figure_suffix(p, flag)
     return p
+
+
+def check_number(value, flag: str, *, minimum: float | None = None, above: float | None = None,
+                 unit: str = "") -> float:
+    """A numeric command-line value that must be finite and ≥ ``minimum`` (or > ``above``).
+
+    Python's ``float`` accepts ``nan`` and ``inf``; they would reach the numerics
+    (a NaN noise level writes a campaign of NaNs), so every numeric option is judged here.
+    """
+    v = float(value)
+    bound = ""
+    if minimum is not None:
+        bound = f" ≥ {minimum:g}"
+    elif above is not None:
+        bound = f" > {above:g}"
+    ok = math.isfinite(v) and (minimum is None or v >= minimum) and (above is None or v > above)
+    if not ok:
+        raise InputError(f"must be a finite number{bound}{(' ' + unit) if unit else ''}, got {value!r}",
+                         file="command line", field=flag)
+    return v
+
+
+def check_figure_suffix(path: Path, flag: str) -> None:
+    """Refuse a figure path whose extension matplotlib cannot write (before any work)."""
+    from matplotlib.figure import Figure
+
+    formats = Figure().canvas.get_supported_filetypes()
+    fmt = path.suffix.lstrip(".").lower()
+    if fmt not in formats:
+        raise InputError(f"cannot write a figure as {fmt or 'a file without extension'!r} "
+                         f"(use one of {', '.join(sorted(formats))})", file=path, field=flag)
 
 
 def save_figure(fig, path: Path) -> None:

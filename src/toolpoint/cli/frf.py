@@ -12,9 +12,11 @@ from .common import out_path, save_figure, use_agg, warnings_to_stderr
 
 
 def register(sub) -> None:
+    """Add the ``frf`` sub-command to the argparse sub-parsers ``sub``."""
     p = sub.add_parser("frf", help="tool-point (or holder-tip) receptance of an assembly by RCSA")
     p.add_argument("assembly", help="assembly TOML file")
-    p.add_argument("--out", required=True, help="FRF file to write, receptance m/N: .csv (freq_hz,real,imag), .uff or .frf")
+    p.add_argument("--out", required=True,
+                   help="FRF file to write, receptance m/N: .csv (freq_hz,real,imag), .uff or .frf")
     p.add_argument("--plot", help="PNG/PDF/SVG file with magnitude and phase")
     p.add_argument(
         "--point",
@@ -26,6 +28,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    """Compute the receptance FRF of ``args.assembly``, write ``--out`` (and ``--plot``); returns exit code 0.
+
+    Bad input raises :class:`~toolpoint.errors.InputError` before anything is written
+    (the CLI turns it into one line and exit code 2).
+    """
     out = out_path(args.out, "--out")
     if out.suffix.lower() not in (".csv", ".uff", ".unv", ".uf", ".frf"):
         raise InputError("use .csv, .uff/.unv or .frf (the format follows the extension)", file=out, field="--out")

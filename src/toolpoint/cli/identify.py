@@ -1,4 +1,11 @@
-"""``toolpoint identify ASSEMBLY.toml MEASURED --method … [--seed N] [--out RESULT.json] [--plot FIT.png]``."""
+"""``toolpoint identify ASSEMBLY.toml MEASURED… --method … [--seed N] [--out RESULT.json] [--plot FIT.png]``.
+
+Without ``--joint``/``--params`` (and no ``joint``/``params`` in the file's ``[identify]``): the holder–tool
+joint from a tool-point FRF. ``--joint spindle_holder`` (or any element): that element's four parameters,
+by default from the holder-tip FRF of the spindle–holder subassembly (no tool). ``--params a.kt,bearings[0].k``
+with one ``--at POINT`` per MEASURED file: any parameters from several FRFs
+(:mod:`toolpoint.identification.problem`).
+"""
 
 from __future__ import annotations
 
@@ -12,20 +19,30 @@ import numpy as np
 from .. import __version__
 from ..dynamics.assembly import load_assembly
 from ..io.atomic import atomic_open
-from ..errors import InputError
+from ..errors import IdentifiabilityWarning, InputError
 from ..io.frf_files import read_frf
 from ..identification.identify import identify, make_algorithm, model_for
 from ..identification.params import PARAMS, UNITS, Bounds
-from ..identification.optim import METHODS
+from ..identification.optim import METHODS, check_method
 from .common import out_path, save_figure, use_agg, warnings_to_stderr
 
 MIN_POINTS = 10
 
 
 def register(sub) -> None:
+    """Add the ``identify`` subcommand to the argparse subparsers ``sub``."""
     p = sub.add_parser("identify", help="identify the holder–tool joint from a measured tool-point FRF")
     p.add_argument("assembly", help="assembly TOML (spindle, holder, tool, spindle–holder joint)")
-    p.add_argument("measured", help="measured tool-point receptance: .csv (freq_hz,real,imag), .uff/.unv or .frf")
+    p.add_argument("measured", nargs="+",
+                   help="measured receptance(s): .csv (freq_hz,real,imag), .uff/.unv or .frf (several with --at)")
+    p.add_argument("--joint", help="identify this element's four parameters (spindle_holder, holder_tool, "
+                   "bearings[i]); default point: holder_tip of the spindle–holder subassembly for spindle_holder")
+    p.add_argument("--params", help="comma-separated parameters, e.g. spindle_holder.kt,bearings[0].k")
+    p.add_argument("--at", action="append", default=[], metavar="POINT",
+                   help="point of each MEASURED file, in order: tool_tip, holder_tip, spindle_nose, "
+                   "tool:x_mm=40, or RESPONSE,FORCE for a cross FRF")
+    p.add_argument("--weight", action="append", type=float, default=[], help="weight of each MEASURED file")
+    p.add_argument("--no-tool", action="store_true", help="model the spindle–holder subassembly (no tool)")
     p.add_argument("--method", default="hybrid", help=f"one of {', '.join(METHODS)} (default hybrid)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--out", help="result JSON file")
@@ -40,6 +57,7 @@ def register(sub) -> None:
 
 
 def parse_bounds(items: list[str]) -> dict:
+    """``["kt=1e6:1e9", …]`` → ``{"kt": [1e6, 1e9], …}`` (SI); a malformed item is an InputError."""
     out = {}
     for it in items:
         name, _, rng = it.partition("=")
@@ -66,9 +84,17 @@ def load_problem_inputs(args):
 
 
 def run(args) -> int:
-    if args.method not in METHODS:
-        raise InputError(f"unknown method {args.method!r} (one of {', '.join(METHODS)})", file="command line",
-                         field="--method")
+    """Run ``toolpoint identify``; returns the exit code (0)."""
+    check_method(args.method)
+    if general_requested(args):
+        return run_general(args)
+    if len(args.measured) != 1:
+        raise InputError(f"{len(args.measured)} measured files: several need --params (or --joint) and --at",
+                         file="command line", field="measured")
+    if args.at or args.weight or args.no_tool:
+        raise InputError("--at, --weight and --no-tool need --params or --joint", file="command line",
+                         field="--at")
+    args.measured = args.measured[0]
     out = out_path(args.out, "--out") if args.out else None
     plot = out_path(args.plot, "--plot") if args.plot else None
     with warnings_to_stderr():
@@ -104,23 +130,30 @@ def run(args) -> int:
 
 
 def _run_with_progress(model, meas, method, seed, bounds, algo):
+    """identify() with a progress bar on stderr; its IdentifiabilityWarnings are not shown here, because
+    the caller prints each of ``result.warnings`` once."""
     from tqdm import tqdm
 
-    total = algo.termination().max_iter
+    total = algo.termination().maxiter
     with tqdm(total=total, desc=f"identify ({method})", unit="it", disable=None, leave=False, file=sys.stderr) as bar:
         def cb(it, best, nfev):
             bar.update(1)
             bar.set_postfix_str(f"best {best:.3e} m/N, {nfev} evals", refresh=False)
 
-        return identify(model, meas, method, seed, bounds, callback=cb)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", IdentifiabilityWarning)
+            return identify(model, meas, method, seed, bounds, callback=cb)
 
 
-def result_document(res, method, seed, **extra) -> dict:
-    """The RESULT.json content (SI units)."""
-    doc = {k: res.params[k] for k in PARAMS}
+def result_document(res, method, seed, *, names=PARAMS, units=None, key=None, **extra) -> dict:
+    """The RESULT.json content (SI units): value, unit, 95 % interval and bounds of each of ``names``
+    (written under ``key(name)``), then how the optimiser ran and stopped."""
+    key = key or (lambda n: n)
+    units = UNITS if units is None else units
+    doc = {key(n): res.params[n] for n in names}
     doc.update(
-        units=UNITS,
-        ci95=res.ci95,
+        units={key(n): units[n] for n in names},
+        ci95={key(n): res.ci95[n] for n in names},
         method=method,
         seed=seed,
         evaluations=int(res.nfev),
@@ -128,20 +161,174 @@ def result_document(res, method, seed, **extra) -> dict:
         seconds=float(res.seconds),
         objective=float(res.fun),
         objective_units="m/N",
+        success=bool(res.success),
+        status=int(res.status),
         message=res.message,
         warnings=list(res.warnings),
-        bounds=res.bounds,
+        bounds={key(n): res.bounds[n] for n in names},
         toolpoint=__version__,
         **extra,
     )
     return doc
 
 
-def _report(res, args) -> None:
+def _report(res, args, names=PARAMS, units=UNITS) -> None:
+    """Print the identified parameters (stdout) and each identifiability warning once (stderr)."""
     print(f"method {args.method}, seed {args.seed}: objective {res.fun:.4g} m/N, {res.nfev} evaluations, "
           f"{res.seconds:.2f} s — {res.message}")
-    for k in PARAMS:
+    for k in names:
         lo, hi = res.ci95[k]
-        print(f"  {k} = {res.params[k]:.6g} {UNITS[k]:9s}  95 % CI [{lo:.4g}, {hi:.4g}]")
+        print(f"  {k} = {res.params[k]:.6g} {units[k]:9s}  95 % CI [{lo:.4g}, {hi:.4g}]")
     for w in res.warnings:
         print(f"warning: {w}", file=sys.stderr)
+
+
+# --------------------------------------------------------------------------- general form
+_GENERAL_KEYS = {"joint", "params", "at", "weights", "start"}
+
+
+def _file_identify(path: str) -> dict:
+    """The ``[identify]`` table of an assembly file, or {} (unreadable files fail later, with their own error)."""
+    from ..io.toml import load_toml
+
+    t = load_toml(path).get("identify", {})
+    if not isinstance(t, dict):
+        raise InputError("must be a table", file=path, field="identify")
+    return t
+
+
+def general_requested(args) -> bool:
+    """True when ``--joint``/``--params`` or the file's ``[identify]`` asks for the general form."""
+    if args.joint or args.params:
+        return True
+    return bool(_GENERAL_KEYS & set(_file_identify(args.assembly)))
+
+
+def _general_setup(args):
+    """Assembly, parameter names, measurements, bounds, start, with_tool, joint (or None), all validated."""
+    from ..dynamics.assembly import load_assembly as _load
+    from ..dynamics.points import parse_at
+    from ..identification.problem import Measured, joint_names, param_bounds, parse_params
+
+    src = args.assembly
+    t = _file_identify(src)
+    r_unknown = set(t) - (_GENERAL_KEYS | {"bounds", "method"})
+    if r_unknown:
+        raise InputError(f"unknown key {sorted(r_unknown)[0]!r}", file=src, field="identify")
+    assembly = _load(src, require_tool=False, require_spindle_holder=False)
+    joint = args.joint or (t.get("joint") if not args.params else None)
+    where = ("command line", "--joint") if args.joint else (src, "identify.joint")
+    if joint is not None:
+        if args.params:
+            raise InputError("give --joint or --params, not both", file="command line", field="--params")
+        if joint not in ("spindle_holder", "holder_tool") and not str(joint).startswith("bearings["):
+            raise InputError(f"unknown joint {joint!r} (spindle_holder, holder_tool or bearings[i])",
+                             file=where[0], field=where[1])
+        names = joint_names(joint)
+    elif args.params:
+        names = [n for n in args.params.split(",") if n.strip()]
+        where = ("command line", "--params")
+    else:
+        names = t.get("params")
+        where = (src, "identify.params")
+        if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+            raise InputError('must be a list of names like ["spindle_holder.kt"]', file=src, field="identify.params")
+    params = parse_params(names, assembly, file=where[0], field=where[1])
+    at = args.at or t.get("at") or []
+    at_where = ("command line", "--at") if args.at else (src, "identify.at")
+    if isinstance(at, str):
+        at = [at]
+    if not at and joint == "spindle_holder":
+        at = ["holder_tip"] * len(args.measured)
+    if not at and joint == "holder_tool":
+        at = ["tool_tip"] * len(args.measured)
+    if len(at) != len(args.measured):
+        raise InputError(f"{len(at)} points for {len(args.measured)} measured files: give one --at per file",
+                         file=at_where[0], field=at_where[1])
+    weights = args.weight or t.get("weights") or [1.0] * len(args.measured)
+    if len(weights) != len(args.measured) or not all(isinstance(w, (int, float)) and w >= 0 for w in weights):
+        raise InputError(f"need one weight ≥ 0 per measured file, got {weights!r}", file="command line",
+                         field="--weight")
+    pts = [parse_at(a, file=at_where[0], field=at_where[1]) for a in at]
+    with_tool = False if (args.no_tool or joint == "spindle_holder" or assembly.tool is None) else None
+    on_tool = [p.text for pair in pts for p in pair if p.component == "tool"]
+    if on_tool and with_tool is False:
+        raise InputError(f"point {on_tool[0]!r}: the spindle–holder subassembly (no tool) has no tool",
+                         file=at_where[0], field=at_where[1])
+    tb = t.get("bounds", {})
+    if not isinstance(tb, dict):
+        raise InputError("must be a table like {kt = [1e6, 1e9]}", file=src, field="identify.bounds")
+    bounds = param_bounds(params, tb, file=src, field="identify.bounds")
+    cli = parse_bounds(args.bounds)
+    if cli:
+        over = {**dict(zip([p[2] for p in params], zip(bounds.lo, bounds.hi))), **cli}
+        bounds = param_bounds(params, over, file="command line", field="--bounds")
+    start = t.get("start", {})
+    if not isinstance(start, dict):
+        raise InputError("must be a table like {\"spindle_holder.kt\" = 5e8}", file=src, field="identify.start")
+    meas = []
+    for path, (resp, force), w in zip(args.measured, pts, weights):
+        frf = read_frf(path, quantity=args.quantity, min_points=MIN_POINTS)
+        if frf.freq_hz[0] == 0:
+            warnings.warn(f"{path}: the 0 Hz point is not used (free–free components are singular there)")
+            frf = frf.band(fmin=np.nextafter(0.0, 1.0))
+        frf = frf.band(args.fmin, args.fmax)
+        if len(frf) < MIN_POINTS:
+            raise InputError(f"only {len(frf)} points in the fitted band, need at least {MIN_POINTS}", file=path,
+                             field="freq_hz")
+        meas.append(Measured(frf.to_receptance(), resp, force, float(w), path))
+    return assembly, [p[2] for p in params], meas, bounds, start, with_tool, joint, at
+
+
+def run_general(args) -> int:
+    """``toolpoint identify`` in its general form (``--joint``/``--params``); returns the exit code (0)."""
+    from ..identification.problem import FRFProblem, identify_frfs
+
+    out = out_path(args.out, "--out") if args.out else None
+    plot = out_path(args.plot, "--plot") if args.plot else None
+    with warnings_to_stderr():
+        assembly, names, meas, bounds, start, with_tool, joint, at = _general_setup(args)
+        try:
+            problem = FRFProblem(assembly, names, meas, bounds, start=start, with_tool=with_tool)
+        except InputError as e:
+            if e.field == "at" and e.file == assembly.source:  # the point belongs to the command line / [identify]
+                raise InputError(e.message, file="command line" if args.at else assembly.source,
+                                 field="--at" if args.at else "identify.at") from None
+            raise
+        algo = make_algorithm(args.method)
+        from tqdm import tqdm
+
+        with tqdm(total=algo.termination().maxiter, desc=f"identify ({args.method})", unit="it", disable=None,
+                  leave=False, file=sys.stderr) as bar:
+            def cb(it, best, nfev):
+                bar.update(1)
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", IdentifiabilityWarning)
+                res = identify_frfs(problem, args.method, args.seed, callback=cb)
+    short = joint is not None
+    key = (lambda n: n.split(".")[-1]) if short else (lambda n: n)
+    _report(res, args, names, problem.units)
+    doc = result_document(
+        res, args.method, args.seed, names=names, units=problem.units, key=key,
+        assembly=args.assembly,
+        measured=[{"file": m.source, "at": a, "weight": m.weight} for m, a in zip(meas, at)],
+        correlation={"names": [key(n) for n in names], "matrix": np.nan_to_num(res.correlation).tolist()},
+    )
+    if joint is not None:
+        doc["joint"] = joint
+    else:
+        doc["params"] = list(names)
+    fig = None
+    if plot:
+        use_agg()
+        from ..identification.figures import fit_figure
+
+        fig = fit_figure(meas[0].frf, {f"identified ({args.method})": res.model_frfs[0]}, {args.method: res.history},
+                         title=f"{Path(meas[0].source).name}: identified {joint or ', '.join(names)}")
+    if out:
+        with atomic_open(out) as fh:
+            json.dump(doc, fh, indent=2)
+    if fig is not None:
+        save_figure(fig, plot)
+    return 0

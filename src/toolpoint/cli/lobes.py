@@ -1,14 +1,27 @@
-"""``toolpoint lobes FRF [--frf-y FRF_Y] --teeth N --kt KT --kr KR --immersion A --rpm LO:HI --out LOBES.csv``.
+"""``toolpoint lobes FRF [--frf-y FRF_Y] --teeth N --tangential-coeff KT --radial-ratio KR --immersion A
+--rpm LO:HI --out LOBES.csv``.
 
 Stability lobes of a milling cut from tool-point receptances: zero-order
-approximation (default) or semi-discretisation of modal-fitted FRFs.
+approximation (default) or semi-discretisation of modal-fitted FRFs
+(``--method sdm``: real modes per direction, or with ``--frf-xy``/``--frf-yx``
+a common-pole fit per force direction realised as a 2×2 state-space model;
+``--accuracy`` scales its resolution; progress on stderr). An FRF with no
+resonance in its band (noise, all zero, the mode outside the band) is refused
+for the SDM.
+
+``--tangential-coeff`` is the cutting coefficient K_t in N/m² and
+``--radial-ratio`` the force ratio K_r = K_n/K_t (not the joint stiffnesses
+kt, kr of ``identify``); the old ``--kt``/``--kr`` still work for one release
+and print a deprecation line on stderr.
 
 Outputs (written only when everything succeeded, all or none):
 
-* ``--out``: header ``rpm,depth_mm,chatter_hz`` — the stability limit (minimum
-  over lobes) at each speed in mm, and the chatter frequency (Hz) of the
-  limiting lobe. ``inf`` means no chatter found at that speed (no lobe covers
-  it with the FRF band given, or stable up to the SDM's search depth).
+* ``--out``: header ``rpm,depth_mm,chatter_hz,lobe`` — the stability limit
+  (minimum over lobes) at each speed in mm, the chatter frequency (Hz) and
+  the lobe number k (whole chatter waves per tooth period) of the limiting
+  lobe. ``inf`` (with chatter ``nan``, lobe −1) means no chatter found at
+  that speed (no lobe covers it with the FRF band given, or stable up to the
+  SDM's search depth).
 * ``--lobes-out``: header ``lobe,rpm,depth_mm,chatter_hz,branch`` — every lobe
   point in the range; ``lobe`` is k (whole chatter waves per tooth period),
   ``branch`` the eigenvalue branch (0/1) that two curves with the same k
@@ -19,17 +32,24 @@ Outputs (written only when everything succeeded, all or none):
 from __future__ import annotations
 
 import contextlib
+import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_open, atomic_path
 from ..errors import InputError
+from ..io.atomic import atomic_open, atomic_path
+from ..stability.milling import MAX_RPM_POINTS
 from .common import out_path, use_agg, warnings_to_stderr
+
+# Deprecated flag → (new flag, what it is), for one release.
+_RENAMED = {"--kt": ("--tangential-coeff", "cutting coefficient, N/m²"),
+            "--kr": ("--radial-ratio", "force ratio Kn/Kt, dimensionless")}
 
 
 def register(sub) -> None:
+    """Add the ``lobes`` sub-command to the CLI's sub-parsers."""
     p = sub.add_parser(
         "lobes",
         help="chatter stability lobes from tool-point FRFs (zero-order or semi-discretisation)",
@@ -39,19 +59,27 @@ def register(sub) -> None:
     # Numbers are parsed in run() so bad values give one error line, not argparse's usage block.
     p.add_argument("frf", help="x (feed) receptance: FRF file (.csv/.uff/.unv/.frf) or assembly .toml")
     p.add_argument("--frf-y", help="y receptance (default: the same as x, symmetric tool)")
+    p.add_argument("--frf-xy", help="cross receptance x/Fy (default 0)")
+    p.add_argument("--frf-yx", help="cross receptance y/Fx (default 0)")
     p.add_argument("--teeth", required=True, help="number of teeth N (integer ≥ 1)")
-    p.add_argument("--kt", required=True, help="tangential cutting coefficient Kt, N/m² (e.g. 6e8)")
-    p.add_argument("--kr", required=True, help="radial ratio Kr = Kn/Kt (≥ 0)")
+    p.add_argument("--tangential-coeff", help="tangential cutting coefficient Kt, N/m² (e.g. 6e8 = 600 N/mm²)")
+    p.add_argument("--radial-ratio", help="radial force ratio Kr = Kn/Kt, dimensionless (≥ 0)")
+    p.add_argument("--kt", help="deprecated: use --tangential-coeff")
+    p.add_argument("--kr", help="deprecated: use --radial-ratio")
     p.add_argument("--immersion", required=True, help="radial immersion a_e/D in (0, 1] (1 = slotting)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--down", dest="milling", action="store_const", const="down", help="down-milling (default)")
     g.add_argument("--up", dest="milling", action="store_const", const="up", help="up-milling")
     p.set_defaults(milling="down")
     p.add_argument("--rpm", required=True, help="spindle speed range LO:HI in rpm, e.g. 2000:20000")
-    p.add_argument("--rpm-points", default="1000", help="number of speeds in the range (default 1000)")
+    p.add_argument("--rpm-points", default="1000",
+                   help=f"number of speeds in the range (default 1000, at most {MAX_RPM_POINTS})")
     p.add_argument("--method", default="zoa", help="zoa (zero-order, default) or sdm (semi-discretisation)")
     p.add_argument("--modes", help="sdm: modes to fit per direction (default: chosen by the fit)")
-    p.add_argument("--out", required=True, help="CSV of the limit: rpm,depth_mm,chatter_hz")
+    p.add_argument("--accuracy", default="1",
+                   help="sdm: resolution factor 0.25–16 (default 1: within ≈ 1 %% of the converged limit); "
+                   "time grows with it: 0.5 → ≈ 0.5×, 2 → ≈ 2.5× the CPU time of 1 (4 modes per direction)")
+    p.add_argument("--out", required=True, help="CSV of the limit: rpm,depth_mm,chatter_hz,lobe")
     p.add_argument("--lobes-out", help="CSV of every lobe: lobe,rpm,depth_mm,chatter_hz,branch")
     p.add_argument("--plot", help="chart file (.png, .pdf, .svg, …)")
     p.set_defaults(func=run)
@@ -59,6 +87,7 @@ def register(sub) -> None:
 
 # ----------------------------------------------------------------- parsing
 def _number(text: str, flag: str, kind=float):
+    """``text`` as a finite float (or int), else an InputError naming ``flag``."""
     try:
         v = kind(text)
     except (TypeError, ValueError):
@@ -69,6 +98,7 @@ def _number(text: str, flag: str, kind=float):
 
 
 def _rpm_range(text: str) -> tuple[float, float]:
+    """``LO:HI`` as two speeds in rpm, 0 < LO < HI."""
     parts = text.split(":")
     if len(parts) != 2:
         raise InputError(f"expected LO:HI (e.g. 2000:20000), got {text!r}", field="--rpm")
@@ -102,23 +132,40 @@ def _load(path: str, flag: str, freq_hz=None):
 
 
 # ----------------------------------------------------------------- command
-def run(args) -> int:
+def _cutting(args):
+    """The cutting conditions from the flags, errors naming the flag given; and the deprecated flags used."""
+    from ..stability import CuttingConditions
+
+    used, values = [], {}
+    for old, (new, _) in _RENAMED.items():
+        given_old, given_new = getattr(args, old[2:]), getattr(args, new[2:].replace("-", "_"))
+        if given_old is not None and given_new is not None:
+            raise InputError(f"give {new} only ({old} is its deprecated name)", field=old)
+        if given_old is None and given_new is None:
+            raise InputError(f"required ({_RENAMED[old][1]})", field=new)
+        flag = old if given_old is not None else new
+        if given_old is not None:
+            used.append(old)
+        values[old] = (_number(given_old if given_old is not None else given_new, flag), flag)
     teeth = _number(args.teeth, "--teeth", int)
-    if teeth < 1:
-        raise InputError(f"must be ≥ 1, got {teeth}", field="--teeth")
-    kt = _number(args.kt, "--kt")
-    if kt <= 0:
-        raise InputError(f"must be > 0 N/m², got {args.kt}", field="--kt")
-    kr = _number(args.kr, "--kr")
-    if kr < 0:
-        raise InputError(f"must be ≥ 0, got {args.kr}", field="--kr")
     immersion = _number(args.immersion, "--immersion")
-    if not 0 < immersion <= 1:
-        raise InputError(f"radial immersion a_e/D must be in (0, 1], got {args.immersion}", field="--immersion")
+    flags = {"teeth": "--teeth", "tangential_coeff": values["--kt"][1], "radial_ratio": values["--kr"][1],
+             "radial_immersion": "--immersion", "milling": "--down/--up"}
+    try:
+        cut = CuttingConditions(teeth=teeth, tangential_coeff=values["--kt"][0], radial_ratio=values["--kr"][0],
+                                radial_immersion=immersion, milling=args.milling)
+    except InputError as err:
+        raise InputError(err.message, field=flags.get(err.field, err.field)) from None
+    return cut, used
+
+
+def run(args) -> int:
+    """Run ``toolpoint lobes``; returns the exit code (InputErrors are left to the caller: exit 2)."""
+    cut, deprecated = _cutting(args)
     lo, hi = _rpm_range(args.rpm)
     npts = _number(args.rpm_points, "--rpm-points", int)
-    if npts < 2:
-        raise InputError(f"must be ≥ 2, got {npts}", field="--rpm-points")
+    if not 2 <= npts <= MAX_RPM_POINTS:
+        raise InputError(f"must be from 2 to {MAX_RPM_POINTS}, got {npts}", field="--rpm-points")
     method = args.method.strip().lower()
     if method not in ("zoa", "sdm"):
         raise InputError(f"must be 'zoa' or 'sdm', got {args.method!r}", field="--method")
@@ -127,26 +174,43 @@ def run(args) -> int:
         n_modes = _number(args.modes, "--modes", int)
         if n_modes < 1:
             raise InputError(f"must be ≥ 1, got {n_modes}", field="--modes")
+    accuracy = _number(args.accuracy, "--accuracy")
+    if not 0.25 <= accuracy <= 16:
+        raise InputError(f"must be from 0.25 to 16, got {args.accuracy}", field="--accuracy")
 
     outs = _outputs(args)
+    frf_x = _load(args.frf, "FRF")
+    frfs = {}
+    for flag in ("--frf-y", "--frf-xy", "--frf-yx"):
+        path = getattr(args, flag[2:].replace("-", "_"))
+        frfs[flag] = None if path is None else _load(path, flag, freq_hz=frf_x.freq_hz)
+    for old in deprecated:  # only once the input is known good: bad input gives one line
+        new, what = _RENAMED[old]
+        print(f"warning: {old} is deprecated, use {new} ({what})", file=sys.stderr)
     with warnings_to_stderr():
-        frf_x = _load(args.frf, "FRF")
-        frf_y = None
-        if args.frf_y is not None:
-            frf_y = _load(args.frf_y, "--frf-y", freq_hz=frf_x.freq_hz)
         rpm = np.linspace(lo, hi, npts)
-        cut = dict(teeth=teeth, kt=kt, kr=kr, radial_immersion=immersion, milling=args.milling, rpm=rpm)
-        if kt < 1e6:
-            warnings.warn(f"--kt {kt:g} N/m² is very small (typical 1e8–3e9 N/m²): was it given in N/mm²?")
+        if cut.tangential_coeff < 1e6:
+            warnings.warn(f"Kt {cut.tangential_coeff:g} N/m² is very small (typical 1e8–3e9 N/m²): "
+                          "was it given in N/mm²?")
         if method == "zoa":
             from ..stability import zoa_lobes
 
-            if n_modes is not None:
-                warnings.warn("--modes is used by --method sdm only; ignored")
-
-            res = zoa_lobes(frf_x, frf_y, **cut)
+            for flag, given in (("--modes", n_modes is not None), ("--accuracy", args.accuracy != "1")):
+                if given:
+                    warnings.warn(f"{flag} is used by --method sdm only; ignored")
+            try:
+                res = zoa_lobes(frf_x, frfs["--frf-y"], cut, rpm=rpm, frf_xy=frfs["--frf-xy"],
+                                frf_yx=frfs["--frf-yx"])
+            except InputError as err:  # name the file the FRF came from
+                flag = {"frf_x": "FRF", "frf_y": "--frf-y", "frf_xy": "--frf-xy", "frf_yx": "--frf-yx"}
+                path = {"FRF": args.frf, "--frf-y": args.frf_y, "--frf-xy": args.frf_xy, "--frf-yx": args.frf_yx}
+                f = flag.get(err.field)
+                if f is None:
+                    raise
+                raise InputError(err.message, file=path[f], field=f) from None
         else:
-            res = _sdm(frf_x, frf_y, n_modes, cut)
+            paths = {"FRF": args.frf, "--frf-y": args.frf_y, "--frf-xy": args.frf_xy, "--frf-yx": args.frf_yx}
+            res = _sdm(dict(frfs, FRF=frf_x), paths, n_modes, cut, rpm, accuracy)
     fig = _figure(res) if outs["plot"] else None
     _write(outs, res, fig)
     _summary(res, outs)
@@ -154,6 +218,7 @@ def run(args) -> int:
 
 
 def _outputs(args) -> dict:
+    """The output paths, checked before any work (distinct, writable, not an input)."""
     outs = {"out": out_path(args.out, "--out"), "lobes": None, "plot": None}
     if args.lobes_out:
         outs["lobes"] = out_path(args.lobes_out, "--lobes-out")
@@ -167,24 +232,105 @@ def _outputs(args) -> dict:
     given = [p.resolve() for p in outs.values() if p is not None]
     if len(set(given)) != len(given):
         raise InputError("--out, --lobes-out and --plot must be different files", field="--out")
-    inputs = {Path(p).resolve() for p in (args.frf, args.frf_y) if p}
+    inputs = {Path(p).resolve() for p in (args.frf, args.frf_y, args.frf_xy, args.frf_yx) if p}
     if inputs & set(given):
         raise InputError("an output would overwrite an input FRF", field="--out")
     return outs
 
 
-def _sdm(frf_x, frf_y, n_modes, cut):
-    from ..stability import fit_modes, sdm_lobes
+# A one-mode fit that leaves this relative RMS error explains < 10 % of the FRF's energy: no resonance.
+_NO_RESONANCE = 0.95
+# A final fit worse than this explains < 75 % of the FRF: lobes from it would describe another structure.
+_BAD_FIT = 0.5
 
-    mx = fit_modes(frf_x, n_modes)
-    print(f"modal fit, x ({frf_x.label or 'FRF'}):\n{mx.table()}")
-    if frf_y is None:
-        my = mx
-        print("y: same modes as x (symmetric tool)")
+
+def _fit_one(frf, flag, path, n_modes):
+    """Real modes of one direct receptance (``stability.fit_modes``), refused when there is nothing to fit.
+
+    A one-mode probe first: noise has no resonance, and the automatic search
+    for more modes would spend seconds fitting noise before failing.
+    """
+    from ..stability import fit_modes
+
+    try:
+        if n_modes is None:
+            probe = fit_modes(frf, 1)
+            if probe.fit_error >= _NO_RESONANCE:
+                raise InputError(f"no resonance found for --method sdm: the best one-mode fit leaves "
+                                 f"{100 * probe.fit_error:.0f} % (relative RMS) unexplained (noise only?)")
+        fit = fit_modes(frf, n_modes)
+    except InputError as err:
+        msg = err.message
+        if "no mode with a non-zero residue" in msg:
+            msg = "no resonance found for --method sdm (modal fit: no mode with a non-zero residue; noise only?)"
+        raise InputError(msg, file=path, field=flag) from None
+    lo, hi = frf.freq_hz[frf.freq_hz > 0][[0, -1]]
+    inside = (fit.fn_hz > lo * (1 + 1e-6)) & (fit.fn_hz < hi * (1 - 1e-6))
+    if not inside.any():
+        raise InputError(f"no mode inside the FRF's band {lo:g}–{hi:g} Hz for --method sdm (the fitted mode "
+                         "sits on the band edge: the resonance lies outside the measured band)", file=path, field=flag)
+    _check_fit(fit.fit_error, flag, path)
+    return fit
+
+
+def _check_fit(error, flag, path):
+    """Refuse a modal fit that does not describe the FRF (relative RMS error above ``_BAD_FIT``)."""
+    if np.max(error) > _BAD_FIT:
+        raise InputError(f"the modal fit leaves {100 * np.max(error):.0f} % (relative RMS) of the FRF unexplained; "
+                         "the semi-discretisation needs a modal model (try --modes, or --method zoa)",
+                         file=path, field=flag)
+
+
+def _cross_model(frfs, paths, n_modes):
+    """A 2×2 state-space model from common-pole fits of each force's column (missing cross FRFs are 0).
+
+    Force x: Φ_xx and Φ_yx share poles; force y: Φ_yy (Φ_xx if not given) and Φ_xy.
+    """
+    from ..dynamics.modal import fit_frfs
+    from ..stability.statespace import from_modal_fit
+
+    fits = []
+    for direct, cross in (("FRF", "--frf-yx"), ("--frf-y" if frfs["--frf-y"] is not None else "FRF", "--frf-xy")):
+        flags = [direct] + ([cross] if frfs[cross] is not None else [])
+        try:
+            fit = fit_frfs([frfs[f] for f in flags], n_modes=n_modes)
+        except InputError as err:
+            raise InputError(f"common-pole fit of {' and '.join(flags)}: {err.message}", file=paths[flags[-1]],
+                             field=flags[-1]) from None
+        print(f"common-pole fit, force {'xy'[len(fits)]} ({', '.join(flags)}):\n{fit.table()}")
+        if fit.n_modes == 0:
+            raise InputError(f"no mode inside the FRF's band {fit.band_hz[0]:g}–{fit.band_hz[1]:g} Hz for "
+                             "--method sdm", file=paths[direct], field=direct)
+        _check_fit(fit.fit_error, direct, paths[direct])
+        fits.append(fit)
+    return from_modal_fit(fits[0], fits[1])
+
+
+def _sdm(frfs, paths, n_modes, cut, rpm, accuracy):
+    """Fit modes to the FRFs (printing them) and run the semi-discretisation, reporting progress on stderr.
+
+    Without cross FRFs: real modes per direction (``stability.fit_modes``);
+    with ``--frf-xy``/``--frf-yx``: a common-pole fit per force direction and
+    its state-space realisation (``stability.statespace.from_modal_fit``).
+    """
+    from ..progress import Progress
+    from ..stability import sdm_lobes
+
+    if frfs["--frf-xy"] is not None or frfs["--frf-yx"] is not None:
+        model, my = _cross_model(frfs, paths, n_modes), None
     else:
-        my = fit_modes(frf_y, n_modes)
-        print(f"modal fit, y ({frf_y.label or 'FRF_Y'}):\n{my.table()}")
-    res = sdm_lobes(mx, my, **cut)
+        frf_x, frf_y = frfs["FRF"], frfs["--frf-y"]
+        model = _fit_one(frf_x, "FRF", paths["FRF"], n_modes)
+        print(f"modal fit, x ({frf_x.label or 'FRF'}):\n{model.table()}")
+        if frf_y is None:
+            my = model
+            print("y: same modes as x (symmetric tool)")
+        else:
+            my = _fit_one(frf_y, "--frf-y", paths["--frf-y"], n_modes)
+            print(f"modal fit, y ({frf_y.label or 'FRF_Y'}):\n{my.table()}")
+    with Progress(rpm.size, "semi-discretisation", "speed") as bar:
+        res = sdm_lobes(model, my, cut, rpm=rpm, accuracy=accuracy,
+                        progress=lambda done, total: bar.update(done - bar.n))
     ms = np.unique(res.params["m"])
     print(f"semi-discretisation: {ms.min()}–{ms.max()} steps over the cut" if ms.size > 1 else
           f"semi-discretisation: {ms[0]} steps over the cut")
@@ -192,6 +338,7 @@ def _sdm(frf_x, frf_y, n_modes, cut):
 
 
 def _figure(res):
+    """The stability chart as a matplotlib Figure (not pyplot: no global state)."""
     use_agg()
     from matplotlib.figure import Figure
 
@@ -200,7 +347,8 @@ def _figure(res):
     res.plot(ax=ax)
     p = res.params
     ax.set_title(
-        f"{res.method.upper()}: {p['teeth']} teeth, Kt = {p['kt'] / 1e6:g} N/mm², Kr = {p['kr']:g}, "
+        f"{res.method.upper()}: {p['teeth']} teeth, Kt = {p['tangential_coeff'] / 1e6:g} N/mm², "
+        f"Kr = {p['radial_ratio']:g}, "
         f"a_e/D = {p['radial_immersion']:g}, {p['milling']}-milling",
         fontsize="medium",
     )
@@ -211,8 +359,9 @@ def _write(outs, res, fig) -> None:
     """Write every output to a temporary file; rename them all only if all succeeded."""
     with contextlib.ExitStack() as stack:
         fh = stack.enter_context(atomic_open(outs["out"], "w", newline=""))
-        fh.write("rpm,depth_mm,chatter_hz\n")
-        np.savetxt(fh, np.column_stack([res.rpm, res.depth_mm, res.chatter_hz]), fmt="%.10g", delimiter=",")
+        fh.write("rpm,depth_mm,chatter_hz,lobe\n")
+        np.savetxt(fh, np.column_stack([res.rpm, res.depth_mm, res.chatter_hz, res.lobe_number]),
+                   fmt=["%.10g", "%.10g", "%.10g", "%d"], delimiter=",")
         if outs["lobes"]:
             fh = stack.enter_context(atomic_open(outs["lobes"], "w", newline=""))
             fh.write("lobe,rpm,depth_mm,chatter_hz,branch\n")
@@ -226,6 +375,7 @@ def _write(outs, res, fig) -> None:
 
 
 def _summary(res, outs) -> None:
+    """Print the minimum, the best pocket and what was written."""
     if np.isfinite(res.min_depth_m):
         print(f"absolute minimum depth: {1e3 * res.min_depth_m:.4g} mm at {res.min_rpm:.0f} rpm "
               f"(chatter {res.min_chatter_hz:.1f} Hz)")
@@ -234,8 +384,9 @@ def _summary(res, outs) -> None:
     pr, pd = res.pocket()
     if np.isfinite(pd):
         print(f"best stable pocket: {1e3 * pd:.4g} mm at {pr:.0f} rpm")
-    elif np.isinf(pd):
-        print(f"best stable pocket: no limit found at {pr:.0f} rpm (beyond the lobes / search depth)")
+    else:
+        print("best stable pocket: none inside the speed range (the limit has no local maximum strictly inside it; "
+              "widen --rpm)")
     n_inf = int(np.isinf(res.depth_m).sum())
     if n_inf:
         print(f"note: {n_inf} of {res.rpm.size} speeds have no limit found (written as inf)")

@@ -2,38 +2,92 @@
 
 Each sub-command lives in its own module ``toolpoint.cli.<name>`` exposing
 ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
+Only the module of the command being run is imported (the others get a stub
+parser that carries their one-line help), so ``toolpoint --version`` and
+``toolpoint --help`` start without NumPy, SciPy or matplotlib.
+
 Bad input (:class:`toolpoint.errors.InputError`) becomes one line on stderr and
-exit code 2, never a traceback.
+exit code 2, never a traceback; so does a bad command-line value.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 
+from .. import __version__
 from ..errors import InputError
 
-# Order is the order shown in --help.
-COMMANDS = ("frf", "identify", "reproduce", "campaign", "predict", "anfis", "lobes")
+# name → one-line help, in the order shown by --help
+COMMANDS = {
+    "frf": "tool-point (or holder-tip) receptance of an assembly by RCSA",
+    "identify": "identify the holder–tool joint from a measured tool-point FRF",
+    "reproduce": "the paper's numerical case: Table 1 and Fig. 4 with GA, SA, PSO and hybrid",
+    "campaign": "many tools on one spindle–holder: synthesise, identify all, learn ANFIS",
+    "predict": "tool-point FRF of an unmeasured tool from the ANFIS-predicted joint",
+    "anfis": "ANFIS (MATLAB genfis + anfis hybrid learning): train a model on a CSV table, or predict with one",
+    "modal": "common-pole modal fit of one or several FRFs → natural frequencies, damping, modal constants",
+    "lobes": "stability lobe diagram from a tool-point FRF (zero-order or semi-discretisation)",
+    "tap": "impact-test records (time, force, response) → FRF with coherence",
+    "library": "safe spindle speeds and depths for every tool of a tool library, with their uncertainty",
+    "report": "one self-contained HTML page of a library run (sortable overview, per-tool figures)",
+}
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from .. import __version__
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-inf$")
 
-    p = argparse.ArgumentParser(
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one error format: a single line ``toolpoint CMD: error: …`` and exit 2 (no usage block).
+
+    Negative numbers in any notation (``-6e8``, ``-.5``) are taken as values, to be judged by the
+    command, not read as unknown options (argparse's own rule knows only ``-6`` and ``-0.5``).
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {' '.join(str(message).split())} (see --help)\n")
+
+
+def _command_in(argv: list[str]) -> str | None:
+    """The sub-command named on the command line (the first word that is one)."""
+    for word in argv:
+        if word in COMMANDS:
+            return word
+        if not word.startswith("-"):
+            return None
+    return None
+
+
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """The ``toolpoint`` parser; only the command named in ``argv`` is built in full.
+
+    With ``argv=None`` every command is built (for documentation tools).
+    """
+    p = _Parser(
         prog="toolpoint",
         description="Tool-point FRF prediction: receptance coupling, joint identification, ANFIS, stability lobes.",
     )
     p.add_argument("--version", action="version", version=f"toolpoint {__version__}")
-    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in COMMANDS:
-        importlib.import_module(f"{__package__}.{name}").register(sub)
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
+    wanted = COMMANDS if argv is None else {_command_in(argv)}
+    for name, help_text in COMMANDS.items():
+        if name in wanted:
+            importlib.import_module(f"{__package__}.{name}").register(sub)
+        else:
+            sub.add_parser(name, help=help_text)
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    """Run ``toolpoint`` with ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(argv)
     args = parser.parse_args(argv)
     try:
         code = args.func(args)

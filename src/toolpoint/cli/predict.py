@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 
 from ..errors import InputError
@@ -11,6 +12,7 @@ from .common import out_path, save_figure, use_agg, warnings_to_stderr
 
 
 def register(sub) -> None:
+    """Add the ``predict`` command to the ``toolpoint`` sub-parsers."""
     p = sub.add_parser("predict", help="tool-point FRF of an unmeasured tool from the ANFIS-predicted joint")
     p.add_argument("source", help="campaign folder or assembly TOML (spindle, holder, spindle–holder joint)")
     p.add_argument("--diameter", type=float, required=True, help="tool diameter D, mm")
@@ -23,11 +25,12 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    """Predict the joint of a tool (D, L in mm) from the learned models and write its tool-point FRF."""
     from ..campaign.predict import predict_frf
 
     for name in ("diameter", "overhang"):
-        if not getattr(args, name) > 0:
-            raise InputError("must be > 0 (mm)", file="command line", field=f"--{name}")
+        if not (math.isfinite(getattr(args, name)) and getattr(args, name) > 0):
+            raise InputError("must be a finite number > 0 (mm)", file="command line", field=f"--{name}")
     out = out_path(args.out, "--out")
     plot = out_path(args.plot, "--plot") if args.plot else None
     with warnings_to_stderr():

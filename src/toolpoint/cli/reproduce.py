@@ -23,8 +23,8 @@ from ..frf import FRF
 from ..io.frf_files import write_csv_frf
 from ..identification.identify import make_algorithm, model_for, relative_errors
 from ..identification.params import PARAMS, UNITS
-from ..identification.optim import METHODS
-from .common import save_figure, use_agg, warnings_to_stderr
+from ..identification.optim import check_method
+from .common import check_number, save_figure, use_agg, warnings_to_stderr
 from .identify import _run_with_progress, result_document
 
 DEFAULT_ASSEMBLY = Path("examples") / "numerical_case.toml"
@@ -37,6 +37,7 @@ PAPER = {
 
 
 def register(sub) -> None:
+    """Add the ``reproduce`` subcommand to the argparse subparsers ``sub``."""
     p = sub.add_parser("reproduce", help="the paper's numerical case: Table 1 and Fig. 4 with GA, SA, PSO and hybrid")
     p.add_argument("assembly", nargs="?", default=str(DEFAULT_ASSEMBLY),
                    help=f"assembly TOML with the exact [joints.holder_tool] (default {DEFAULT_ASSEMBLY})")
@@ -49,16 +50,17 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    """Run ``toolpoint reproduce``; returns the exit code (0)."""
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise InputError("exists and is not a folder", file=out, field="--out")
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    if not methods:
+        raise InputError("names no method (give e.g. ga,sa,pso,hybrid)", file="command line", field="--methods")
     for m in methods:
-        if m not in METHODS:
-            raise InputError(f"unknown method {m!r} (one of {', '.join(METHODS)})", file="command line",
-                             field="--methods")
-    if args.noise < 0:
-        raise InputError("must be ≥ 0", file="command line", field="--noise")
+        check_method(m, field="--methods")
+    check_number(args.noise, "--noise", minimum=0)
+    check_number(args.seed, "--seed", minimum=0)
     with warnings_to_stderr():
         assembly = load_assembly(args.assembly, require_holder_tool=True)
         exact = assembly.holder_tool.as_array()
@@ -67,7 +69,8 @@ def run(args) -> int:
         h = model.tool_point(exact)
         if args.noise:
             rng = np.random.default_rng(args.seed)
-            h = h + args.noise * np.abs(h).max() * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)) / np.sqrt(2)
+            noise = (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)) / np.sqrt(2)
+            h = h + args.noise * np.abs(h).max() * noise
         measured = FRF(f, h, "receptance", "synthetic measurement (exact joint)")
         out.mkdir(parents=True, exist_ok=True)
         write_csv_frf(out / "measured.csv", measured)
@@ -93,6 +96,7 @@ def run(args) -> int:
 
 
 def _table(results, exact, out: Path) -> None:
+    """Print Table 1 (and each method's warnings once) and write table1.csv and table1_summary.json."""
     rows = []
     print()
     print("Table 1 — holder–tool joint, numerical case (relative error in %; paper's in brackets)")

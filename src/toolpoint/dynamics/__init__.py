@@ -5,5 +5,6 @@ Assembly description (:mod:`.assembly`) → exact Timoshenko segments
 coupling through complex joints (:mod:`.coupling`) → the spindle–holder
 subassembly (:mod:`.subassembly`, or from a blank by :mod:`.inverse_rcsa`) → the
 tool-point FRF (:mod:`.model`). :mod:`.fe` is an independent full-assembly
-finite-element check; :mod:`.polefit` a common-pole modal fit.
+finite-element check; :mod:`.modal` a common-pole modal fit (natural
+frequencies, damping, modal constants; the denoiser of inverse RCSA).
 """

@@ -50,13 +50,25 @@ def cowper_kappa(nu: float, id_over_od: float = 0.0) -> float:
 
 @dataclass(frozen=True)
 class Section:
-    """Cross-section and material of a uniform segment (SI units)."""
+    """Cross-section and material of a uniform segment (SI units).
+
+    Attributes
+    ----------
+    E, G : complex
+        Young's and shear modulus, Pa, complex E(1 + iη) with structural damping.
+    rho : float
+        Density, kg/m³.
+    A, Iz : float
+        Area m² and second moment of area about the bending (z) axis, m⁴.
+    kappa : float
+        Shear coefficient (Cowper).
+    """
 
     E: complex  # Pa, complex with structural damping
     G: complex  # Pa
     rho: float  # kg/m³
     A: float  # m²
-    I: float  # m⁴
+    Iz: float  # m⁴
     kappa: float
 
     @classmethod
@@ -64,16 +76,17 @@ class Section:
         """Hollow (or solid, id 0) circular section."""
         Ec = E * (1 + 1j * loss_factor)
         A = math.pi / 4 * (od_m**2 - id_m**2)
-        I = math.pi / 64 * (od_m**4 - id_m**4)
-        return cls(Ec, Ec / (2 * (1 + nu)), rho, A, I, cowper_kappa(nu, id_m / od_m))
+        Iz = math.pi / 64 * (od_m**4 - id_m**4)
+        return cls(Ec, Ec / (2 * (1 + nu)), rho, A, Iz, cowper_kappa(nu, id_m / od_m))
 
     @property
     def mass_per_length(self) -> float:
+        """ρA, kg/m."""
         return self.rho * self.A
 
     def wavenumber(self, omega) -> np.ndarray:
         """Euler–Bernoulli bending wavenumber β = (ρAω²/EI)^¼, 1/m (a size estimate)."""
-        return (self.rho * self.A * np.asarray(omega, float) ** 2 / abs(self.E * self.I)) ** 0.25
+        return (self.rho * self.A * np.asarray(omega, float) ** 2 / abs(self.E * self.Iz)) ** 0.25
 
 
 def _series(x, odd: bool, terms: int = 10):
@@ -144,9 +157,9 @@ def transfer_matrices(pieces, omega) -> np.ndarray:
     P, F = len(pieces), w.size
     col = lambda v: np.repeat(np.asarray(v), F)  # noqa: E731 — per piece, repeated over frequency
     a = col([1.0 / (s.kappa * s.G * s.A) for s, _ in pieces])
-    b = col([1.0 / (s.E * s.I) for s, _ in pieces])
+    b = col([1.0 / (s.E * s.Iz) for s, _ in pieces])
     m = col([s.rho * s.A for s, _ in pieces]) * np.tile(w**2, P) + 0j
-    j = col([s.rho * s.I for s, _ in pieces]) * np.tile(w**2, P) + 0j
+    j = col([s.rho * s.Iz for s, _ in pieces]) * np.tile(w**2, P) + 0j
     L = col([float(length) for _, length in pieces])
     C0, S0, C1, S1 = _coefficients(a, b, m, j, L)
     T = np.empty((P * F, 4, 4), complex)
@@ -163,7 +176,7 @@ def transfer_matrix(sec: Section, L: float, omega) -> np.ndarray:
 
 
 def mul2(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """Product of two stacks of 2×2 matrices (F, 2, 2), written out: ~3× faster than np.matmul here."""
+    """Product of two stacks of 2×2 matrices (F, 2, 2), written out entry by entry (faster than np.matmul)."""
     a00, a01, a10, a11 = A[:, 0, 0], A[:, 0, 1], A[:, 1, 0], A[:, 1, 1]
     b00, b01, b10, b11 = B[:, 0, 0], B[:, 0, 1], B[:, 1, 0], B[:, 1, 1]
     C = np.empty(np.broadcast_shapes(A.shape, B.shape), np.result_type(A, B))

@@ -4,26 +4,25 @@ Two exact routes to the same receptances, chosen per frequency for round-off:
 
 * **transfer chain** — T = Pₙ Tₙ ⋯ P₁ T₁ P₀ (pieces T, spring point matrices
   P = [[I, 0], [G, I]]); with end loads (F, M) at both ends the end receptance is
-  R = [[T21⁻¹T22, T21⁻¹], [T11T21⁻¹T22 − T12, T11T21⁻¹]]. Every entry keeps its
-  relative precision at low frequency, where a free–free stiffness matrix is
-  nearly singular (its inverse loses (ω₁/ω)⁴·ε in the elastic part), but the
-  product grows like exp(Σ βL), so it is used only while Σ|β|L ≤ ``CHAIN_LIMIT``,
-  and only for free–free components (holder, tool, a suspended spindle);
+  R = [[T21⁻¹T22, T21⁻¹], [T11T21⁻¹T22 − T12, T11T21⁻¹]]. It keeps every entry's
+  relative precision at low frequency, but the product grows like exp(Σ βL), so
+  it is used only while Σ|β|L ≤ ``CHAIN_LIMIT``, and only for free–free
+  components (holder, tool, a suspended spindle);
 * **stiffness sweep** — condensation of the chain's dynamic stiffness onto
   its end nodes, well conditioned at high frequency.
 
 A component (multi-segment beam, optional bearings to ground) is cut into
 pieces at segment ends and bearing positions, and each piece into equal
 sub-pieces so that its bending wavenumber times length stays ≤ ``max_beta_l``
-at the top frequency (the exact segment stiffness is then far from its own
-clamped–clamped poles, and well conditioned). The piece matrices are exact
-(:mod:`toolpoint.dynamics.beam`), so no mesh convergence is involved: refining only
-re-expresses the same solution.
+at the top frequency (the piece stiffness is then far from its own
+clamped–clamped poles). The piece matrices are exact
+(:mod:`toolpoint.dynamics.beam`), so refining only re-expresses the same solution.
 
 Global dynamic stiffness D(ω) (2 DOF per node: w, ψ) is assembled for all
 frequencies at once and solved in one batched LAPACK call for the columns of
 the requested end nodes: R = (D⁻¹)[ends, ends] is the receptance matrix,
 [[h, l], [n, p]] per node pair (h = w/F, l = w/M, n = ψ/F, p = ψ/M).
+Why the two routes and these limits: ``docs/design/dynamics.md``.
 """
 
 from __future__ import annotations
@@ -35,22 +34,39 @@ import numpy as np
 from .assembly import Component
 from .beam import inv2, mul2, stiffness_from_transfer, transfer_matrices
 
+__all__ = ["MAX_BETA_L", "CHAIN_LIMIT", "Mesh", "interior_cuts", "mesh", "chain_growth", "assemble", "receptance",
+           "end_receptances", "end_receptances_dense"]
+
 MAX_BETA_L = 2.0
+"""Default largest bending wavenumber × piece length at the top frequency (dimensionless)."""
+
 # Above Σ βL ≈ 6 (past the first free–free mode, βL = 4.73) the stiffness
 # sweep is well conditioned while the chain starts to lose digits (e^6 ≈ 400).
 CHAIN_LIMIT = 6.0
+"""Largest chain growth exponent Σ βL for which the transfer chain is used (dimensionless)."""
 
 
 @dataclass(frozen=True)
 class Mesh:
-    """Nodes (x in m) and exact pieces of one component."""
+    """Nodes and exact pieces of one component.
 
-    x: np.ndarray  # node positions, m
-    pieces: tuple  # (Section, length m, left node index)
-    ground: tuple  # (node, k, c, kr, cr) springs to ground
+    Attributes
+    ----------
+    x : numpy.ndarray
+        (N,) node positions, m, from the component's start.
+    pieces : tuple
+        (Section, length m, left node index) per piece.
+    ground : tuple
+        (node, k N/m, c N s/m, kr N m/rad, cr N m s/rad) springs to ground.
+    """
+
+    x: np.ndarray
+    pieces: tuple
+    ground: tuple
 
     @property
     def n_nodes(self) -> int:
+        """Number of nodes N."""
         return self.x.size
 
 
@@ -60,8 +76,31 @@ def interior_cuts(x0: float, x1: float, points, tol: float = 1e-9) -> list[float
     return [x0] + [p for i, p in enumerate(inside) if i == 0 or p - inside[i - 1] > tol] + [x1]
 
 
-def mesh(component: Component, fmax_hz: float, max_beta_l: float = MAX_BETA_L) -> Mesh:
-    """Cut ``component`` at segment ends and bearings; sub-divide for conditioning at fmax_hz."""
+def mesh(component: Component, fmax_hz: float, max_beta_l: float | None = None) -> Mesh:
+    """Cut ``component`` at segment ends and bearings; sub-divide for conditioning at ``fmax_hz``.
+
+    Every piece gets n = ⌈β(ω_max) L / max_beta_l⌉ equal sub-pieces, β the
+    Euler–Bernoulli bending wavenumber (1/m) at ω_max = 2π max(fmax_hz, 1 Hz).
+
+    Parameters
+    ----------
+    component : Component
+    fmax_hz : float
+        Highest frequency the mesh serves, Hz.
+    max_beta_l : float, optional
+        Largest βL per piece; None means :data:`MAX_BETA_L` (read at call time).
+        Smaller values give more pieces (the same exact answer: a convergence check).
+
+    Examples
+    --------
+    >>> from toolpoint.dynamics.assembly import Component, Material, Segment
+    >>> bar = Component("bar", (Segment(0.3, 0.02, 0.0, Material("steel", 210e9, 7800.0, 0.3)),))
+    >>> len(mesh(bar, 3000.0).pieces), len(mesh(bar, 3000.0, max_beta_l=0.25).pieces)
+    (5, 33)
+    """
+    max_beta_l = MAX_BETA_L if max_beta_l is None else float(max_beta_l)
+    if not max_beta_l > 0:
+        raise ValueError(f"max_beta_l must be > 0, got {max_beta_l!r}")
     wmax = 2 * np.pi * max(float(fmax_hz), 1.0)
     edges = np.cumsum([0.0] + [s.length for s in component.segments])
     xs = [0.0]
@@ -174,11 +213,9 @@ def _chain_end_stiffness(m: Mesh, omega: np.ndarray) -> np.ndarray:
     """Dynamic stiffness (F, 4, 4) condensed onto the first and last node of a chain.
 
     Interior nodes are condensed one at a time (block Gaussian elimination along
-    the chain, ``Z ← Z − Z_·k Π⁻¹ Z_k·`` with the 2×2 pivot Π at node k), which
-    costs a few 2×2 operations per node instead of a dense solve. A pivot is
-    singular only at a natural frequency of the part of the chain between the
-    first node and node k + 1 with both clamped; springs and damping keep it
-    regular in practice, and the tests compare with the dense LAPACK solve.
+    the chain, ``Z ← Z − Z_·k Π⁻¹ Z_k·`` with the 2×2 pivot Π at node k): a few
+    2×2 operations per node instead of a dense solve. A pivot is singular only at
+    a clamped–clamped natural frequency of the chain up to node k + 1.
     """
     G = _ground(m, omega)
     P = _piece_matrices(m, omega)
@@ -198,18 +235,42 @@ def _chain_end_stiffness(m: Mesh, omega: np.ndarray) -> np.ndarray:
     return Z
 
 
-def end_receptances(component: Component, freq_hz, ends: str = "both") -> np.ndarray:
+def end_receptances(component: Component, freq_hz, ends: str = "both", *,
+                    max_beta_l: float | None = None) -> np.ndarray:
     """Receptance matrix at the component's ends, one global x axis.
 
-    ``ends="both"`` → (F, 4, 4) on [w_start, ψ_start, w_end, ψ_end];
-    ``ends="end"`` → (F, 2, 2) at the end (x = L) only; ``"start"`` likewise.
-    Units: m/N, m/(N m) = 1/N, rad/N, rad/(N m).
-    A free–free component is singular at 0 Hz: ask for ω > 0 only.
+    Parameters
+    ----------
+    component : Component
+    freq_hz : array_like
+        (F,) frequencies, Hz. A free–free component is singular at 0 Hz: ask for ω > 0 only.
+    ends : str
+        ``"both"`` → (F, 4, 4) on [w_start, ψ_start, w_end, ψ_end];
+        ``"end"`` → (F, 2, 2) at the end (x = L) only; ``"start"`` likewise.
+    max_beta_l : float, optional
+        Mesh parameter (see :func:`mesh`).
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex receptances, blocks [[h, l], [n, p]] in m/N, 1/N, rad/N, rad/(N m).
+
+    Examples
+    --------
+    Slender free–free bar far below its first mode: the rigid-body mass line
+    h ≈ −4/(m ω²) at either end.
+
+    >>> import numpy as np
+    >>> from toolpoint.dynamics.assembly import Component, Material, Segment
+    >>> bar = Component("bar", (Segment(0.3, 0.02, 0.0, Material("steel", 210e9, 7800.0, 0.3)),))
+    >>> h = end_receptances(bar, [1.0], "end")[0, 0, 0]
+    >>> bool(abs(h.real * bar.mass * (2 * np.pi) ** 2 / -4 - 1) < 0.01)
+    True
     """
     f = np.asarray(freq_hz, float).reshape(-1)
     if not component.bearings and np.any(f == 0):
         raise ValueError(f"{component.name}: free–free receptance is singular at 0 Hz")
-    m = mesh(component, f.max() if f.size else 1.0)
+    m = mesh(component, f.max() if f.size else 1.0, max_beta_l)
     w = 2 * np.pi * f
     R = np.empty((f.size, 4, 4), complex)
     # The chain is for free–free parts only: stiff springs in a chain mix scales
@@ -223,10 +284,11 @@ def end_receptances(component: Component, freq_hz, ends: str = "both") -> np.nda
     return R[:, sel, sel]
 
 
-def end_receptances_dense(component: Component, freq_hz, ends: str = "both") -> np.ndarray:
+def end_receptances_dense(component: Component, freq_hz, ends: str = "both", *,
+                          max_beta_l: float | None = None) -> np.ndarray:
     """Same as :func:`end_receptances` by a dense LAPACK solve of the whole chain (a check)."""
     f = np.asarray(freq_hz, float).reshape(-1)
-    m = mesh(component, f.max() if f.size else 1.0)
+    m = mesh(component, f.max() if f.size else 1.0, max_beta_l)
     D, _ = assemble([m], [], 2 * np.pi * f)
     last = 2 * (m.n_nodes - 1)
     dofs = {"both": [0, 1, last, last + 1], "end": [last, last + 1], "start": [0, 1]}[ends]

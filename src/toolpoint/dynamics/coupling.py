@@ -16,7 +16,8 @@ import numpy as np
 
 from .beam import inv2
 
-CHUNK = 16  # parameter sets per vectorised block (cache-sized at a few thousand frequencies)
+CHUNK = 16
+"""Joint parameter sets per vectorised block of :class:`ToolPointCoupler` (cache-sized temporaries)."""
 
 
 def joint_compliance(params, omega) -> np.ndarray:
@@ -91,12 +92,58 @@ class ToolPointCoupler:
     """
 
     def __init__(self, T: np.ndarray, SH: np.ndarray, omega):
+        self._setup(T[:, 2, 2].copy(), T[:, 2, :2], T[:, :2, 2], T[:, :2, :2] + SH, omega)
+
+    @classmethod
+    def from_parts(cls, t00, u, v, P, omega) -> "ToolPointCoupler":
+        """The same rational form for any receptance h = t00 − u (P + K⁻¹)⁻¹ v.
+
+        By the Woodbury identity, adding one 2-DOF spring element K = diag(k̃t, k̃r) (a joint between
+        DOF pairs a and b, or a bearing from a to ground) to a structure of receptance G₀ gives, between
+        any response DOF i and force DOF j,
+
+            h_ij = G₀,ij − (G₀,ib − G₀,ia)(P + K⁻¹)⁻¹(G₀,bj − G₀,aj),  P = Dᵀ G₀ D,
+
+        D = e_b − e_a (e_b for a bearing): this class with t00 = G₀,ij, u = G₀,ib − G₀,ia (F, 2),
+        v = G₀,bj − G₀,aj (F, 2). ``params`` are then [k, c, kr, cr] of that element.
+
+        Parameters
+        ----------
+        t00 : (F,) complex
+            Receptance without the element, m/N (or 1/N, rad/N, rad/(N m) for other DOF pairs).
+        u, v : (F, 2) complex
+            Row and column couplings to the element's (w, ψ) DOFs.
+        P : (F, 2, 2) complex
+            Receptance across the element's DOFs without it.
+        omega : (F,) float
+            rad/s.
+
+        Returns
+        -------
+        ToolPointCoupler
+
+        Examples
+        --------
+        A mass-less spring to ground seen from its own DOF: h = 1/(k + iωc) once G₀ → ∞ is removed
+        (here G₀ = P = 1 m/N, u = v = [1, 0]: h = 1 − 1/(1 + 1/k̃) = 1/(k̃ + 1)).
+
+        >>> one = np.ones(1, complex)
+        >>> P = np.eye(2, dtype=complex)[None]
+        >>> c = ToolPointCoupler.from_parts(one, np.array([[1, 0]], complex), np.array([[1, 0]], complex), P, [1.0])
+        >>> complex(c(np.array([3.0, 0.0, 1.0, 0.0]))[0])
+        (0.25+0j)
+        """
+        self = cls.__new__(cls)
+        self._setup(np.asarray(t00, complex).copy(), np.asarray(u, complex), np.asarray(v, complex),
+                    np.asarray(P, complex), omega)
+        return self
+
+    def _setup(self, t00, u, v, P, omega) -> None:
+        """Bases B_num, B_den (8, F) of the rational form (class docstring)."""
         w = np.asarray(omega, float)
         self.omega = w
-        P = T[:, :2, :2] + SH
-        u = T[:, 2, :2]
-        v = T[:, :2, 2]
-        self.t00 = T[:, 2, 2].copy()
+        self.t00 = t00
+        self._u, self._v, self._P = u, v, P  # kept so that couplers can be stacked (from_parts)
         alpha = u[:, 0] * v[:, 0]
         beta = u[:, 1] * v[:, 1]
         self.det = P[:, 0, 0] * P[:, 1, 1] - P[:, 0, 1] * P[:, 1, 0]
@@ -127,7 +174,7 @@ class ToolPointCoupler:
         single = np.ndim(params) == 1
         c = joint_coefficients(params)
         h = np.empty((c.shape[0], self.t00.size), complex)
-        # Chunks of a few sets keep the (chunk, F) temporaries in cache: ~5× faster than one big batch.
+        # Chunks of a few sets keep the (chunk, F) temporaries in cache (timings: docs/design/dynamics.md).
         for s in range(0, c.shape[0], CHUNK):
             x = c[s : s + CHUNK]
             q = self._real_matmul(x, self.B_num)

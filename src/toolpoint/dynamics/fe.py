@@ -14,8 +14,10 @@ Element (Przemieniecki 1968; Friedman & Kosmatka 1993): cubic deflection and
     K = EI/((1+Φ)L³) [[12, 6L, −12, 6L], [6L, (4+Φ)L², −6L, (2−Φ)L²], …]
 
 and the consistent mass (translational ρAL and rotary ρI/L parts, both over
-(1+Φ)², polynomials in Φ given below). Frequency error falls as h⁴.
-This is a check, not a hot path: it loops over frequencies.
+(1+Φ)², polynomials in Φ given below). The natural-frequency error falls as h²
+with the element length h (measured in ``tests/test_beam.py``; the tool-point
+FRF error likewise, ``tests/test_coupling.py``), so Richardson extrapolation in
+h² sharpens it. This is a check, not a hot path: it loops over frequencies.
 """
 
 from __future__ import annotations
@@ -30,8 +32,8 @@ from .components import interior_cuts
 def element_matrices(seg: Segment, L: float) -> tuple[np.ndarray, np.ndarray]:
     """Stiffness (complex, E with loss factor) and mass (real) 4×4 on [w1, ψ1, w2, ψ2]."""
     sec = seg.section()
-    EI = sec.E * sec.I
-    phi = (12 * sec.E * sec.I / (sec.kappa * sec.G * sec.A * L**2)).real  # E/G is real
+    EI = sec.E * sec.Iz
+    phi = (12 * sec.E * sec.Iz / (sec.kappa * sec.G * sec.A * L**2)).real  # E/G is real
     K = EI / ((1 + phi) * L**3) * np.array(
         [
             [12, 6 * L, -12, 6 * L],
@@ -66,7 +68,7 @@ def element_matrices(seg: Segment, L: float) -> tuple[np.ndarray, np.ndarray]:
             [-r11, -r12, r11, -r12],
             [r12, r24, -r12, r22],
         ]
-    ) * (sec.rho * sec.I / ((1 + p) ** 2 * L))
+    ) * (sec.rho * sec.Iz / ((1 + p) ** 2 * L))
     return K, Mt + Mr
 
 
@@ -83,6 +85,7 @@ class FEModel:
         nodes_per = []
         self.elements = []  # (first dof, K, M)
         self.ground = []  # (dof, k, c) for both w and ψ springs
+        self.node_x: list[np.ndarray] = []  # node positions per component, m from its start
         first = 0
         for comp in components:
             x = 0.0
@@ -97,6 +100,7 @@ class FEModel:
                         xs.append(xs[-1] + (b - a) / n)
                 x += seg.length
             xs = np.array(xs)
+            self.node_x.append(xs)
             for b in comp.bearings:
                 node = int(np.argmin(abs(xs - b.x)))
                 self.ground += [(first + 2 * node, b.k, b.c), (first + 2 * node + 1, b.kr, b.cr)]
@@ -130,12 +134,34 @@ class FEModel:
                 Cb[bw + i - j, j] += sgn * cc
         return Kb, Cb, Mb
 
-    def receptance(self, freq_hz, dof: int) -> np.ndarray:
-        """Direct receptance at ``dof`` (m/N for a w DOF) at each frequency (Hz)."""
+    def matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Dense global K (complex, N/m and N m/rad), C (real, N s/m …) and M (real, kg, kg m²), (ndof, ndof).
+
+        For eigenvalue checks of small models; the solver itself uses band storage.
+        """
+        bw = self.BW
+        bands = self._bands()
+        i, j = np.meshgrid(np.arange(self.ndof), np.arange(self.ndof), indexing="ij")
+        inside = np.abs(i - j) <= bw
+        out = []
+        for B in bands:
+            A = np.zeros((self.ndof, self.ndof), B.dtype)
+            A[inside] = B[bw + i[inside] - j[inside], j[inside]]
+            out.append(A)
+        return tuple(out)
+
+    def node_dof(self, component: int, x: float) -> int:
+        """The w DOF of the node of component number ``component`` nearest to ``x`` (m from its start)."""
+        xs = self.node_x[component]
+        return int(self.first_dof[component] + 2 * np.argmin(abs(xs - x)))
+
+    def receptance(self, freq_hz, dof: int, force_dof: int | None = None) -> np.ndarray:
+        """Receptance at ``dof`` for a unit load at ``force_dof`` (default ``dof``: direct), m/N for w DOFs,
+        at each frequency (Hz)."""
         Kb, Cb, Mb = self._bands()
         out = np.empty(len(freq_hz), complex)
         e = np.zeros(self.ndof)
-        e[dof] = 1.0
+        e[dof if force_dof is None else force_dof] = 1.0
         for k, f in enumerate(np.asarray(freq_hz, float)):
             w = 2 * np.pi * f
             out[k] = solve_banded((self.BW, self.BW), Kb + 1j * w * Cb - w * w * Mb, e,

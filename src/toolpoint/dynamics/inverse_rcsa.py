@@ -31,41 +31,26 @@ so (1,1), (1,2), (2,2) give a 3×3 system M x = d per frequency, solved in one
 batched LAPACK call, and then SH = X⁻¹ − R_33 (l = n by construction).
 
 **Accuracy of the blank model.** At low frequency R_33 is dominated by the
-rigid-body terms ~1/(mω²) and is far larger than SH (≈ 1e-3 against 2.5e-8 m/N
-at 20 Hz for a Ø16 × 80 mm blank), so SH = X⁻¹ − R_33 needs R to a relative
-accuracy far better than the 1e-6 asked of SH. A dense free–free stiffness
-inverse loses (ω₁/ω)²·ε in R (observed: 1e-4 relative error in the recovered
-p at 10 Hz, 5e-7 at 50 Hz for that blank); the transfer chain keeps every
-entry to round-off (recovered SH to ~1e-9 down to 10 Hz). The blank
+rigid-body terms ~1/(mω²) and is far larger than SH, so SH = X⁻¹ − R_33 needs R
+to a relative accuracy far better than the one asked of SH. The blank
 receptances therefore come from the exact transfer chain cut at point 2
-(:func:`blank_receptances`) wherever its growth Σ βL ≤ ``CHAIN_LIMIT``, and
-from the dense exact stiffness matrix above that (high frequency, where it is
-well conditioned).
+(:func:`blank_receptances`), which keeps every entry to round-off, wherever its
+growth Σ βL ≤ ``CHAIN_LIMIT``, and from the dense exact stiffness matrix above
+that (high frequency, where it is well conditioned).
 
 **Noise.** The problem is ill conditioned: SH is a small part of the
-measured response (the blank's own compliance dominates), and h, l, p are
-extrapolated from the two measuring points to the holder tip over lever
-arms L and L − x2. To first order dSH = J dG with (:func:`sensitivity`)
+measured response, and h, l, p are extrapolated from the two measuring points
+to the holder tip. To first order dSH = J dG with (:func:`sensitivity`)
 
     J = S(P) M⁻¹,   P = R_33 + SH,   S(P) x = P X P in (00, 01, 11) coordinates,
 
 and complex Gaussian measurement noise of standard deviation σ_k on G_k gives
 standard deviations √(Σ_k |J_ek|² σ_k²) on h, l, p (:func:`noise_std`).
-For the numerical case with a Ø16 × 80 mm blank and x2 = 30 mm the median
-(over 20–3000 Hz) relative error of h, l, p is ≈ 5000, 10000, 5000 times the
-noise level (noise std relative to each FRF's peak); with the second point
-10 mm from the holder face (a 50 mm blank, x2 = 40 mm) it is ≈ 190, 570, 520,
-and 5 mm from it ≈ 130–150, 380–400, 360–390 whatever the blank length. The
-3×3 system itself is well conditioned (column-scaled condition number 20–40):
-the amplification comes from the step X → SH, SH being a small part of the
-measured response, i.e. from extrapolating to the holder tip. So: measure the
-second point as close to the holder as possible. A second blank adds nothing
-unless it adds measurements near the holder (see the benchmark).
-:func:`smooth_subassembly` (Savitzky–Golay on real and imaginary parts over
-frequency) reduces the noise by a further ≈ 2–5× but rounds off modes
-narrower than its window (the numerical case has a 9 Hz wide mode at 790 Hz):
-it pays for the noise-dominated rotational entries l, n, p more than for h.
-``benchmarks/bench_inverse_rcsa.py`` prints the study.
+Measure the second point as close to the holder as possible.
+:func:`smooth_subassembly` (Savitzky–Golay) and ``smooth="modal"`` (a common-pole
+fit, :mod:`toolpoint.dynamics.modal`) reduce the noise. The measured error
+amplification and the comparison of the smoothers are in
+``docs/design/dynamics.md`` (``benchmarks/bench_inverse_rcsa.py`` prints them).
 
 The subassembly can also come straight from a model
 (:func:`subassembly_from_assembly`) or from four measured FRF files
@@ -84,15 +69,14 @@ from .assembly import Assembly, Component
 from .beam import inv2, transfer_matrix
 from .components import CHAIN_LIMIT, assemble, chain_growth, mesh, receptance
 from ..errors import InputError
-from ..frf import FRF
+from ..frf import FRF, check_freq_hz
 from ..io.frf_files import read_frf
-from .polefit import fit_common_poles
+from .modal import fit_modal
 from .subassembly import Subassembly
 
 __all__ = [
-    "blank_receptances", "blank_frfs", "subassembly_from_blank", "subassembly_from_files",
-    "subassembly_from_assembly", "smooth_subassembly", "modal_smooth_subassembly", "sensitivity", "noise_std", "Conditioning",
-    "conditioning",
+    "blank_receptances", "blank_frfs", "subassembly_from_blank", "subassembly_from_files", "subassembly_from_assembly",
+    "smooth_subassembly", "modal_smooth_subassembly", "sensitivity", "noise_std", "Conditioning", "conditioning",
 ]
 
 TIP, POINT2, ROOT = 0, 1, 2  # indices of points 1, 2, 3 in blank_receptances
@@ -124,14 +108,6 @@ def _split(blank: Component, x_cut: float) -> Component:
     return replace(blank, segments=tuple(segs))
 
 
-def _check_freq(freq_hz) -> np.ndarray:
-    f = np.asarray(freq_hz, float).reshape(-1)
-    if f.size == 0 or np.any(~np.isfinite(f)) or np.any(f <= 0):
-        raise InputError("frequencies must be finite and > 0 Hz (the free–free blank is singular at 0 Hz)",
-                         field="freq_hz")
-    return f
-
-
 def blank_receptances(blank: Component, x2_m: float, freq_hz) -> np.ndarray:
     """Free–free receptances R (F, 3, 3, 2, 2) of the blank between its points 1, 2, 3.
 
@@ -150,7 +126,7 @@ def blank_receptances(blank: Component, x2_m: float, freq_hz) -> np.ndarray:
         R_1j = T11 R_3j − T12 δ_j3 − T_B,12 δ_j2.
     """
     x2 = _check_blank(blank, x2_m)
-    f = _check_freq(freq_hz)
+    f = check_freq_hz(freq_hz, positive=True)  # the free–free blank is singular at 0 Hz
     cut = blank.length - x2
     m = mesh(_split(blank, cut), f.max())
     k2 = int(np.argmin(abs(m.x - cut)))
@@ -257,8 +233,9 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
     G21 : optional second cross FRF (y2/F1); if given, G12 is replaced by the mean
         (G12 + G21)/2 (reciprocity), which halves that FRF's noise variance.
     smooth : None; ``"modal"`` — the three FRFs are first replaced by a common-pole
-        modal fit (:func:`toolpoint.dynamics.polefit.fit_common_poles`), which removes the
-        noise and keeps the peaks (recommended); or a Savitzky–Golay window in Hz
+        modal fit (:func:`toolpoint.dynamics.modal.fit_modal`, weighted in the quantity
+        G11 was measured in: ``meta["file_quantity"]``, else its ``quantity``), which removes
+        the noise and keeps the peaks (recommended); or a Savitzky–Golay window in Hz
         applied to the result (:func:`smooth_subassembly`, ``polyorder``).
 
     Returns a :class:`Subassembly` on the FRFs' grid: h m/N, l 1/N, n rad/N,
@@ -270,16 +247,13 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
     given = {"G11": G11, "G12": G12, "G22": G22}
     if G21 is not None:
         given["G21"] = G21
-    f = _common_grid(given, "G11")
-    if np.any(f <= 0):
-        raise InputError("frequencies must be > 0 Hz (the free–free blank is singular at 0 Hz); "
-                         "drop 0 Hz with .band(fmin=...)", field="G11")
+    f = check_freq_hz(_common_grid(given, "G11"), field="G11", positive=True)  # free–free blank: no 0 Hz
     g = {k: v.to_receptance().values for k, v in given.items()}
     g12 = 0.5 * (g["G12"] + g["G21"]) if G21 is not None else g["G12"]
     Gm = np.stack([g["G11"], g12, g["G22"]], -1)
     label = ""
     if _is_modal(smooth):
-        fit = _modal_fit(f, Gm)
+        fit = _modal_fit(f, Gm, G11.meta.get("file_quantity", G11.quantity))
         Gm = fit(f)
         label = f", modal fit ({fit.n_modes} modes)"
     R = blank_receptances(blank, x2_m, f)
@@ -293,11 +267,12 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
     return sub if smooth is None or _is_modal(smooth) else smooth_subassembly(sub, float(smooth), polyorder)
 
 
-def _modal_fit(f, Y):
+def _modal_fit(f, Y, noise: str = "receptance"):
+    """Common-pole fit of the receptance columns of ``Y`` (noise white in ``noise``)."""
     try:
-        return fit_common_poles(f, Y)
-    except ValueError as e:  # too few points, an all-zero FRF: a one-line input error
-        raise InputError(f"modal fit impossible: {e}", field="smooth") from None
+        return fit_modal(f, Y, quantity="receptance", noise=noise)
+    except InputError as e:  # too few points, an all-zero FRF: say it is the modal fit that failed
+        raise InputError(f"modal fit impossible: {e.message}", field="smooth") from None
 
 
 def _is_modal(smooth) -> bool:
@@ -317,7 +292,8 @@ def subassembly_from_assembly(assembly: Assembly, freq_hz) -> Subassembly:
     return Subassembly.from_assembly(assembly, freq_hz)
 
 
-def subassembly_from_files(h, l, n, p, *, smooth: float | str | None = None, polyorder: int = 3) -> Subassembly:
+def subassembly_from_files(h_path, l_path, n_path, p_path, *, smooth: float | str | None = None,
+                           polyorder: int = 3) -> Subassembly:
     """The subassembly from four FRF files (any format :func:`~toolpoint.io.frf_files.read_frf` reads).
 
     Each file holds one entry of SH = [[h, l], [n, p]] at the holder tip, written
@@ -329,7 +305,7 @@ def subassembly_from_files(h, l, n, p, *, smooth: float | str | None = None, pol
     kept as given (reciprocity l = n is not enforced). ``smooth``: None, ``"modal"``
     (:func:`modal_smooth_subassembly`) or a Savitzky–Golay window in Hz.
     """
-    paths = {"h": h, "l": l, "n": n, "p": p}
+    paths = {"h": h_path, "l": l_path, "n": n_path, "p": p_path}
     frfs = {k: read_frf(v) for k, v in paths.items()}
     f = frfs["h"].freq_hz
     for k, g in frfs.items():
@@ -337,12 +313,10 @@ def subassembly_from_files(h, l, n, p, *, smooth: float | str | None = None, pol
             raise InputError(f"frequency grid ({g.freq_hz.size} points, {g.freq_hz[0]:g}–{g.freq_hz[-1]:g} Hz) "
                              f"differs from that of h ({paths['h']}: {f.size} points, {f[0]:g}–{f[-1]:g} Hz)",
                              file=paths[k], field="freq_hz")
-        if np.any(g.freq_hz <= 0):
-            raise InputError("the subassembly needs frequencies > 0 Hz (drop the 0 Hz point)",
-                             file=paths[k], field="freq_hz")
+        check_freq_hz(g.freq_hz, file=paths[k], positive=True)  # the subassembly has no 0 Hz point
     R = np.stack([np.stack([frfs["h"].values, frfs["l"].values], -1),
                   np.stack([frfs["n"].values, frfs["p"].values], -1)], 1)
-    sub = Subassembly(f, R, f"spindle–holder (files {Path(str(h)).name}, …)")
+    sub = Subassembly(f, R, f"spindle–holder (files {Path(str(h_path)).name}, …)")
     if smooth is None:
         return sub
     return modal_smooth_subassembly(sub) if _is_modal(smooth) else smooth_subassembly(sub, float(smooth), polyorder)
@@ -350,7 +324,7 @@ def subassembly_from_files(h, l, n, p, *, smooth: float | str | None = None, pol
 
 # --------------------------------------------------------------------------- smoothing
 def modal_smooth_subassembly(sub: Subassembly) -> Subassembly:
-    """h, l, n, p replaced by one common-pole modal fit (:mod:`toolpoint.dynamics.polefit`).
+    """h, l, n, p replaced by one common-pole modal fit (:mod:`toolpoint.dynamics.modal`).
 
     For a subassembly that is already noisy (e.g. four measured files). With a
     blank, ``subassembly_from_blank(..., smooth="modal")`` fits the measured

@@ -3,44 +3,169 @@
     result = identify(model, measured, method="hybrid", seed=0)
     result.params        # {"kt": …, "ct": …, "kr": …, "cr": …}  (SI)
     result.ci95          # {"kt": [lo, hi], …}
-    result.warnings      # identifiability and bound warnings
+    result.warnings      # identifiability and bound warnings (also emitted as IdentifiabilityWarning)
+    result.optimizer     # the optimiser's scipy OptimizeResult (x in log10 space)
 
 ``model`` is a :class:`~toolpoint.dynamics.model.ToolPointModel` (tool on a
-subassembly, any frequencies) or an :class:`~toolpoint.dynamics.model.AssemblyModel`;
-the measured FRF is evaluated on the model's frequencies.
+subassembly, any frequencies); the measured FRF must be on the model's frequencies.
 """
 
 from __future__ import annotations
 
 import time
+import warnings
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import OptimizeResult
 
 from ..dynamics.assembly import Assembly
-from ..frf import FRF
 from ..dynamics.model import ToolPointModel
-from .objective import JointProblem
-from .params import PARAMS, Bounds
-from .optim import METHODS, Termination
 from ..dynamics.subassembly import Subassembly
-from .uncertainty import confidence_intervals, identifiability_warnings
+from ..errors import IdentifiabilityWarning
+from ..frf import FRF
+from .objective import JointProblem
+from .optim import METHODS, Termination, check_method
+from .params import PARAMS, Bounds
+from .uncertainty import identifiability_warnings, intervals_and_correlation
 
-__all__ = ["make_algorithm", "model_for", "identify", "relative_errors"]
+__all__ = ["IdentificationResult", "make_algorithm", "model_for", "identify", "relative_errors"]
 
 
 def make_algorithm(method: str, options: dict | None = None):
-    """An optimiser instance by name (``hybrid``, ``ga``, ``sa``, ``pso``, ``de``)."""
-    if method not in METHODS:
-        raise ValueError(f"unknown method {method!r} (one of {', '.join(METHODS)})")
+    """An optimiser instance by name.
+
+    Parameters
+    ----------
+    method : str
+        ``hybrid``, ``ga``, ``sa``, ``pso`` or ``de`` (checked by
+        :func:`~toolpoint.identification.optim.check_method`: anything else is an InputError).
+    options : dict, optional
+        Keyword arguments of the optimiser's class (e.g. ``{"maxiter": 100, "maxfev": 20000}``).
+
+    Returns
+    -------
+    GA, SA, PSO, DE or Hybrid
+
+    Examples
+    --------
+    >>> make_algorithm("pso", {"maxiter": 50}).maxiter
+    50
+    """
+    check_method(method, file=None, field="method")
     return METHODS[method](**(options or {}))
 
 
 def model_for(assembly: Assembly, freq_hz, subassembly: Subassembly | None = None) -> ToolPointModel:
-    """Tool-point model of ``assembly`` on ``freq_hz`` (Hz, > 0); the subassembly
-    defaults to the assembly's own spindle + holder + spindle–holder joint."""
+    """Tool-point model of ``assembly`` on ``freq_hz``.
+
+    Parameters
+    ----------
+    assembly : Assembly
+    freq_hz : (F,) array
+        Frequencies, Hz (> 0).
+    subassembly : Subassembly, optional
+        Default: the assembly's own spindle + holder + spindle–holder joint.
+
+    Returns
+    -------
+    ToolPointModel
+    """
     sub = subassembly or Subassembly.from_assembly(assembly, freq_hz)
     return ToolPointModel(assembly.tool, sub, freq_hz)
+
+
+@dataclass(frozen=True, eq=False)
+class IdentificationResult:
+    """The identified holder–tool joint (SI units) and how it was found.
+
+    Attributes
+    ----------
+    params : dict
+        {"kt": N/m, "ct": N s/m, "kr": N m/rad, "cr": N m s/rad}.
+    x : (4,) ndarray
+        The same values in ``PARAMS`` order, SI.
+    ci95 : dict
+        name → [lo, hi], 95 % interval, SI (see :mod:`.uncertainty`).
+    se_log10 : dict
+        name → standard error of log10 p.
+    warnings : tuple of str
+        Identifiability findings (wide interval, on a bound); each was also emitted as an
+        :class:`~toolpoint.errors.IdentifiabilityWarning`.
+    model_frf : FRF
+        The model's tool-point receptance with the identified joint, m/N.
+    method : str
+    seed : int or None
+    bounds : dict
+        name → [lo, hi] search bounds, SI.
+    seconds : float
+        Wall time of the search and the uncertainty step, s.
+    optimizer : scipy.optimize.OptimizeResult
+        The optimiser's own result: ``x`` and ``fun`` in its space (log10 p; m/N), ``success``,
+        ``status``, ``message``, ``nit``, ``nfev``, ``history``, …
+    names : tuple of str
+        Parameter names, in the order of ``x`` (``PARAMS`` for the holder–tool joint; full names such as
+        ``spindle_holder.kt`` or ``bearings[0].k`` from :func:`~toolpoint.identification.problem.identify_frfs`).
+    correlation : (n, n) ndarray or None
+        Correlation of the log10 estimates (:func:`~toolpoint.identification.uncertainty.intervals_and_correlation`).
+    model_frfs : tuple of FRF
+        The model at every measured point (``model_frf`` is the first).
+    """
+
+    params: dict
+    x: np.ndarray
+    ci95: dict
+    se_log10: dict
+    warnings: tuple
+    model_frf: FRF
+    method: str
+    seed: int | None
+    bounds: dict
+    seconds: float
+    optimizer: OptimizeResult
+    names: tuple = PARAMS
+    correlation: np.ndarray | None = None
+    model_frfs: tuple = ()
+
+    @property
+    def fun(self) -> float:
+        """Objective at the optimum, ‖h − h_meas‖₂, m/N."""
+        return float(self.optimizer.fun)
+
+    @property
+    def nfev(self) -> int:
+        """Model evaluations of the search (the uncertainty step's 5 are not included)."""
+        return int(self.optimizer.nfev)
+
+    @property
+    def nit(self) -> int:
+        """Iterations of the optimiser (hybrid: of its global stage)."""
+        return int(self.optimizer.nit)
+
+    @property
+    def success(self) -> bool:
+        """True when the optimiser's convergence test held (not merely a cap reached)."""
+        return bool(self.optimizer.success)
+
+    @property
+    def status(self) -> int:
+        """The optimiser's status code (0 converged, 1 iteration limit, 2 evaluation limit, 3 other)."""
+        return int(self.optimizer.status)
+
+    @property
+    def message(self) -> str:
+        """Why the optimiser stopped."""
+        return str(self.optimizer.message)
+
+    @property
+    def history(self) -> np.ndarray:
+        """Best objective per iteration, m/N."""
+        return self.optimizer.history
+
+    @property
+    def x_log(self) -> np.ndarray:
+        """log10 of ``x`` (the optimiser's ``x``)."""
+        return np.asarray(self.optimizer.x, float)
 
 
 def identify(
@@ -52,35 +177,102 @@ def identify(
     options: dict | None = None,
     termination: Termination | None = None,
     callback=None,
-) -> OptimizeResult:
-    """Run one identification; returns a scipy-style ``OptimizeResult`` with
+) -> IdentificationResult:
+    """Identify the holder–tool joint p = [kt, ct, kr, cr] from a measured tool-point FRF.
 
-    x (SI [kt, ct, kr, cr]), x_log, fun (objective, m/N), nfev (points),
-    nit, seconds, history (best objective per iteration), message, success,
-    method, seed, params, ci95, se_log10, warnings.
+    Minimises the paper's Eq. (8), f(x) = ‖h(10^x) − h̄‖₂ (m/N), over x = log10 p within ``bounds``, then
+    computes linearised 95 % intervals and identifiability warnings (see :mod:`.uncertainty`).
+
+    Parameters
+    ----------
+    model : ToolPointModel
+        Tool on a subassembly, on the measured frequencies (:func:`model_for`).
+    measured : FRF
+        Measured tool-point FRF (converted to receptance, m/N).
+    method : str, default "hybrid"
+        ``hybrid``, ``ga``, ``sa``, ``pso`` or ``de``.
+    seed : int or None, default 0
+        Seed of the ``numpy.random.Generator`` that drives the search.
+    bounds : Bounds, optional
+        Search bounds, SI; default the paper's (:data:`~toolpoint.identification.params.PAPER_BOUNDS`).
+    options : dict, optional
+        Options of the optimiser (see its class, e.g. ``{"maxiter": 100}``).
+    termination : Termination, optional
+        Deprecated: use ``options`` (``maxiter``, ``maxfev``, ``stall_iter``, ``tol``, ``f_target``).
+    callback : callable, optional
+        ``callback(nit, best_f, nfev)`` after every iteration.
+
+    Returns
+    -------
+    IdentificationResult
+
+    Warns
+    -----
+    IdentifiabilityWarning
+        Once per entry of ``result.warnings``.
+
+    Examples
+    --------
+    >>> from toolpoint.dynamics.assembly import load_assembly
+    >>> a = load_assembly("examples/numerical_case.toml")
+    >>> f = np.arange(100.0, 3001.0, 10.0)
+    >>> model = model_for(a, f)
+    >>> measured = FRF(f, model.tool_point(a.holder_tool.as_array()))
+    >>> r = identify(model, measured, "hybrid", seed=0)
+    >>> r.success, round(r.params["kt"] / 2.1e7, 6), r.warnings
+    (True, 1.0, ())
     """
     if not np.array_equal(measured.freq_hz, model.freq_hz):
         raise ValueError("measured FRF and model frequencies differ: build the model on measured.freq_hz")
-    problem = JointProblem(model.coupler, measured.to_receptance().values, bounds)
     algo = make_algorithm(method, options)
+    if termination is not None:
+        warnings.warn("identify(termination=…) is deprecated: pass options={'maxiter': …, 'maxfev': …, "
+                      "'stall_iter': …, 'tol': …}", DeprecationWarning, stacklevel=2)
+        algo = algo._with_termination(termination)
+    problem = JointProblem(model.coupler, measured.to_receptance().values, bounds)
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
-    res = algo.minimize(problem, rng, termination, callback)
-    x_log = np.asarray(res.x, float)
-    ci, se = confidence_intervals(problem, x_log)
-    res.seconds = time.perf_counter() - t0  # includes the uncertainty step
-    res.x_log = x_log
-    res.x = 10.0**x_log
-    res.params = dict(zip(PARAMS, map(float, res.x)))
-    res.ci95 = {k: [float(a), float(b)] for k, (a, b) in zip(PARAMS, ci)}
-    res.se_log10 = dict(zip(PARAMS, map(float, se)))
-    res.warnings = identifiability_warnings(x_log, ci, problem.bounds)
-    res.seed = seed
-    res.bounds = problem.bounds.as_dict()
-    res.model_frf = FRF(model.freq_hz, problem.model(x_log), "receptance", f"identified ({method})")
-    return res
+    opt = algo.minimize(problem, rng, callback=callback)
+    x_log = np.asarray(opt.x, float)
+    ci, se, corr = intervals_and_correlation(problem, x_log)
+    seconds = time.perf_counter() - t0  # includes the uncertainty step
+    found = tuple(identifiability_warnings(x_log, ci, problem.bounds, corr=corr))
+    for w in found:
+        warnings.warn(w, IdentifiabilityWarning, stacklevel=2)
+    x = 10.0**x_log
+    return IdentificationResult(
+        params=dict(zip(PARAMS, map(float, x))),
+        x=x,
+        ci95={k: [float(a), float(b)] for k, (a, b) in zip(PARAMS, ci)},
+        se_log10=dict(zip(PARAMS, map(float, se))),
+        warnings=found,
+        model_frf=FRF(model.freq_hz, problem.model(x_log), "receptance", f"identified ({method})"),
+        method=method,
+        seed=seed,
+        bounds=problem.bounds.as_dict(),
+        seconds=seconds,
+        optimizer=opt,
+        correlation=corr,
+        model_frfs=(),
+    )
 
 
 def relative_errors(x, exact) -> dict:
-    """|x − exact| / exact per parameter, as fractions."""
+    """|x − exact| / |exact| per parameter, as fractions.
+
+    Parameters
+    ----------
+    x, exact : (4,) array
+        [kt, ct, kr, cr], same units.
+
+    Returns
+    -------
+    dict
+        name → relative error.
+
+    Examples
+    --------
+    >>> relative_errors([2.2e7, 15, 1.4e6, 3], [2e7, 15, 1.4e6, 3])["kt"]
+    0.1
+    """
     return {k: float(abs(a - b) / abs(b)) for k, a, b in zip(PARAMS, np.asarray(x, float), np.asarray(exact, float))}

@@ -19,19 +19,31 @@ import numpy as np
 
 from ..dynamics.coupling import CHUNK, ToolPointCoupler, joint_coefficients
 from ..frf import FRF
-from .params import PARAMS, Bounds
+from .params import Bounds
+
+__all__ = ["JointProblem"]
+
 
 class JointProblem:
     """Minimise f(x) over x = log10 [kt, ct, kr, cr] within ``bounds``.
 
     Parameters
     ----------
-    coupler : ToolPointCoupler on the measured frequencies (see
-        :class:`toolpoint.dynamics.model.ToolPointModel`).
-    measured : (F,) complex tool-point receptance, m/N.
-    bounds : Bounds (SI).
+    coupler : ToolPointCoupler
+        Coupling on the measured frequencies (see :class:`toolpoint.dynamics.model.ToolPointModel`).
+    measured : (F,) complex array or FRF
+        Measured tool-point receptance, m/N.
+    bounds : Bounds, optional
+        Search bounds, SI (default the paper's).
 
-    ``nfev`` counts model evaluations as points (members), not calls.
+    Attributes
+    ----------
+    xl, xu : (4,) ndarray
+        log10 of the bounds.
+    residual_scale : float
+        RMS of |measured|, m/N: least-squares residuals are divided by it.
+    nfev : int
+        Model evaluations so far, counted as points (members), not calls.
     """
 
     n_var = 4

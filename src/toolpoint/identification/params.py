@@ -24,7 +24,7 @@ from ..errors import InputError
 
 __all__ = [
     "PARAMS", "UNITS", "PAPER_BOUNDS", "IDENTIFIED_RATIO", "Bounds", "interval_ratio", "is_identified",
-    "ci_quantile", "sigma_ln_from_interval",
+    "ci_quantile", "sigma_ln_from_interval", "ELEMENT_PARAMS", "ELEMENT_UNITS", "DEFAULT_BOUNDS", "CORRELATION_LIMIT",
 ]
 
 PARAMS = ("kt", "ct", "kr", "cr")
@@ -35,14 +35,49 @@ PAPER_BOUNDS = {"kt": (1e6, 1e9), "ct": (1.0, 300.0), "kr": (1e5, 1e7), "cr": (1
 
 @dataclass(frozen=True)
 class Bounds:
-    """Box bounds in SI units, one (lo, hi) per parameter of ``PARAMS``."""
+    """Box bounds of the search, SI units, one (lo, hi) per parameter of :data:`PARAMS`.
+
+    Parameters
+    ----------
+    lo, hi : (4,) ndarray
+        Lower and upper bounds of [kt N/m, ct N s/m, kr N m/rad, cr N m s/rad], 0 < lo < hi.
+
+    Examples
+    --------
+    >>> b = Bounds.from_dict({"kt": [1e6, 1e8]})
+    >>> b.as_dict()["kt"], b.log_hi[0]
+    ([1000000.0, 100000000.0], np.float64(8.0))
+    >>> Bounds.from_dict({"kt": [1e8, 1e6]}, source="a.toml")
+    Traceback (most recent call last):
+    ...
+    toolpoint.errors.InputError: a.toml: bounds.kt: lo must be < hi, got [1e+08, 1e+06]
+    """
 
     lo: np.ndarray
     hi: np.ndarray
 
     @classmethod
     def from_dict(cls, d: dict | None = None, *, source: str | None = None, section: str = "bounds") -> "Bounds":
-        """Paper defaults, overridden by ``d`` = {"kt": [lo, hi], …}; bad values raise InputError."""
+        """The paper's bounds (:data:`PAPER_BOUNDS`), overridden by ``d``.
+
+        Parameters
+        ----------
+        d : dict, optional
+            {"kt": [lo, hi], …}, SI units.
+        source : str, optional
+            File the values came from (for error messages).
+        section : str, default "bounds"
+            Table name used in error messages (``section.kt``).
+
+        Returns
+        -------
+        Bounds
+
+        Raises
+        ------
+        InputError
+            Unknown name, not [lo, hi], not finite and > 0, or lo ≥ hi.
+        """
         merged = dict(PAPER_BOUNDS)
         for key, val in (d or {}).items():
             field = f"{section}.{key}"
@@ -61,15 +96,33 @@ class Bounds:
 
     @property
     def log_lo(self) -> np.ndarray:
+        """log10 of ``lo`` (the optimisers' space)."""
         return np.log10(self.lo)
 
     @property
     def log_hi(self) -> np.ndarray:
+        """log10 of ``hi`` (the optimisers' space)."""
         return np.log10(self.hi)
 
     def as_dict(self) -> dict:
+        """{"kt": [lo, hi], …} with Python floats, SI units."""
         return {k: [float(a), float(b)] for k, a, b in zip(PARAMS, self.lo, self.hi)}
 
+
+# Every spring element of an assembly (see toolpoint.dynamics.points): joints have kt, ct, kr, cr, bearings
+# k, c, kr, cr, all in the slot order [k, c, kr, cr] of K = diag(k + iωc, kr + iωcr).
+ELEMENT_PARAMS = {"joint": PARAMS, "bearing": ("k", "c", "kr", "cr")}
+ELEMENT_UNITS = {"joint": UNITS, "bearing": {"k": "N/m", "c": "N s/m", "kr": "N m/rad", "cr": "N m s/rad"}}
+# Default search bounds by element (SI): the holder–tool joint the paper's; the spindle–holder joint (an ISO 40 /
+# HSK taper is 1e8–1e9 N/m, 1e6–1e8 N m/rad) and the bearings (preloaded angular-contact sets 1e7–1e9 N/m)
+# two or more decades around the usual values.
+DEFAULT_BOUNDS = {
+    "holder_tool": PAPER_BOUNDS,
+    "spindle_holder": {"kt": (1e6, 1e10), "ct": (1.0, 1e4), "kr": (1e4, 1e9), "cr": (0.01, 1e3)},
+    "bearing": {"k": (1e6, 1e10), "c": (1.0, 1e5), "kr": (1e3, 1e8), "cr": (0.01, 1e3)},
+}
+# |correlation| of two identified log10 parameters above which they are reported as trading off.
+CORRELATION_LIMIT = 0.95
 
 # An interval wider than this factor says the data do not determine the parameter.
 IDENTIFIED_RATIO = 2.0

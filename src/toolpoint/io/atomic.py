@@ -8,18 +8,34 @@ import tempfile
 from pathlib import Path
 
 
+def _umask() -> int:
+    mask = os.umask(0)  # the only portable way to read it is to set it
+    os.umask(mask)
+    return mask
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
     """Yield a temporary path beside ``path``; rename it onto ``path`` only on success.
 
-    Use for writers that want a file name (``savefig``, ``pyuff``)::
+    The file gets the permissions of a plain ``open(path, "w")`` (0666 less the
+    user's umask), not ``mkstemp``'s private 0600. Use for writers that want a
+    file name (``savefig``, ``pyuff``).
 
-        with atomic_path("fig.png") as tmp:
-            fig.savefig(tmp, format="png")
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> out = Path(tempfile.mkdtemp()) / "a.txt"
+    >>> with atomic_path(out) as tmp:
+    ...     _ = Path(tmp).write_text("ok")
+    >>> out.read_text()
+    'ok'
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix, dir=path.parent)
+    os.fchmod(fd, 0o666 & ~_umask())
     os.close(fd)
     try:
         yield tmp

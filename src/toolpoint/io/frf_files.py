@@ -14,7 +14,18 @@
   stores values and uneven frequencies as exact doubles.
 * ``.frf`` — CutPro text: whitespace (normally tab) separated columns Freq (Hz),
   Real, Imag (m/N); an optional header line ``Freq  Real  Imag`` and comment
-  lines starting with ``%`` or ``#`` are skipped.
+  lines starting with ``%`` or ``#`` are skipped. Exports with more columns
+  (e.g. 9: several FRFs side by side) need a header naming them and may have a
+  unit line after it: the first frequency, real and imaginary columns are read
+  (and a coherence column if one is named so); m/N, mm/N and µm/N are known.
+* ``.txt`` / ``.tsv`` / ``.dat`` — the same reader: whitespace, tab or comma
+  separated Hz, real, imaginary (m/N), header optional (a lab export of three
+  tab-separated columns without a header reads as is).
+
+Coherence, when a file has it (a ``coherence`` column of CSV or text, a UFF
+dataset 58 of function type 6 for the same response and reference), is kept as
+an array on ``frf.meta["coherence"]`` (checked to lie in [0, 1]); the CSV and
+UFF writers write it back.
 
 Every reader returns a receptance :class:`~toolpoint.frf.FRF` in m/N (a
 mobility or accelerance file is converted with :meth:`FRF.to_receptance`) and
@@ -34,39 +45,110 @@ import pyuff
 
 from .atomic import atomic_open, atomic_path
 from ..errors import InputError
-from ..frf import FRF, QUANTITIES
+from ..frf import FRF, QUANTITIES, check_freq_hz
 
 __all__ = [
     "read_frf", "write_frf", "read_csv_frf", "write_csv_frf", "read_uff58", "read_uff58_all",
-    "write_uff58", "read_cutpro", "write_cutpro",
+    "write_uff58", "read_cutpro", "write_cutpro", "read_text_frf",
 ]
 
 G0 = 9.80665  # standard gravity, m/s² per g
 CSV_HEADER = ("freq_hz", "real", "imag")
+COHERENCE_TOL = 1e-6  # round-off allowed outside [0, 1] before a coherence is refused
 CUTPRO_COLUMNS = ("Freq", "Real", "Imag")
 
 
 # ---------------------------------------------------------------- dispatch
-def read_frf(path, *, quantity: str | None = None, min_points: int = 1, label: str | None = None) -> FRF:
-    """Read an FRF file (``.csv``, ``.uff``/``.unv``/``.uf``, ``.frf``) as receptance in m/N.
+def read_frf(path, *, quantity: str | None = None, min_points: int = 1, label: str | None = None,
+             response=None, reference=None) -> FRF:
+    """Read an FRF file (``.csv``, ``.uff``/``.unv``/``.uf``, ``.frf``, ``.txt``/``.tsv``/``.dat``) as receptance.
 
-    ``quantity`` ("receptance", "mobility" or "accelerance") says what the file
-    holds and overrides what the file says; mobility/accelerance points at 0 Hz
-    are dropped with a warning. ``label`` defaults to the file stem. Fewer than
-    ``min_points`` points raises :class:`InputError`.
+    Parameters
+    ----------
+    path : str or Path
+        The file; its extension picks the format.
+    quantity : str, optional
+        ``"receptance"``, ``"mobility"`` or ``"accelerance"``: what the file holds
+        (overrides what a UFF file says). Mobility/accelerance points at 0 Hz are
+        dropped with a warning.
+    min_points : int
+        Fewest points accepted.
+    label : str, optional
+        Defaults to the file stem.
+    response, reference : int, str or tuple, optional
+        UFF only: pick the FRF by response / reference node (``7``), or node and
+        direction (``"7:3"``, ``"7:-2"`` or ``(7, 3)``). Needed when the file holds
+        several FRFs; the error lists them.
+
+    Returns
+    -------
+    FRF
+        Receptance (m/N), SISO; ``meta`` holds the source, format, file quantity
+        and, when the file has one, ``coherence`` (array on the FRF's grid).
+
+    Raises
+    ------
+    InputError
+        One line naming the file and field (and the line of a text file).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> from toolpoint.frf import FRF
+    >>> frf = FRF([10.0, 20.0, 30.0], [1e-8 - 2e-8j, 3e-8j, -1e-9 + 0j], label="tool")
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_frf(os.path.join(d, "tp.csv"), frf)
+    ...     got = read_frf(os.path.join(d, "tp.csv"))
+    >>> got.label, bool(np.array_equal(got.values, frf.values))
+    ('tp', True)
     """
-    return _pick(path, _READERS)(path, quantity=quantity, min_points=min_points, label=label)
+    reader = _pick(path, _READERS)
+    if reader is read_uff58:
+        return reader(path, quantity=quantity, min_points=min_points, label=label, response=response,
+                      reference=reference)
+    if response is not None or reference is not None:
+        raise InputError("response=/reference= pick among the FRFs of a UFF file; this file holds one",
+                         file=path, field="response")
+    return reader(path, quantity=quantity, min_points=min_points, label=label)
 
 
-def write_frf(path, frf: FRF) -> None:
-    """Write ``frf`` as receptance (m/N) in the format given by the extension of ``path``."""
-    _pick(path, _WRITERS)(path, frf)
+def write_frf(path, frf: FRF, *, as_measured: bool = False) -> None:
+    """Write a SISO ``frf`` as receptance (m/N) in the format given by the extension of ``path``.
+
+    ``.csv`` and ``.frf`` are exact (``%.17g``); ``.uff``/``.unv``/``.uf`` is UFF
+    dataset 58 (see :func:`write_uff58`). The file is replaced atomically: a
+    failure leaves any old file untouched. A coherence on ``frf.meta["coherence"]``
+    (same length as the FRF) is written as a fourth CSV column or a second UFF
+    dataset (function type 6); CutPro files hold no coherence. With
+    ``as_measured`` the FRF is written in its own quantity (mobility,
+    accelerance) instead of receptance (UFF says which; CSV and CutPro do not).
+
+    Raises
+    ------
+    InputError
+        Unknown extension, an empty or matrix FRF, or a mobility/accelerance at 0 Hz.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from toolpoint.frf import FRF
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_frf(Path(d) / "h.csv", FRF([0.0, 5.0], [1e-8 + 0j, 2e-8 - 1e-8j]))
+    ...     print(Path(d, "h.csv").read_text(), end="")
+    freq_hz,real,imag
+    0,1e-08,0
+    5,2e-08,-1e-08
+    """
+    _pick(path, _WRITERS)(path, frf, as_measured=as_measured)
 
 
 def _pick(path, table):
     ext = Path(path).suffix.lower()
     if ext not in table:
-        raise InputError(f"unknown FRF file extension {ext!r} (use one of {', '.join(table)})", file=path, field="extension")
+        raise InputError(f"unknown FRF file extension {ext!r} (use one of {', '.join(table)})", file=path,
+                         field="extension")
     return table[ext]
 
 
@@ -78,47 +160,145 @@ def read_csv_frf(path, *, quantity: str | None = None, min_points: int = 1, labe
     if not lines:
         raise InputError("empty file", file=path, field="header")
     head = lines[0][1]
-    if tuple(c.strip() for c in head.split(",")) != CSV_HEADER:
-        raise InputError(f"expected {','.join(CSV_HEADER)!r}, found {head.strip()!r}", file=path, field="header")
+    names = tuple(c.strip() for c in head.split(","))
+    if names not in (CSV_HEADER, CSV_HEADER + ("coherence",)):
+        raise InputError(f"expected {','.join(CSV_HEADER)!r} (optionally ',coherence'), found {head.strip()!r}",
+                         file=path, field="header")
     rows = [(n, s.split(",")) for n, s in lines[1:]]
-    return _table_frf(path, rows, CSV_HEADER, q, min_points, label, "csv")
+    return _table_frf(path, rows, names, q, min_points, label, "csv")
 
 
-def write_csv_frf(path, frf: FRF) -> None:
-    """Write ``frf`` as receptance to a toolpoint CSV file (``%.17g``: exact round trip)."""
-    _write_table(path, frf, ",".join(CSV_HEADER) + "\n", ",")
+def write_csv_frf(path, frf: FRF, *, as_measured: bool = False) -> None:
+    """Write ``frf`` as receptance to a toolpoint CSV file (``%.17g``: exact round trip).
+
+    A coherence on ``frf.meta["coherence"]`` becomes a fourth column ``coherence``.
+    """
+    _write_table(path, frf, ",".join(CSV_HEADER), ",", as_measured)
 
 
 # ---------------------------------------------------------------- CutPro
 def read_cutpro(path, *, quantity: str | None = None, min_points: int = 1, label: str | None = None) -> FRF:
-    """Read a CutPro ``.frf`` text file: columns Freq (Hz), Real, Imag (m/N).
+    """Read a CutPro ``.frf`` (or ``.txt``/``.tsv``/``.dat``) text file: columns Freq (Hz), Real, Imag (m/N).
 
-    Columns may be separated by tabs or any whitespace; lines starting with
-    ``%`` or ``#`` and one header line before the data are skipped.
+    Columns may be separated by tabs, any whitespace or commas; lines starting
+    with ``%`` or ``#`` are skipped. A header line is optional for three
+    columns and required for more: it names the columns (``Freq``/``Hz``,
+    ``Real``/``Re``, ``Imag``/``Im``, ``Coherence``), the first of each is read.
+    A line of units may follow the header (``Hz``, ``m/N``, ``mm/N``, ``um/N``).
     """
     q = _quantity(path, quantity)
-    rows, header_seen = [], False
+    rows, head, units = [], None, None
     for n, line in enumerate(_read_lines(path), 1):
-        cells = line.split()
+        cells = _split(line)
         if not cells or cells[0][0] in "%#":
             continue
-        if not rows and not header_seen and not _is_number(cells[0]):
-            header_seen = True
+        if not rows and not _is_number(cells[0]):
+            if head is None:
+                head = (n, cells)
+            elif units is None:
+                units = (n, cells)
+            else:
+                raise InputError(f"line {n}: {cells[0]!r} is not a number (a third header line?)", file=path,
+                                 field="header")
             continue
         rows.append((n, cells))
-    return _table_frf(path, rows, CUTPRO_COLUMNS, q, min_points, label, "cutpro")
+    cols, names, scale = _columns(path, head, units, rows)
+    if cols is not None:
+        width = max(cols) + 1
+        picked = []
+        for n, cells in rows:
+            if len(cells) < width:
+                raise InputError(f"line {n}: expected {len(head[1])} columns, found {len(cells)}", file=path,
+                                 field="columns")
+            picked.append((n, [cells[c] for c in cols]))
+        rows = picked
+    frf = _table_frf(path, rows, names, q, min_points, label, Path(path).suffix.lower().lstrip(".") or "text")
+    if scale != 1.0:
+        frf = FRF(frf.freq_hz, frf.values * scale, frf.quantity, frf.label, frf.meta)
+    return frf
 
 
-def write_cutpro(path, frf: FRF) -> None:
+read_text_frf = read_cutpro
+"""Whitespace/tab/comma separated Hz, real, imaginary (m/N); header optional (see :func:`read_cutpro`)."""
+
+_NAMES = {"freq": ("freq", "frequency", "f", "hz", "freq_hz"), "real": ("real", "re"),
+          "imag": ("imag", "im", "imaginary"), "coherence": ("coherence", "coh", "gamma2", "γ²")}
+_LENGTH_UNITS = {"m/n": 1.0, "mm/n": 1e-3, "um/n": 1e-6, "µm/n": 1e-6, "μm/n": 1e-6}
+
+
+def _kind(name: str) -> str | None:
+    """What a header cell names: 'freq', 'real', 'imag', 'coherence' or None (``Re(H11)`` → real)."""
+    s = name.strip().lower()
+    base = s.split("(")[0].split("[")[0].strip(" _-") or s
+    for k, words in _NAMES.items():
+        if base in words or (k != "freq" and base.startswith(words[0])) or (k == "freq" and base.startswith("freq")):
+            return k
+    return None
+
+
+def _columns(path, head, units, rows):
+    """(column indices or None, names, value scale to m/N) from the header and unit lines."""
+    ncol = len(rows[0][1]) if rows else 3
+    if head is None:
+        if ncol != 3:
+            n = rows[0][0]
+            raise InputError(f"line {n}: {ncol} columns and no header naming them; expected 3 (Hz, real, imag) "
+                             "or a header line", file=path, field="columns")
+        return None, CUTPRO_COLUMNS, 1.0
+    n, cells = head
+    kinds = [_kind(c) for c in cells]
+    if len(cells) == 3 and ncol == 3 and kinds == [None] * 3:
+        return None, CUTPRO_COLUMNS, 1.0  # an unlabelled header such as "Freq Re Im" of another language
+    pos = {}
+    for i, k in enumerate(kinds):
+        if k is not None and k not in pos:
+            pos[k] = i
+    missing = [k for k in ("freq", "real", "imag") if k not in pos]
+    if missing:
+        raise InputError(f"line {n}: header {' '.join(cells)!r} names no {' or '.join(missing)} column",
+                         file=path, field="header")
+    order = ["freq", "real", "imag"] + (["coherence"] if "coherence" in pos else [])
+    cols = [pos[k] for k in order]
+    names = tuple(cells[c] for c in cols)
+    scale = 1.0
+    if units is not None:
+        un, ucells = units
+        if len(ucells) != len(cells):
+            raise InputError(f"line {un}: {len(ucells)} unit labels for {len(cells)} columns", file=path,
+                             field="units")
+        fu, vu = ucells[pos["freq"]].strip("[]()").lower(), ucells[pos["real"]].strip("[]()").lower()
+        if fu not in ("hz", "1/s"):
+            raise InputError(f"line {un}: frequency unit {ucells[pos['freq']]!r}; need Hz", file=path,
+                             field="units")
+        if vu not in _LENGTH_UNITS:
+            raise InputError(f"line {un}: FRF unit {ucells[pos['real']]!r}; known: m/N, mm/N, um/N", file=path,
+                             field="units")
+        scale = _LENGTH_UNITS[vu]
+    return cols, names, scale
+
+
+def _split(line: str) -> list[str]:
+    """Cells of a text line: comma separated, else tab separated (a header cell may hold spaces), else whitespace."""
+    s = line.strip()
+    if "," in s:
+        return [c.strip() for c in s.split(",")]
+    if "\t" in s:
+        return [c.strip() for c in s.split("\t") if c.strip()]
+    return s.split()
+
+
+def write_cutpro(path, frf: FRF, *, as_measured: bool = False) -> None:
     """Write ``frf`` as receptance to a CutPro ``.frf`` file: tab-separated Hz, real, imaginary (m/N).
 
-    No header line is written (CutPro-style plain three-column data).
+    No header line is written (CutPro-style plain three-column data); a coherence is not written.
     """
-    _write_table(path, frf, "", "\t")
+    _write_table(path, frf, None, "\t", as_measured)
 
 
 # ---------------------------------------------------------------- UFF 58
 _UFF_QUANTITY = {8: "receptance", 11: "mobility", 12: "accelerance"}  # ordinate specific data type
+_UFF_TYPE = {q: t for t, q in _UFF_QUANTITY.items()}
+_UFF_UNIT = {"receptance": "m", "mobility": "m/s", "accelerance": "m/s^2"}
 _FUNC_TYPES = {
     0: "general or unknown", 1: "time response", 2: "auto spectrum", 3: "cross spectrum",
     4: "frequency response function", 5: "transmissibility", 6: "coherence", 7: "auto correlation",
@@ -127,27 +307,104 @@ _FUNC_TYPES = {
 
 
 def read_uff58(path, *, index: int | None = None, quantity: str | None = None, min_points: int = 1,
-               label: str | None = None) -> FRF:
+               label: str | None = None, response=None, reference=None) -> FRF:
     """Read one FRF from a Universal File Format dataset 58 (ASCII or binary 58b).
 
-    ``index`` picks among the datasets 58 of the file (0 = first); by default
-    the first whose function type is 4 (frequency response function). The
-    quantity comes from the ordinate specific data type (8 displacement, 11
-    velocity, 12 acceleration, over force) unless ``quantity`` is given; an
-    ordinate units label ``g`` is converted to m/s² (×9.80665) with a warning.
-    Values are assumed SI (m, N, s).
+    The FRF is a dataset 58 of function type 4. ``index`` picks among the
+    datasets 58 of the file (0 = first); otherwise ``response`` / ``reference``
+    (node ``7``, or node and direction ``"7:3"`` / ``(7, 3)``) pick among the
+    FRFs, and a file with one FRF needs neither; several candidates raise
+    :class:`InputError` listing them. The quantity comes from the ordinate
+    specific data type (8 displacement, 11 velocity, 12 acceleration, over
+    force), else from the ordinate unit label (``m/s²``…), unless ``quantity``
+    is given; a unit ``g`` is converted to m/s² (×9.80665) with a warning.
+    Values are assumed SI (m, N, s). A coherence dataset (function type 6) with
+    the same response and reference goes to ``meta["coherence"]``.
     """
     q = _quantity(path, quantity) if quantity is not None else None
     uff, sets, heads = _uff_headers(path)
     if index is None:
-        k = next((k for k, h in enumerate(heads) if h.get("func_type") == 4), 0)
+        k = _pick_frf(path, heads, response, reference)
     else:
         try:
             k = range(len(heads))[index]
         except (IndexError, TypeError):
             raise InputError(f"index {index!r} out of range: the file has {len(heads)} datasets 58",
                              file=path, field="index") from None
-    return _uff_frf(path, uff, sets[k], k, q, min_points, label)
+    frf = _uff_frf(path, uff, sets[k], k, q, min_points, label)
+    coh = [j for j, h in enumerate(heads) if h.get("func_type") == 6 and _dofs(h) == _dofs(heads[k])]
+    if coh:
+        c = _uff_coherence(path, uff, sets[coh[0]], coh[0], frf)
+        frf = FRF(frf.freq_hz, frf.values, frf.quantity, frf.label, {**frf.meta, "coherence": c})
+    return frf
+
+
+def _dofs(h) -> tuple:
+    return (h.get("rsp_node"), h.get("rsp_dir"), h.get("ref_node"), h.get("ref_dir"))
+
+
+def _parse_dof(path, value, name):
+    """(node, direction or None) from 7, "7", "7:3", (7, 3)."""
+    try:
+        if isinstance(value, (tuple, list)):
+            node, d = value
+            return int(node), int(d)
+        s = str(value).strip()
+        if ":" in s:
+            node, d = s.split(":")
+            return int(node), int(d)
+        return int(s), None
+    except (TypeError, ValueError):
+        raise InputError(f"{value!r} is not a node or node:direction (e.g. 7 or 7:3)", file=path,
+                         field=name) from None
+
+
+def _pick_frf(path, heads, response, reference) -> int:
+    """Index of the one FRF (function type 4) matching ``response`` / ``reference``."""
+    frfs = [k for k, h in enumerate(heads) if h.get("func_type") == 4]
+    if not frfs:
+        return 0  # _uff_frf reports its function type
+    want = {}
+    for name, value, keys in (("response", response, ("rsp_node", "rsp_dir")),
+                              ("reference", reference, ("ref_node", "ref_dir"))):
+        if value is not None:
+            want[name] = (_parse_dof(path, value, name), keys)
+
+    def ok(h):
+        return all(h.get(keys[0]) == node and (d is None or h.get(keys[1]) == d)
+                   for (node, d), keys in want.values())
+
+    found = [k for k in frfs if ok(heads[k])]
+    if len(found) == 1:
+        return found[0]
+    choices = "; ".join(f"#{k}: response {heads[k].get('rsp_node')}:{heads[k].get('rsp_dir')} reference "
+                        f"{heads[k].get('ref_node')}:{heads[k].get('ref_dir')}" for k in frfs)
+    field = "response" if response is not None or reference is None else "reference"
+    if not found:
+        asked = ", ".join(f"{n} {v}" for n, v in (("response", response), ("reference", reference)) if v is not None)
+        raise InputError(f"no FRF with {asked}; the file has {choices}", file=path, field=field)
+    raise InputError(f"{len(found)} FRFs match; pick one with response=/reference= (--response/--reference): "
+                     f"{choices}", file=path, field=field)
+
+
+def _uff_coherence(path, uff, setno, k, frf) -> np.ndarray:
+    """Coherence dataset 58 #k on the FRF's grid, checked to lie in [0, 1]."""
+    try:
+        ds = uff.read_sets(setno)
+    except Exception as exc:  # pyuff raises bare Exception
+        raise InputError(f"dataset 58 #{k} cannot be read ({exc})", file=path, field="coherence") from exc
+    x = np.asarray(ds["x"], dtype=float)
+    c = np.asarray(ds["data"])
+    if np.iscomplexobj(c):
+        if np.any(c.imag != 0):
+            raise InputError(f"coherence dataset 58 #{k} has imaginary values", file=path, field="coherence")
+        c = c.real
+    c = np.asarray(c, dtype=float)
+    sel = np.isin(x, frf.freq_hz) if x.size != len(frf) else np.ones(x.size, bool)
+    if np.count_nonzero(sel) != len(frf):
+        raise InputError(f"coherence dataset 58 #{k} has {x.size} points, the FRF {len(frf)}", file=path,
+                         field="coherence")
+    return _check_coherence(path, c[sel], lambda i: f"dataset 58 #{k} point {i + 1}")
 
 
 def read_uff58_all(path, *, quantity: str | None = None, min_points: int = 1) -> list[FRF]:
@@ -162,8 +419,12 @@ def read_uff58_all(path, *, quantity: str | None = None, min_points: int = 1) ->
     return [_uff_frf(path, uff, sets[k], k, q, min_points, f"{Path(path).stem}#{k}") for k in ks]
 
 
-def write_uff58(path, frf: FRF, *, binary: bool = False) -> None:
-    """Write ``frf`` as one UFF dataset 58 (receptance m/N, complex double), replacing ``path``.
+def write_uff58(path, frf: FRF, *, binary: bool = False, as_measured: bool = False) -> None:
+    """Write ``frf`` as a UFF dataset 58 (receptance m/N, complex double), replacing ``path``.
+
+    A coherence on ``frf.meta["coherence"]`` is written as a second dataset 58
+    (function type 6, real double) with the same nodes. ``as_measured`` keeps a
+    mobility or accelerance as it is (ordinate data type 11 or 12).
 
     An evenly spaced grid is written as abscissa minimum and increment when
     those survive pyuff's 6-digit ``%13.5e`` header format; otherwise every
@@ -171,7 +432,8 @@ def write_uff58(path, frf: FRF, *, binary: bool = False) -> None:
     significant digits: a warning gives the rounding, and frequencies that
     would collide raise :class:`InputError`; ``binary=True`` keeps them exact.
     """
-    r = _for_write(path, frf)
+    r = _for_write(path, frf, as_measured)
+    coh = _coherence_of(path, r)
     f, v = r.freq_hz, r.values
     if len(f) < 2:
         raise InputError("a UFF dataset 58 needs at least 2 points", file=path, field="freq_hz")
@@ -194,17 +456,23 @@ def write_uff58(path, frf: FRF, *, binary: bool = False) -> None:
         ref_node=_dof(m, "ref_node"), ref_dir=_dof(m, "ref_dir"),
         ord_data_type=6, abscissa_spacing=int(even),
         abscissa_spec_data_type=18, abscissa_axis_units_lab="Hz",
-        ordinate_spec_data_type=8, ordinate_axis_units_lab="m",
+        ordinate_spec_data_type=_UFF_TYPE[r.quantity], ordinate_axis_units_lab=_UFF_UNIT[r.quantity],
         orddenom_spec_data_type=13, orddenom_axis_units_lab="N",
         data=v.copy(), x=f.copy(),
     )
+    sets = [ds]
+    if coh is not None:
+        cs = dict(ds, func_type=6, ord_data_type=4, ordinate_spec_data_type=0, ordinate_axis_units_lab="NONE",
+                  orddenom_spec_data_type=0, orddenom_axis_units_lab="NONE", data=coh.copy(), x=f.copy())
+        cs["id1"] = ("coherence " + ds["id1"])[:80]
+        sets.append(cs)
     with atomic_path(path) as tmp, warnings.catch_warnings():
         # tmp is a new, empty file, so "add" writes exactly one dataset. Not "overwrite":
         # pyuff 2.5.8 reopens the file with "wb" for binary data and truncates the header.
         # For binary data it also leaves its last handle to be closed (and flushed) when its
         # writer returns, which CPython does at once, with a ResourceWarning.
         warnings.simplefilter("ignore", ResourceWarning)
-        pyuff.UFF(tmp).write_sets(ds, mode="add")
+        pyuff.UFF(tmp).write_sets(sets, mode="add")
 
 
 def _uff_headers(path):
@@ -268,9 +536,23 @@ def _uff_quantity(path, ds, tag) -> str:
     if num in (9, 13):
         raise InputError(f"{tag} is force over data type {den} (dynamic stiffness or similar); "
                          "need response over force", file=path, field="ordinate_spec_data_type")
+    by_unit = _quantity_from_unit(_label(ds, "ordinate_axis_units_lab"))
+    if by_unit is not None:
+        return by_unit
     warnings.warn(f"{path}: {tag} ordinate data type {num} over {den} is not displacement, velocity or "
                   "acceleration over force; assuming receptance (m/N) — pass quantity= to say", stacklevel=4)
     return "receptance"
+
+
+def _quantity_from_unit(unit: str) -> str | None:
+    """Quantity named by an ordinate unit label such as ``(1/N)*(m/s²)`` or ``m/s^2/N`` (None if unclear).
+
+    Vendors write the square as ``²``, ``^2`` or ``2``; a non-UTF-8 ``²`` reads as a replacement character.
+    """
+    u = "".join(unit.lower().split()).replace("(", "").replace(")", "").replace("*", "")
+    u = u.replace("1/n", "").replace("/n", "")
+    u = u.replace("\ufffd", "²").replace("^2", "²").replace("s2", "s²")
+    return {"m": "receptance", "m/s": "mobility", "m/s²": "accelerance"}.get(u)
 
 
 def _dof(meta, key) -> int:
@@ -326,35 +608,41 @@ def _is_number(s: str) -> bool:
 
 
 def _table_frf(path, rows, names, quantity, min_points, label, fmt) -> FRF:
-    """FRF from text rows ``[(line number, [freq, real, imag]), ...]``."""
-    a = np.empty((len(rows), 3))
+    """FRF from text rows ``[(line number, [freq, real, imag(, coherence)]), ...]``; ``names`` name the columns."""
+    k = len(names)
+    a = np.empty((len(rows), k))
     for i, (n, cells) in enumerate(rows):
-        if len(cells) != 3:
-            raise InputError(f"line {n}: expected 3 columns, found {len(cells)}", file=path, field="columns")
+        if len(cells) != k:
+            raise InputError(f"line {n}: expected {k} columns, found {len(cells)}", file=path, field="columns")
         for j, cell in enumerate(cells):
             try:
                 a[i, j] = float(cell)
             except ValueError:
                 raise InputError(f"line {n}: {cell.strip()!r} is not a number", file=path, field=names[j]) from None
-    _validate(path, a[:, 0], a[:, 1], a[:, 2], lambda i: f"line {rows[i][0]}", names)
+    where = lambda i: f"line {rows[i][0]}"  # noqa: E731
+    _validate(path, a[:, 0], a[:, 1], a[:, 2], where, names)
     v = np.empty(len(rows), dtype=complex)
     v.real, v.imag = a[:, 1], a[:, 2]
-    return _finish(path, a[:, 0], v, quantity, min_points, label, fmt, {})
+    meta = {} if k == 3 else {"coherence": _check_coherence(path, a[:, 3], where, names[3])}
+    return _finish(path, a[:, 0], v, quantity, min_points, label, fmt, meta)
+
+
+def _check_coherence(path, c, where, name="coherence") -> np.ndarray:
+    """A coherence column: finite and in [0, 1] (round-off of ``COHERENCE_TOL`` clipped)."""
+    c = np.asarray(c, dtype=float)
+    bad = np.flatnonzero(~np.isfinite(c) | (c < -COHERENCE_TOL) | (c > 1 + COHERENCE_TOL))
+    if bad.size:
+        raise InputError(f"coherence {c[bad[0]]:.6g} outside [0, 1] at {where(bad[0])}", file=path, field=name)
+    return np.clip(c, 0.0, 1.0)
 
 
 def _validate(path, f, re, im, where, names) -> None:
-    """Finite values, non-negative and strictly increasing frequencies."""
-    for name, col in zip(names, (f, re, im)):
+    """Finite values (with their location in the file) and a valid frequency grid (:func:`check_freq_hz`)."""
+    for name, col in zip(names[1:], (re, im)):
         bad = np.flatnonzero(~np.isfinite(col))
         if bad.size:
             raise InputError(f"non-finite value {col[bad[0]]} at {where(bad[0])}", file=path, field=name)
-    if f.size and f[0] < 0:
-        raise InputError(f"negative frequency {f[0]:.10g} Hz at {where(0)}", file=path, field=names[0])
-    bad = np.flatnonzero(np.diff(f) <= 0)
-    if bad.size:
-        i = bad[0] + 1
-        what = "duplicate" if f[i] == f[i - 1] else f"non-increasing (after {f[i - 1]:.10g} Hz)"
-        raise InputError(f"{what} frequency {f[i]:.10g} Hz at {where(i)}", file=path, field=names[0])
+    check_freq_hz(f, file=path, field=names[0], min_points=0, where=where)
 
 
 def _finish(path, f, v, quantity, min_points, label, fmt, meta) -> FRF:
@@ -363,6 +651,8 @@ def _finish(path, f, v, quantity, min_points, label, fmt, meta) -> FRF:
         warnings.warn(f"{path}: dropped the 0 Hz point ({quantity} cannot be converted to receptance at 0 Hz)",
                       stacklevel=4)
         f, v = f[1:], v[1:]
+        if "coherence" in meta:
+            meta = {**meta, "coherence": meta["coherence"][1:]}
     if f.size == 0:
         raise InputError("no data points", file=path, field="data")
     if f.size < min_points:
@@ -371,25 +661,43 @@ def _finish(path, f, v, quantity, min_points, label, fmt, meta) -> FRF:
     return FRF(f, v, quantity, Path(path).stem if label is None else label, meta).to_receptance()
 
 
-def _for_write(path, frf: FRF) -> FRF:
-    """``frf`` as receptance, checked for writing."""
+def _for_write(path, frf: FRF, as_measured: bool = False) -> FRF:
+    """``frf`` as receptance (or as it is, ``as_measured``), checked for writing."""
     try:
-        r = frf.to_receptance()
-    except ValueError as exc:
-        raise InputError(str(exc), file=path, field="values") from None
+        r = frf if as_measured else frf.to_receptance()
+    except InputError as exc:
+        raise InputError(exc.message, file=path, field="values") from None
     if len(r) == 0:
         raise InputError("no data points to write", file=path, field="values")
-    _validate(path, r.freq_hz, r.values.real, r.values.imag, lambda i: f"point {i + 1}",
-              ("freq_hz", "values.real", "values.imag"))
+    if not r.is_siso:
+        raise InputError("an FRF file holds one response; write each entry (.entry(i, j)) to its own file",
+                         file=path, field="values")
     return r
 
 
-def _write_table(path, frf, header: str, sep: str) -> None:
-    r = _for_write(path, frf)
-    rows = "".join(f"{f:.17g}{sep}{z.real:.17g}{sep}{z.imag:.17g}\n" for f, z in zip(r.freq_hz, r.values))
+def _coherence_of(path, frf: FRF):
+    """``frf.meta["coherence"]`` checked for writing, or None when there is none."""
+    c = frf.meta.get("coherence")
+    if c is None:
+        return None
+    c = np.asarray(c, dtype=float).reshape(-1)
+    if c.size != len(frf):
+        raise InputError(f"meta['coherence'] has {c.size} values for {len(frf)} frequencies (an FRF cut with "
+                         "band()/at() keeps the old coherence: drop or cut it too)", file=path, field="coherence")
+    return _check_coherence(path, c, lambda i: f"{frf.freq_hz[i]:g} Hz")
+
+
+def _write_table(path, frf, header: str | None, sep: str, as_measured: bool = False) -> None:
+    r = _for_write(path, frf, as_measured)
+    coh = _coherence_of(path, r) if header is not None else None
+    cols = [r.freq_hz, r.values.real, r.values.imag] + ([coh] if coh is not None else [])
+    head = "" if header is None else header + (f"{sep}coherence" if coh is not None else "") + "\n"
+    fmt = sep.join(["{:.17g}"] * len(cols)) + "\n"
+    rows = "".join(fmt.format(*row) for row in zip(*cols))
     with atomic_open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(header + rows)
+        fh.write(head + rows)
 
 
-_READERS = {".csv": read_csv_frf, ".uff": read_uff58, ".unv": read_uff58, ".uf": read_uff58, ".frf": read_cutpro}
+_READERS = {".csv": read_csv_frf, ".uff": read_uff58, ".unv": read_uff58, ".uf": read_uff58, ".frf": read_cutpro,
+            ".txt": read_cutpro, ".tsv": read_cutpro, ".dat": read_cutpro}
 _WRITERS = {".csv": write_csv_frf, ".uff": write_uff58, ".unv": write_uff58, ".uf": write_uff58, ".frf": write_cutpro}

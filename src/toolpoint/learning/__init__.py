@@ -1,1 +1,2 @@
-"""Learning across a tool family: ANFIS (:mod:`.anfis`), the paper's metrics (:mod:`.metrics`), figures."""
+"""Learning across a tool family: ANFIS (:mod:`.anfis`), the paper's metrics (:mod:`.metrics`), figures
+(:mod:`.figures`)."""

@@ -91,9 +91,12 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_array, check_X_y
 
 from ..io.atomic import atomic_open
-from ..errors import ExtrapolationWarning
+from ..errors import ExtrapolationWarning, InputError
 
-__all__ = ["ANFIS", "MF_PARAMS", "membership", "genfis_params", "save_model", "load_model", "plot_membership"]
+__all__ = [
+    "ANFIS", "MF_PARAMS", "membership", "genfis_params", "save_model", "load_model", "predict_quietly",
+    "plot_membership",
+]
 
 #: Parameter names per membership-function type (MATLAB order).
 MF_PARAMS = {"gauss": ("sigma", "c"), "gbell": ("a", "b", "c"), "tri": ("a", "b", "c"), "trap": ("a", "b", "c", "d")}
@@ -313,6 +316,14 @@ def _step_change(e, k, last_dec, last_inc):
 
 
 # ----------------------------------------------------------------- validation
+def _is_int(v) -> bool:
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+
+
+def _is_real(v) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
 def _as_target(y, n, name):
     """1-D finite float target of length n (checking data)."""
     t = check_array(y, ensure_2d=False, dtype=float, input_name=name)
@@ -362,6 +373,16 @@ class ANFIS(RegressorMixin, BaseEstimator):
         checking data) and ``step_size`` (κ used for each epoch's update).
     best_epoch_ : 1-based epoch whose parameters were kept.
     n_features_in_, n_mfs_, input_names_, target_name_.
+
+    Examples
+    --------
+    A straight line is reproduced exactly by linear consequents:
+
+    >>> import numpy as np
+    >>> X = np.linspace(0.0, 1.0, 11)[:, None]
+    >>> model = ANFIS(n_mfs=2, mf="gauss", epochs=5).fit(X, 3.0 * X[:, 0] + 1.0)
+    >>> np.round(model.predict([[0.25], [0.5]]), 6).tolist()
+    [1.75, 2.5]
     """
 
     def __init__(
@@ -397,28 +418,57 @@ class ANFIS(RegressorMixin, BaseEstimator):
         self.verbose = verbose
 
     # ------------------------------------------------------------ helpers
-    def _check_params(self, d):
+    def check_params(self, n_inputs: int) -> tuple[int, ...]:
+        """Validate the settings for a model of ``n_inputs`` inputs (the one place they are checked).
+
+        Parameters
+        ----------
+        n_inputs : int
+            Number of input columns d.
+
+        Returns
+        -------
+        tuple of int
+            MFs per input (``n_mfs`` broadcast to d entries).
+
+        Raises
+        ------
+        InputError
+            A bad setting; ``err.field`` is the parameter's name (``n_mfs``, ``mf``,
+            ``order``, ``epochs``, ``step_size``, ``step_decrease``, ``step_increase``, ``tol``).
+
+        Examples
+        --------
+        >>> ANFIS(n_mfs=(3, 7)).check_params(2)
+        (3, 7)
+        >>> ANFIS(n_mfs=1).check_params(2)
+        Traceback (most recent call last):
+        ...
+        toolpoint.errors.InputError: n_mfs: must be at least 2 for every input, got 1
+        """
+        d = int(n_inputs)
         if self.mf not in MF_PARAMS:
-            raise ValueError(f"mf must be one of {', '.join(MF_PARAMS)}, got {self.mf!r}")
+            raise InputError(f"must be one of {', '.join(MF_PARAMS)}, got {self.mf!r}", field="mf")
         if isinstance(self.order, bool) or self.order not in (0, 1):
-            raise ValueError(f"order must be 0 (constant) or 1 (linear), got {self.order!r}")
-        m = np.atleast_1d(np.asarray(self.n_mfs))
-        if m.ndim != 1 or not all(isinstance(v, numbers.Integral) for v in m.tolist()):
-            raise ValueError(f"n_mfs must be an int or a sequence of ints, got {self.n_mfs!r}")
+            raise InputError(f"must be 0 (constant) or 1 (linear), got {self.order!r}", field="order")
+        m = np.atleast_1d(np.asarray(self.n_mfs, dtype=object))
+        if m.ndim != 1 or not all(_is_int(v) for v in m.tolist()):
+            raise InputError(f"must be an int or a sequence of ints, got {self.n_mfs!r}", field="n_mfs")
+        m = m.astype(int)
         if m.size == 1:
             m = np.repeat(m, d)
         if m.size != d:
-            raise ValueError(f"n_mfs has {m.size} entries but X has {d} input columns")
+            raise InputError(f"has {m.size} entries but X has {d} input columns", field="n_mfs")
         if np.any(m < 2):
-            raise ValueError(f"n_mfs must be at least 2 for every input, got {self.n_mfs!r}")
-        if not (isinstance(self.epochs, numbers.Integral) and self.epochs >= 1):
-            raise ValueError(f"epochs must be a positive integer, got {self.epochs!r}")
+            raise InputError(f"must be at least 2 for every input, got {self.n_mfs!r}", field="n_mfs")
+        if not (_is_int(self.epochs) and self.epochs >= 1):
+            raise InputError(f"must be a positive integer, got {self.epochs!r}", field="epochs")
         for name in ("step_size", "step_decrease", "step_increase"):
             v = getattr(self, name)
-            if not (isinstance(v, numbers.Real) and np.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be a positive number, got {v!r}")
-        if not (isinstance(self.tol, numbers.Real) and self.tol >= 0):
-            raise ValueError(f"tol must be a non-negative number, got {self.tol!r}")
+            if not (_is_real(v) and np.isfinite(v) and v > 0):
+                raise InputError(f"must be a positive number, got {v!r}", field=name)
+        if not (_is_real(self.tol) and self.tol >= 0):
+            raise InputError(f"must be a non-negative number, got {self.tol!r}", field="tol")
         return tuple(int(v) for v in m)
 
     def _transform_target(self, t, name="y"):
@@ -462,7 +512,7 @@ class ANFIS(RegressorMixin, BaseEstimator):
                 raise ValueError("sample_weight: fewer than 2 weights are non-zero")
             sw = sw / sw.mean()
         rw = np.sqrt(sw)
-        n_mfs = self._check_params(d)
+        n_mfs = self.check_params(d)
         t = self._transform_target(t_raw)
 
         if X_val is None and y_val is None and self.validation_data is not None:
@@ -529,7 +579,8 @@ class ANFIS(RegressorMixin, BaseEstimator):
             grads = _premise_gradient(nus, inv_s, dmus, rule_out, f, t, sw)
             norm = float(np.sqrt(sum(np.sum(g**2) for g in grads)))
             if norm > 0:
-                premise = [_make_valid(kind, P - kappa * g / norm, span[i]) for i, (P, g) in enumerate(zip(premise, grads))]
+                premise = [_make_valid(kind, P - kappa * g / norm, span[i])
+                           for i, (P, g) in enumerate(zip(premise, grads))]
             steps.append(kappa)
             # 4. step-size heuristic on the training-error sequence
             change = _step_change(train_rmse, k, last_dec, last_inc)
@@ -556,17 +607,50 @@ class ANFIS(RegressorMixin, BaseEstimator):
         }
         return self
 
-    def predict(self, X):
-        """Model output f(x) (10**f with ``log_target``); warns outside the training range."""
+    def outside_training_range(self, X) -> np.ndarray:
+        """Which samples lie outside the training input range (any input).
+
+        Parameters
+        ----------
+        X : array_like, shape (n, d)
+            Inputs, in the units the model was trained in.
+
+        Returns
+        -------
+        ndarray of bool, shape (n,)
+            True where some input is below or above its training range
+            (:attr:`input_range_`, with a tolerance of 1e-9 of the range).
+        """
         self._check_fitted()
         X = check_array(X, dtype=float)
         if X.shape[1] != self.n_features_in_:
-            raise ValueError(f"X has {X.shape[1]} features, but ANFIS is expecting {self.n_features_in_} features as input")
+            raise ValueError(f"X has {X.shape[1]} features, but ANFIS is expecting {self.n_features_in_} features "
+                             "as input")
         lo, hi = self.input_range_[:, 0], self.input_range_[:, 1]
         tol = 1e-9 * (hi - lo)
-        if np.any(X < lo - tol) or np.any(X > hi + tol):
+        return np.any((X < lo - tol) | (X > hi + tol), axis=1)
+
+    def predict(self, X):
+        """Model output f(x) (10**f with ``log_target``).
+
+        Parameters
+        ----------
+        X : array_like, shape (n, d)
+            Inputs, in the units the model was trained in.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            Predictions, in the unit of the target.
+
+        Warns
+        -----
+        ExtrapolationWarning
+            If a sample lies outside the training input range (see :func:`predict_quietly`).
+        """
+        if self.outside_training_range(X).any():  # also checks the model is fitted and X valid
             warnings.warn("ANFIS prediction outside the training input range", ExtrapolationWarning, stacklevel=2)
-        f = self._raw_predict(X)
+        f = self._raw_predict(check_array(X, dtype=float))
         return 10.0**f if self.log_target else f
 
     def _check_fitted(self):
@@ -616,7 +700,7 @@ class ANFIS(RegressorMixin, BaseEstimator):
             model = cls(**params)
             n_mfs = tuple(int(v) for v in doc["n_mfs"])
             d = len(n_mfs)
-            model._check_params(d)
+            model.check_params(d)
             p = len(MF_PARAMS[model.mf])
             premise = [np.array(P, dtype=float) for P in doc["premise"]]
             if len(premise) != d or any(P.shape != (m, p) for P, m in zip(premise, n_mfs)):
@@ -683,34 +767,33 @@ def load_model(path: str | os.PathLike) -> ANFIS:
     return ANFIS.load(path)
 
 
-def plot_membership(model: ANFIS, ax=None, input_names=None, n_points: int = 400):
-    """Plot the MFs of each input over its training range (one axes per input).
+def predict_quietly(model: ANFIS, X) -> tuple[np.ndarray, bool]:
+    """Predict without the :class:`~toolpoint.errors.ExtrapolationWarning`, and say whether it applied.
 
-    ``ax``: None (new pyplot figure) or a sequence of d matplotlib axes (a single
-    axes for a one-input model). Returns the figure.
+    For callers that report extrapolation themselves (once, in their own words).
+
+    Parameters
+    ----------
+    model : ANFIS
+        A fitted model.
+    X : array_like, shape (n, d)
+        Inputs, in the units the model was trained in.
+
+    Returns
+    -------
+    prediction : ndarray, shape (n,)
+        As :meth:`ANFIS.predict`, in the unit of the target.
+    outside : bool
+        Whether any sample lay outside the training input range.
     """
-    model._check_fitted()
-    d = model.n_features_in_
-    if ax is None:
-        import matplotlib.pyplot as plt
+    outside = bool(model.outside_training_range(X).any())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)
+        return model.predict(X), outside
 
-        fig, axes = plt.subplots(d, 1, figsize=(6.0, 2.2 * d), squeeze=False)
-        axes = axes[:, 0]
-    else:
-        axes = np.atleast_1d(np.asarray(ax, dtype=object)).ravel()
-        if axes.size != d:
-            raise ValueError(f"need {d} axes (one per input), got {axes.size}")
-        fig = axes[0].figure
-    names = input_names or model.input_names_ or [f"input {i + 1}" for i in range(d)]
-    for i, axi in enumerate(axes):
-        lo, hi = model.input_range_[i]
-        x = np.linspace(lo, hi, n_points)
-        mu = membership(model.mf, model.premise_[i], x)
-        for j in range(mu.shape[1]):
-            axi.plot(x, mu[:, j], label=f"MF {j + 1}")
-        axi.set_xlim(lo, hi)
-        axi.set_ylim(-0.02, 1.05)
-        axi.set_xlabel(names[i])
-        axi.set_ylabel("membership")
-    fig.tight_layout()
-    return fig
+
+def plot_membership(model: ANFIS, ax=None, input_names=None, n_points: int = 400):
+    """Same as :func:`toolpoint.learning.figures.plot_membership` (kept here for compatibility)."""
+    from .figures import plot_membership as plot
+
+    return plot(model, ax=ax, input_names=input_names, n_points=n_points)

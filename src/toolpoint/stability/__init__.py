@@ -2,26 +2,37 @@
 
 * :func:`zoa_lobes` — zero-order approximation (Altintas & Budak 1995),
   straight from x/y receptances; fast, exact for time-invariant cutting.
-* :func:`sdm_lobes` — first-order semi-discretisation (Insperger & Stépán
-  2002/2004) for modal models; needed at low radial immersion.
-* :func:`fit_modes` — modal fit of an FRF (:class:`ModalModel`) to feed the SDM.
+* :func:`sdm_lobes` — semi-discretisation (Insperger & Stépán 2002/2004) of a
+  state-space model of the tool point (:class:`StateSpaceModel`: real or
+  complex modes, cross terms); needed at low radial immersion.
+* :func:`fit_modes` — modal fit of an FRF (:class:`ModalModel`, real modes per
+  direction), one way to build the SDM's model; :func:`from_modal_fit` builds
+  it from common-pole fits of :mod:`toolpoint.dynamics.modal`.
 
-Units are SI inside (depth m, K_t N/m², receptance m/N); speeds in rpm.
+The cut is described once by :class:`CuttingConditions` (teeth, tangential
+cutting coefficient K_t in N/m², radial force ratio K_r = K_n/K_t, radial
+immersion a_e/D, down/up milling). Units are SI inside (depth m, K_t N/m²,
+receptance m/N); speeds in rpm.
 Geometry and sign conventions: :mod:`toolpoint.stability.milling`.
 """
 
+from .cutting import CuttingConditions
 from .milling import Lobe, LobeResult, average_directional_matrix, directional_coefficients, immersion_angles
 from .modalfit import ModalModel, fit_modes
 from .sdm import sdm_lobes, sdm_spectral_radius
+from .statespace import StateSpaceModel, from_modal_fit
 from .zoa import zoa_lobes
 
 __all__ = [
+    "CuttingConditions",
     "Lobe",
     "LobeResult",
     "ModalModel",
+    "StateSpaceModel",
     "average_directional_matrix",
     "directional_coefficients",
     "fit_modes",
+    "from_modal_fit",
     "immersion_angles",
     "sdm_lobes",
     "sdm_spectral_radius",

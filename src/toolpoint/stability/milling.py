@@ -43,50 +43,40 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from .cutting import MILLING  # noqa: F401  (re-exported: the old home of the name)
 
-MILLING = ("down", "up")
-
-
-def single_thread_blas():
-    """Context: BLAS/LAPACK on one thread.
-
-    The solvers call LAPACK on stacks of small matrices (or tall-thin least
-    squares); there OpenBLAS threads only contend — measured 6–20× slower on
-    the 2-core development machine.
-    """
-    from threadpoolctl import threadpool_limits
-
-    return threadpool_limits(1, user_api="blas")
+# Most spindle speeds one call evaluates: the envelope work grows with speeds ×
+# lobes, and a chart never needs more points than a screen has pixels × 10.
+MAX_RPM_POINTS = 100_000
 
 
 # ----------------------------------------------------------------- validation
-def check_cutting(teeth, kt, kr, radial_immersion, milling) -> tuple[int, float, float, float, str]:
-    """Validate the cutting parameters shared by both solvers (raises InputError)."""
-    try:
-        n = int(teeth)
-    except (TypeError, ValueError):
-        raise InputError(f"must be a positive integer, got {teeth!r}", field="teeth") from None
-    if n != teeth or n < 1:
-        raise InputError(f"must be a positive integer, got {teeth!r}", field="teeth")
-    kt = float(kt)
-    if not np.isfinite(kt) or kt <= 0:
-        raise InputError(f"tangential cutting coefficient must be > 0 N/m², got {kt:g}", field="kt")
-    kr = float(kr)
-    if not np.isfinite(kr) or kr < 0:
-        raise InputError(f"radial ratio Kn/Kt must be finite and ≥ 0, got {kr:g}", field="kr")
-    ri = float(radial_immersion)
-    if not (0.0 < ri <= 1.0):
-        raise InputError(f"radial immersion a_e/D must be in (0, 1], got {ri:g}", field="radial_immersion")
-    if milling not in MILLING:
-        raise InputError(f"must be 'down' or 'up', got {milling!r}", field="milling")
-    return n, kt, kr, ri, milling
-
-
 def check_rpm(rpm) -> np.ndarray:
-    """Spindle speeds (rpm): finite, > 0, strictly increasing, at least one."""
-    r = np.asarray(rpm, dtype=float).reshape(-1)
+    """Spindle speeds as a 1-D float array, rpm, checked.
+
+    Parameters
+    ----------
+    rpm : array_like
+        Speeds, rpm: finite, > 0, strictly increasing, 1 … ``MAX_RPM_POINTS`` of them.
+
+    Returns
+    -------
+    numpy.ndarray
+        The speeds, rpm.
+
+    Raises
+    ------
+    InputError
+        Field ``rpm``.
+    """
+    try:
+        r = np.asarray(rpm, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError("spindle speeds must be numbers", field="rpm") from None
     if r.size < 1:
         raise InputError("need at least one spindle speed", field="rpm")
+    if r.size > MAX_RPM_POINTS:
+        raise InputError(f"{r.size} spindle speeds, at most {MAX_RPM_POINTS} are evaluated in one call", field="rpm")
     if not np.all(np.isfinite(r)) or r[0] <= 0:
         raise InputError("spindle speeds must be finite and > 0 rpm", field="rpm")
     if np.any(np.diff(r) <= 0):
@@ -96,7 +86,24 @@ def check_rpm(rpm) -> np.ndarray:
 
 # ----------------------------------------------------------------- geometry
 def immersion_angles(radial_immersion: float, milling: str = "down") -> tuple[float, float]:
-    """Entry and exit angles (φ_st, φ_ex) in rad for radial immersion a_e/D ∈ (0, 1]."""
+    """Entry and exit angles of a tooth.
+
+    Parameters
+    ----------
+    radial_immersion : float
+        a_e/D ∈ (0, 1], dimensionless.
+    milling : {"down", "up"}
+
+    Returns
+    -------
+    (phi_st, phi_ex) : tuple of float
+        rad; up-milling (0, arccos(1 − 2a_e/D)), down-milling (arccos(2a_e/D − 1), π).
+
+    Examples
+    --------
+    >>> immersion_angles(1.0, "up") == (0.0, float(np.pi))
+    True
+    """
     ri = float(radial_immersion)
     if milling == "up":
         return 0.0, float(np.arccos(1.0 - 2.0 * ri))
@@ -105,11 +112,12 @@ def immersion_angles(radial_immersion: float, milling: str = "down") -> tuple[fl
     raise InputError(f"must be 'down' or 'up', got {milling!r}", field="milling")
 
 
-def _h_integral(phi, kr: float) -> np.ndarray:
+def _h_integral(phi, radial_ratio: float) -> np.ndarray:
     """Antiderivative ∫ H(φ) dφ / K_t of one tooth's directional matrix, shape (..., 2, 2).
 
     From ∫sc = −cos2φ/4, ∫s² = φ/2 − sin2φ/4, ∫c² = φ/2 + sin2φ/4.
     """
+    kr = radial_ratio
     phi = np.asarray(phi, dtype=float)
     c2, s2 = np.cos(2 * phi), np.sin(2 * phi)
     isc = -c2 / 4
@@ -123,24 +131,63 @@ def _h_integral(phi, kr: float) -> np.ndarray:
     return out
 
 
-def directional_coefficients(phi_st: float, phi_ex: float, kr: float) -> np.ndarray:
-    """Altintas' directional coefficients [α] (2×2, dimensionless), see module docstring."""
-    return -2.0 * (_h_integral(phi_ex, kr) - _h_integral(phi_st, kr))
+def directional_coefficients(phi_st: float, phi_ex: float, radial_ratio: float) -> np.ndarray:
+    """Altintas' directional coefficients [α] (module docstring), 2×2, dimensionless.
+
+    Parameters
+    ----------
+    phi_st, phi_ex : float
+        Entry and exit angles, rad.
+    radial_ratio : float
+        K_r = K_n/K_t, dimensionless.
+
+    Examples
+    --------
+    >>> (directional_coefficients(0.0, np.pi, 0.0).round(6) + 0.0).tolist()  # slotting: [[0, −π], [π, 0]]
+    [[0.0, -3.141593], [3.141593, 0.0]]
+    """
+    return -2.0 * (_h_integral(phi_ex, radial_ratio) - _h_integral(phi_st, radial_ratio))
 
 
-def average_directional_matrix(teeth: int, kt: float, kr: float, phi_st: float, phi_ex: float) -> np.ndarray:
-    """Tooth-pass average H₀ = −N K_t [α]/(4π) of H(t) in (1), N/m² (2×2)."""
-    return -teeth * kt * directional_coefficients(phi_st, phi_ex, kr) / (4 * np.pi)
+def average_directional_matrix(teeth: int, tangential_coeff: float, radial_ratio: float, phi_st: float,
+                               phi_ex: float) -> np.ndarray:
+    """Tooth-pass average H₀ = −N K_t [α]/(4π) of H(t) in (1), N/m² (2×2).
+
+    Parameters
+    ----------
+    teeth : int
+        N.
+    tangential_coeff : float
+        K_t, N/m².
+    radial_ratio : float
+        K_r = K_n/K_t, dimensionless.
+    phi_st, phi_ex : float
+        Entry and exit angles, rad.
+    """
+    return -teeth * tangential_coeff * directional_coefficients(phi_st, phi_ex, radial_ratio) / (4 * np.pi)
 
 
-def interval_directional_matrix(phi_edges, teeth: int, kt: float, kr: float, phi_st: float, phi_ex: float) -> np.ndarray:
-    """Average of H(t) over each interval of tooth-0 angle, shape (len(phi_edges) − 1, 2, 2), N/m².
+def interval_directional_matrix(phi_edges, teeth: int, tangential_coeff: float, radial_ratio: float,
+                                phi_st: float, phi_ex: float) -> np.ndarray:
+    """Average of H(t) over each interval of tooth-0 angle.
 
-    Interval i spans tooth-0 angles [φ_i, φ_{i+1}] (φ increases linearly in
-    time, so the angle average is the time average). Every tooth j contributes
-    over its own angles φ + 2πj/N clipped to the cut [φ_st, φ_ex] — the screen
-    function g — so jumps of H at entry/exit inside an interval are averaged
-    exactly.
+    Interval i spans tooth-0 angles [φ_i, φ_{i+1}] (rad; φ increases linearly
+    in time, so the angle average is the time average). Every tooth j
+    contributes over its own angles φ + 2πj/N clipped to the cut
+    [φ_st, φ_ex] — the screen function g — so jumps of H at entry/exit inside
+    an interval are averaged exactly.
+
+    Parameters
+    ----------
+    phi_edges : array_like
+        Increasing interval edges of the tooth-0 angle, rad.
+    teeth, tangential_coeff, radial_ratio, phi_st, phi_ex
+        As in :func:`average_directional_matrix` (K_t in N/m², angles in rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (len(phi_edges) − 1, 2, 2), N/m².
     """
     e = np.asarray(phi_edges, dtype=float)
     lo, hi = e[:-1], e[1:]
@@ -152,8 +199,8 @@ def interval_directional_matrix(phi_edges, teeth: int, kt: float, kr: float, phi
     for wrap in (0.0, -2 * np.pi):  # intervals straddling φ_st + 2π fold back one turn
         aa = np.clip(a + wrap, phi_st, phi_ex)
         bb = np.clip(b + wrap, phi_st, phi_ex)
-        total += (_h_integral(bb, kr) - _h_integral(aa, kr)).sum(axis=0)
-    return kt * total / (hi - lo)[:, None, None]
+        total += (_h_integral(bb, radial_ratio) - _h_integral(aa, radial_ratio)).sum(axis=0)
+    return tangential_coeff * total / (hi - lo)[:, None, None]
 
 
 # ----------------------------------------------------------------- results
@@ -161,8 +208,18 @@ def interval_directional_matrix(phi_edges, teeth: int, kt: float, kr: float, phi
 class Lobe:
     """One lobe: the points of the stability boundary with k whole chatter waves per tooth period.
 
-    k = floor(f_c T), T the tooth period; ``branch`` tells the eigenvalue branch
-    (zero-order approximation: 0 or 1; semi-discretisation: 0).
+    Attributes
+    ----------
+    k : int
+        Lobe number, k = floor(f_c T), T the tooth period.
+    branch : int
+        Eigenvalue branch (zero-order approximation: 0 or 1; semi-discretisation: 0).
+    rpm : numpy.ndarray
+        Spindle speeds of the points, rpm.
+    depth_m : numpy.ndarray
+        Axial depth limit at the points, m.
+    chatter_hz : numpy.ndarray
+        Chatter frequency at the points, Hz.
     """
 
     k: int
@@ -178,16 +235,28 @@ class LobeResult:
 
     Attributes
     ----------
-    rpm : (n,) spindle speeds, rpm.
-    depth_m : (n,) stability limit (axial depth, m), the minimum over lobes;
-        ``inf`` where no lobe (ZOA) or no instability up to the searched depth
-        (SDM) was found.
-    chatter_hz : (n,) chatter frequency of the limiting lobe, Hz (nan with inf depth).
-    lobes : the individual lobes (each its own points, inside the speed range).
-    method : ``"zoa"`` or ``"sdm"``.
-    min_depth_m, min_rpm, min_chatter_hz : absolute minimum of the limit in the
-        range, refined between grid points where the method allows.
-    params : the cutting parameters and solver settings used.
+    rpm : numpy.ndarray
+        (n,) spindle speeds, rpm.
+    depth_m : numpy.ndarray
+        (n,) stability limit (axial depth, m), the minimum over lobes; ``inf``
+        where no lobe (ZOA) or no instability up to the searched depth (SDM)
+        was found.
+    chatter_hz : numpy.ndarray
+        (n,) chatter frequency of the limiting lobe, Hz (nan with inf depth).
+    lobes : list of Lobe
+        The individual lobes (each its own points, inside the speed range).
+    method : str
+        ``"zoa"`` or ``"sdm"``.
+    min_depth_m, min_rpm, min_chatter_hz : float
+        Absolute minimum of the limit in the range (m, rpm, Hz), refined
+        between grid points where the method allows.
+    params : dict
+        The cutting conditions (``params["cutting"]``, a
+        :class:`~toolpoint.stability.cutting.CuttingConditions`, and its
+        fields) and solver settings used.
+    limit_lobe : numpy.ndarray or None
+        (n,) lobe number k of the limiting lobe at each speed, when the solver
+        knows it (ZOA); see :attr:`lobe_number`.
     """
 
     rpm: np.ndarray
@@ -199,21 +268,68 @@ class LobeResult:
     min_rpm: float = float("nan")
     min_chatter_hz: float = float("nan")
     params: dict = field(default_factory=dict, compare=False)
+    limit_lobe: np.ndarray | None = field(default=None, compare=False)
 
     @property
     def depth_mm(self) -> np.ndarray:
+        """The stability limit in mm (``1e3 * depth_m``)."""
         return 1e3 * self.depth_m
 
+    @property
+    def lobe_number(self) -> np.ndarray:
+        """Lobe number k of the limiting lobe per speed; −1 where no limit.
+
+        ``limit_lobe`` when the solver gave it, else k = floor(f_c T), T = 60/(N n) s.
+        """
+        if self.limit_lobe is not None:
+            return np.where(np.isfinite(self.depth_m), self.limit_lobe, -1).astype(int)
+        teeth = self.params.get("teeth", 1)
+        ok = np.isfinite(self.depth_m) & np.isfinite(self.chatter_hz)
+        with np.errstate(invalid="ignore"):
+            waves = self.chatter_hz * 60.0 / (teeth * self.rpm)
+        # Points on a lobe's own boundary (f_c T an integer up to round-off) belong to the lower k.
+        return np.where(ok, np.floor(np.where(ok, waves, 0.0) + 1e-9), -1).astype(int)
+
     def pocket(self) -> tuple[float, float]:
-        """Best stable pocket: (rpm, depth m) of the maximum limit on the grid (inf if unbounded)."""
-        d = self.depth_m
-        if np.all(np.isnan(d)):
+        """Best stable pocket: the highest local maximum of the limit strictly inside the speed range.
+
+        A local maximum is a run of equal finite limits whose neighbours on
+        both sides are lower, so a limit still rising at either end of the
+        range is not a pocket (the best speed may lie outside it).
+
+        Returns
+        -------
+        (rpm, depth_m) : tuple of float
+            rpm and m; ``(nan, nan)`` when the limit has no such maximum.
+        """
+        d = np.asarray(self.depth_m, dtype=float)
+        if d.size < 3:
             return float("nan"), float("nan")
-        i = int(np.nanargmax(d))
-        return float(self.rpm[i]), float(d[i])
+        start = np.r_[0, np.flatnonzero(d[1:] != d[:-1]) + 1]  # runs of equal values
+        stop = np.r_[start[1:], d.size]
+        inner = (start > 0) & (stop < d.size)
+        start, stop = start[inner], stop[inner]
+        val = d[start]
+        peak = np.isfinite(val) & (d[start - 1] < val) & (d[stop] < val)
+        if not peak.any():
+            return float("nan"), float("nan")
+        j = int(np.argmax(np.where(peak, val, -np.inf)))
+        mid = (start[j] + stop[j] - 1) // 2
+        return float(self.rpm[mid]), float(d[mid])
 
     def plot(self, ax=None, **kw):
-        """Stability chart (see :func:`toolpoint.stability.plot.plot_lobes`); returns the axes."""
+        """Stability chart, speed (rpm) against depth (mm).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+        **kw
+            Passed to :func:`toolpoint.stability.plot.plot_lobes`.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+        """
         from .plot import plot_lobes
 
         return plot_lobes(self, ax=ax, **kw)

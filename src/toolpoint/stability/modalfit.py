@@ -32,7 +32,7 @@ from scipy.signal import find_peaks
 
 from ..errors import InputError
 from ..frf import FRF
-from .milling import single_thread_blas
+from ..blas import single_thread_blas
 
 __all__ = ["ModalModel", "fit_modes"]
 
@@ -72,6 +72,7 @@ class ModalModel:
 
     @property
     def n_modes(self) -> int:
+        """Number of modes."""
         return self.fn_hz.size
 
     @property
@@ -90,7 +91,27 @@ class ModalModel:
         return 2 * self.zeta * self.mass_kg * self.omega_n
 
     def frf(self, freq_hz, *, residuals: bool = True) -> FRF:
-        """Re-synthesised receptance (m/N) at ``freq_hz`` (residual terms optional)."""
+        """Re-synthesised receptance at ``freq_hz``.
+
+        Parameters
+        ----------
+        freq_hz : array_like
+            Increasing frequencies, Hz.
+        residuals : bool
+            Include the residual terms R_u − R_l/ω².
+
+        Returns
+        -------
+        FRF
+            Receptance, m/N.
+
+        Examples
+        --------
+        >>> m = ModalModel([100.0], [0.05], [2.0])
+        >>> k = m.stiffness[0]                         # N/m
+        >>> bool(np.isclose(m.frf([0.0]).values[0], 1 / k))   # static compliance 1/k, m/N
+        True
+        """
         f = np.asarray(freq_hz, dtype=float).reshape(-1)
         w = 2 * np.pi * f
         basis = _mode_basis(w, self.omega_n, self.zeta)

@@ -1,4 +1,4 @@
-"""Stability chart of a :class:`~toolpoint.stability.milling.LobeResult`."""
+"""Stability chart of a :class:`~toolpoint.stability.milling.LobeResult` (speed in rpm, depth in mm)."""
 
 from __future__ import annotations
 
@@ -6,10 +6,21 @@ import numpy as np
 
 
 def chart_top_mm(result) -> float:
-    """Upper depth of the chart, mm: the highest finite limit (+10 %), at most 10 × the absolute minimum.
+    """Upper depth of the chart, mm.
 
-    Lobe flanks rise steeply toward the stable pockets; without the cap one
-    tall pocket would flatten everything else.
+    The highest finite limit (+10 %), at most 10 × the absolute minimum —
+    lobe flanks rise steeply and one tall pocket would flatten everything
+    else — but always above the best pocket (+10 %), so its marker is inside
+    the axes.
+
+    Parameters
+    ----------
+    result : LobeResult
+
+    Returns
+    -------
+    float
+        mm.
     """
     d = result.depth_mm
     fin = d[np.isfinite(d)]
@@ -17,16 +28,33 @@ def chart_top_mm(result) -> float:
         return 1.0
     top = 1.1 * fin.max()
     low = 1e3 * result.min_depth_m if np.isfinite(result.min_depth_m) else fin.min()
-    return float(min(top, 10 * low)) if low > 0 else float(top)
+    top = float(min(top, 10 * low)) if low > 0 else float(top)
+    pocket = 1e3 * result.pocket()[1]
+    return max(top, 1.1 * pocket) if np.isfinite(pocket) else top
 
 
 def plot_lobes(result, ax=None, *, show_lobes: bool | None = None, ymax_mm: float | None = None, annotate: bool = True):
     """Draw the stability limit, shade the unstable region above it, and the lobes.
 
     Axes: spindle speed [rpm] against axial depth of cut [mm]. ``inf`` limits
-    (no instability found) are drawn at the top of the chart. ``show_lobes``
-    (default: for the zero-order approximation, whose lobes extend beyond the
-    limit) draws every lobe thin. Returns ``ax``.
+    (no instability found) are drawn at the top of the chart.
+
+    Parameters
+    ----------
+    result : LobeResult
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure by default).
+    show_lobes : bool, optional
+        Draw every lobe thin (default: for the zero-order approximation, whose
+        lobes extend beyond the limit).
+    ymax_mm : float, optional
+        Top of the depth axis, mm (default :func:`chart_top_mm`).
+    annotate : bool
+        Mark the absolute minimum and the best pocket (when they lie inside the axes).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
     """
     if ax is None:
         import matplotlib.pyplot as plt
@@ -42,12 +70,18 @@ def plot_lobes(result, ax=None, *, show_lobes: bool | None = None, ymax_mm: floa
         for i, lobe in enumerate(result.lobes):
             ax.plot(lobe.rpm, 1e3 * lobe.depth_m, color="0.55", lw=0.7, label="lobes" if i == 0 else None)
     ax.plot(rpm, d, color="tab:blue", lw=1.6, label=f"stability limit ({result.method.upper()})")
-    if annotate and np.isfinite(result.min_depth_m):
-        ax.plot([result.min_rpm], [1e3 * result.min_depth_m], "v", color="k", ms=6,
-                label=f"minimum {1e3 * result.min_depth_m:.3g} mm @ {result.min_rpm:.0f} rpm")
+    if annotate:
+        # Markers only where they fall inside the axes (a given ymax_mm can be lower).
+        def inside(r, d_mm):
+            return np.isfinite(d_mm) and rpm[0] <= r <= rpm[-1] and 0 <= d_mm <= top
+
+        mr, md = result.min_rpm, 1e3 * result.min_depth_m
+        if inside(mr, md):
+            ax.plot([mr], [md], "v", color="k", ms=6, label=f"minimum {md:.3g} mm @ {mr:.0f} rpm")
         pr, pd = result.pocket()
-        if np.isfinite(pd):
-            ax.plot([pr], [1e3 * pd], "^", color="tab:green", ms=7, label=f"best pocket {1e3 * pd:.3g} mm @ {pr:.0f} rpm")
+        if inside(pr, 1e3 * pd):
+            ax.plot([pr], [1e3 * pd], "^", color="tab:green", ms=7,
+                    label=f"best pocket {1e3 * pd:.3g} mm @ {pr:.0f} rpm")
     ax.set_xlim(rpm[0], rpm[-1])
     ax.set_ylim(0, top)
     ax.set_xlabel("spindle speed [rpm]")

@@ -1,109 +1,116 @@
-"""First-order semi-discretisation (SDM) of milling stability for modal models.
+"""Semi-discretisation (SDM) of milling stability for state-space tool-point models.
 
 Insperger & Stépán (2002) "Semi-discretization method for delayed systems",
 IJNME 55:503–518; (2004) "Updated semi-discretization method for periodic
 delay-differential equations with discrete delay", IJNME 61:117–141.
 
-Model. Modes r (mass m_r, stiffness k_r, damping c_r) in x and/or y, modal
-coordinates q, x = Σ_{r∈x} q_r, y = Σ_{r∈y} q_r (u = S q). With (1) of
-:mod:`~toolpoint.stability.milling`,
+Model. The tool point is ż = A z + B F, r = C z
+(:class:`~toolpoint.stability.statespace.StateSpaceModel`: n states, forces
+F = (F_x, F_y) in N, displacements r = (x, y) in m). With the directional
+matrix H(t) (N/m² per m of chip, :mod:`~toolpoint.stability.milling`) the
+regenerative force at axial depth a (m) is F = −a H(t) [r(t) − r(t − T)],
+T = 60/(N n) s the tooth period, so
 
-    M q̈ + C q̇ + K q = −a Sᵀ H(t) S [q(t) − q(t − T)],     T = 60/(N n).
+    ż = (A − a B H(t) C) z + a B H(t) r(t − T).
 
-In state form ẏ = A(t) y + B(t) u(t − T), y = (q, q̇):
+Only the d directions that move (non-zero rows of C) and the force
+directions that excite the model (non-zero columns of B) are kept.
 
-    A(t) = [[0, I], [−M⁻¹(K + a SᵀH(t)S), −M⁻¹C]],  B(t) = [[0], [a M⁻¹SᵀH(t)]].
+Discretisation. Time runs from a tooth's entry. H(t) is non-zero only on the
+cut [0, t_c], t_c = min(T, (φ_ex − φ_st)/Ω) s, Ω the spindle speed in rad/s.
+The cut is split into m steps Δt = t_c/m; on each, H is replaced by its
+exact average H_i (:func:`~toolpoint.stability.milling.interval_directional_matrix`)
+and the delayed displacement by the straight line between its values at the
+step's ends one period earlier (first order). Then exactly
 
-Discretisation. Time is measured from a tooth's entry. H(t) is non-zero only
-on the cut [0, t_c], t_c = min(T, (φ_ex − φ_st)/Ω), and vanishes in free
-flight [t_c, T]. The cut is split into ``m`` steps Δt = t_c/m with nodes t_i;
-on each, H is replaced by its exact average H_i (see
-:func:`~toolpoint.stability.milling.interval_directional_matrix`) and the
-delayed term by the straight line between the nodes one period earlier
-(first-order SDM: u(t−T) ≈ u_{i−m*} + (t − t_i)/Δt · (u_{i−m*+1} − u_{i−m*}),
-where "m*" denotes the same node of the previous period). Then exactly
-
-    y_{i+1} = P_i y_i + (Γ0_i − Γ1_i) u'_i + Γ1_i u'_{i+1},
+    z_{i+1} = P_i z_i + (Γ0_i − Γ1_i) r'_i + Γ1_i r'_{i+1},
     P_i = e^{A_iΔt},  Γ0_i = ∫₀^Δt e^{A_i(Δt−s)} ds B_i,  Γ1_i = ∫₀^Δt e^{A_i(Δt−s)} (s/Δt) ds B_i,
 
-all three from one exponential of the block matrix
-[[A_iΔt, B_iΔt, 0], [0, 0, I], [0, 0, 0]] (Van Loan). Free flight is solved
-exactly, y(T) = e^{A₀(T − t_c)} y_m: with H = 0 there is no delayed term, so
-this equals the classic uniform-step SDM there, at no cost. Because the delay
-is one tooth period, the nodes of the previous period are the delayed nodes,
-so the state z = (y_0, u'_0, …, u'_m) of size 2n + (m+1)d (d flexible
-directions) maps linearly over one period: z' = Φ z. The cut is stable iff the
-spectral radius ρ(Φ) < 1 (Floquet).
+with A_i = A − a B H_i C, B_i = a B H_i and r' the delayed displacement; all
+three come from one exponential of the block matrix
+[[A_iΔt, B_iΔt, 0], [0, 0, I], [0, 0, 0]] (Van Loan). Free flight
+[t_c, T] has no delayed term and is solved exactly, z(T) = e^{A(T − t_c)} z(t_c).
 
-Discretisation number m. ``m`` counts steps over the *cut*, not over the
-whole tooth period as in Insperger & Stépán; the two coincide whenever a
-tooth still cuts when the next one enters (slotting with ≥ 2 teeth, for
-instance); at a/D = 0.05 (2 teeth, down-milling: cut ≈ 14 % of the
-period) m = 20 over the cut has the resolution of ≈ 140 uniform steps. The
-error is O(Δt²) and grows with the number of chatter waves per cut (high
-lobe numbers, low speeds), so by default m is set per speed to 20 steps per
-wave of 1.1 × the highest natural frequency, at least 20 and at most 200
-(``params["m"]`` of the result). Convergence on the benchmark of Insperger &
-Stépán 2004 (2 teeth, K_t = 6e8 N/m², K_n = 2e8 N/m², f_n = 922 Hz,
-ζ = 0.011, modal mass 0.03993 kg, x only, down-milling; limit in mm at 7424,
-10051, 15909, 21000 rpm for slotting, at 7500, 10000, 15800, 18900 rpm for
-a/D = 0.05; benchmarks/bench_lobes.py):
+Delayed-displacement nodes. The delayed displacement is carried at every
+s-th step only (q + 1 = m/s + 1 nodes over the cut) and interpolated to the
+m + 1 step ends by local Lagrange polynomials of degree 7 (``s = 1``:
+every node, the plain first-order SDM). Because the delay is one tooth
+period, the state ζ = (z_0, r_0, …, r_q) of size n + (q + 1)d maps linearly
+over one period, ζ' = Φ ζ; the cut is stable iff the spectral radius
+ρ(Φ) < 1 (Floquet).
 
-    slotting  m =  20: 0.36475 0.34356 0.32702 2.29568
-              m =  40: 0.32736 0.32445 0.31985 2.26602   (max change 10 %)
-              m =  80: 0.31891 0.31992 0.31809 2.25860   (2.6 %)
-              m = 160: 0.31685 0.31880 0.31765 2.25674   (0.65 %)
-              default, m = 96, 68, 40, 32: 0.31807 0.32050 0.31985 2.27159
-    a/D=0.05  m =  20: 2.62511 4.09208 5.99221 4.14411   (default; 0.28 % from m = 10)
-              m =  40: 2.62326 4.09106 5.99254 4.14583   (0.07 %)
+Default resolution. A chatter wave is a period of f_w = 1.1 × the highest
+zero-order chatter frequency of the speed range, Hz (1.1 × the highest
+natural frequency without a zero-order lobe, with ``seed=False`` and in
+:func:`sdm_spectral_radius`). Per speed,
+m = accuracy · 30 · f_w t_c on a ladder 20, 24, 28, 32, 40, … (≈ 2^(1/4)
+apart) within [20, m_max], and s is the largest divisor of m (≤ 16) leaving
+at least 8 · accuracy nodes per wave and 8 node intervals over the cut.
+``m`` counts steps over the cut, not over the tooth period. Measured
+accuracy and cost are in ``docs/design/stability.md``.
 
-The default changes by < 1 % when m is doubled (tests/test_stability_sdm.py).
-Near cusps, where two lobes meet, the limit is steep in speed and the
-relative change at one fixed speed can be larger.
-
-Stability limit. For each speed the depth is raised geometrically (ratio
-``step``) from a small value until ρ ≥ 1 — only the still-stable speeds are
-evaluated at each level, all at once — then bisected (geometric mean) to a
-relative width ``rtol`` (default 1e-3, well below the discretisation error). An unstable band thinner than ``step`` in depth
-(the tip of a flip-lobe island) can be stepped over.
-
-Cost: eigenvalues of the (2n + (m+1)d)² Floquet matrices dominate; BLAS is
-held to one thread meanwhile (threads only contend on stacks of small
-matrices). One mode, 100 speeds: ≈ 2 s in slotting (m up to 136), ≈ 0.3 s at
-a/D = 0.05 (m = 20) on the 2-core development machine.
+Stability limit. Per speed the depth starts at half the zero-order limit
+(or at ``depth_min`` where no zero-order lobe covers the speed, or where
+the start is already unstable), rises geometrically (ratio ``step``) until
+ρ ≥ 1, and the bracket is then shrunk by Illinois false position on ln ρ
+against ln a, with bisection steps, to a relative width ``rtol``. An
+unstable band thinner than ``step`` in depth can be stepped over. Speeds are
+searched in blocks of 50, all still-open speeds of a block at once; BLAS is
+held to one thread meanwhile.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import matrix_balance
 
+from ..blas import single_thread_blas
 from ..errors import InputError
-from .milling import (
-    Lobe,
-    LobeResult,
-    check_cutting,
-    check_rpm,
-    immersion_angles,
-    interval_directional_matrix,
-    single_thread_blas,
-)
-from .modalfit import ModalModel
+from .cutting import CuttingConditions, resolve_cutting
+from .milling import Lobe, LobeResult, check_rpm, interval_directional_matrix
+from .statespace import StateSpaceModel
 
-__all__ = ["sdm_lobes", "sdm_spectral_radius", "expm_batch", "STEPS_PER_WAVE"]
+__all__ = ["sdm_lobes", "sdm_spectral_radius", "as_state_space", "expm_batch", "STEPS_PER_WAVE", "NODES_PER_WAVE"]
 
-STEPS_PER_WAVE = 20  # default resolution: steps of the cut per chatter wave
+STEPS_PER_WAVE = 30
+"""Default steps of the cut per chatter wave at ``accuracy=1`` (module docstring)."""
+NODES_PER_WAVE = 8
+"""Default delayed-displacement nodes per chatter wave at ``accuracy=1``."""
+INTERP_DEGREE = 7  # local Lagrange interpolation of the delayed displacement between nodes
+MIN_NODES = 8  # fewest node intervals over the cut
+WAVE_MARGIN = 1.1  # resolution frequency / highest zero-order chatter frequency
 M_MIN, M_MAX = 20, 200  # bounds of the step count over the cut
+SEED_FRACTION = 0.5  # the seeded search starts at this fraction of the zero-order limit
+_BLOCK_SPEEDS = 50  # speeds searched together (progress is reported per block)
+_ZOA_POINTS = 200_000  # most frequency points of the zero-order seed
 # Soft cap on floats held by one batch (expm blocks and Floquet matrices).
 _CHUNK_FLOATS = 4_000_000
 
 
 # ------------------------------------------------------------------ batched expm
 def expm_batch(X: np.ndarray) -> np.ndarray:
-    """exp(X) for a stack (..., k, k): Taylor degree 12 with per-matrix scaling and squaring.
+    """Matrix exponentials of a stack of small square matrices.
 
-    With ‖X/2^s‖₁ ≤ 1/2 the truncation error is < 0.5¹³/13! ≈ 2e-14. Stacked
-    small matmuls in NumPy are ~10× faster here than scipy.linalg.expm's
-    per-matrix Padé for the 4×4 … 16×16 blocks of the SDM.
+    Taylor polynomial of degree 12 (Horner) of X/2^s with a per-matrix s such
+    that ‖X/2^s‖₁ ≤ 1/2 (truncation error < 0.5¹³/13! ≈ 2e-14 relative), then
+    s squarings. Stacked matrix products keep the work in NumPy, without a
+    Python loop over the matrices.
+
+    Parameters
+    ----------
+    X : numpy.ndarray
+        (..., k, k) real or complex matrices (dimensionless: time already multiplied in).
+
+    Returns
+    -------
+    numpy.ndarray
+        e^X, same shape.
+
+    Examples
+    --------
+    >>> E = expm_batch(np.array([[[0.0, 1.0], [-1.0, 0.0]]]))  # a rotation by 1 rad
+    >>> bool(np.allclose(E[0], [[np.cos(1), np.sin(1)], [-np.sin(1), np.cos(1)]]))
+    True
     """
     shape = X.shape
     X = X.reshape(-1, shape[-2], shape[-1])
@@ -128,52 +135,72 @@ def _m_ladder(m_max: int) -> np.ndarray:
     return np.r_[ladder[ladder < m_max], m_max]
 
 
-class _System:
-    """Modal matrices and cut geometry for one cutting condition; discretisations cached per m."""
+def _interp_matrix(m: int, s: int, degree: int = None) -> np.ndarray:
+    """(m + 1, q + 1) weights of local Lagrange interpolation from q + 1 = m/s + 1 nodes to m + 1 nodes.
 
-    def __init__(self, modes_x, modes_y, teeth, kt, kr, radial_immersion, milling):
-        if modes_x is None and modes_y is None:
-            raise InputError("need modes in x, y or both", field="modes")
-        groups = [(d, mm) for d, mm in ((0, modes_x), (1, modes_y)) if mm is not None]
-        for d, mm in groups:
-            if not isinstance(mm, ModalModel):
-                raise InputError(f"expected a ModalModel, got {type(mm).__name__}", field="modes_" + "xy"[d])
-            if np.any(mm.mass_kg <= 0):
-                raise InputError(
-                    "modal masses must be > 0 for the semi-discretisation (negative: not a driving-point FRF?)",
-                    field="modes_" + "xy"[d],
-                )
-        self.teeth, self.kt, self.kr, self.ri, self.milling = check_cutting(teeth, kt, kr, radial_immersion, milling)
-        self.phi_st, self.phi_ex = immersion_angles(self.ri, self.milling)
-        self.modes = groups
-        self.dirs = [d for d, _ in groups]
-        self.wn = np.concatenate([mm.omega_n for _, mm in groups])
-        self.ze = np.concatenate([mm.zeta for _, mm in groups])
-        self.mass = np.concatenate([mm.mass_kg for _, mm in groups])
-        n = self.n = self.wn.size
-        self.d = len(groups)
-        S = np.zeros((self.d, n))
-        start = 0
-        for j, (_, mm) in enumerate(groups):
-            S[j, start : start + mm.n_modes] = 1.0
-            start += mm.n_modes
-        self.S = S  # u = S q: displacement of each flexible direction
-        self.A0 = np.block([[np.zeros((n, n)), np.eye(n)], [-np.diag(self.wn**2), -np.diag(2 * self.ze * self.wn)]])
+    Fine node i sits at coarse coordinate t = i/s; it is interpolated from the
+    ``degree`` + 1 coarse nodes around it (the stencil shifted inwards at the
+    ends), so the interpolation error is O(h^(degree+1)), h the coarse spacing.
+    ``s = 1``: identity.
+    """
+    if s == 1:
+        return np.eye(m + 1)
+    degree = INTERP_DEGREE if degree is None else degree
+    q = m // s
+    t = np.arange(m + 1) / s
+    p = min(degree, q)
+    j0 = np.clip(np.floor(t).astype(int) - (p - 1) // 2, 0, q - p)
+    L = np.zeros((m + 1, q + 1))
+    rows = np.arange(m + 1)
+    for k in range(p + 1):  # Lagrange basis polynomials of the stencil
+        w = np.ones(m + 1)
+        for j in range(p + 1):
+            if j != k:
+                w *= (t - (j0 + j)) / (k - j)
+        L[rows, j0 + k] += w
+    return L
+
+
+class _System:
+    """State-space matrices and cut geometry for one cutting condition; discretisations cached per m."""
+
+    def __init__(self, model: StateSpaceModel, cut: CuttingConditions):
+        self.model = model
+        self.cut = cut
+        self.teeth, self.tangential_coeff, self.radial_ratio = cut.teeth, cut.tangential_coeff, cut.radial_ratio
+        self.phi_st, self.phi_ex = cut.immersion_angles
+        self.out, self.inp = model.outputs, model.inputs
+        # Balance A by a diagonal similarity of powers of 2 (exact): second-order modal blocks
+        # [[0, 1], [−ω², ·]] have norm ω², [[0, ω], [−ω, ·]] only ω, which spares the exponentials
+        # many squarings.
+        A0, (scale, _) = matrix_balance(model.A, permute=False, separate=True)
+        self.A0 = A0
+        self.C = model.C[self.out] * scale[None, :]  # (d, n): displacement of each moving direction
+        self.Bin = model.B[:, self.inp] / scale[:, None]  # (n, p): forces that excite the model
+        self.n = model.n_states
+        self.d = self.out.size
+        self.f_max = model.max_frequency_hz
         # Cut span of one tooth within a tooth period (several teeth may cut at once).
         self.cut_angle = min(self.phi_ex - self.phi_st, 2 * np.pi / self.teeth)
         self._EF = {}
+        self._L = {}
 
     def directional(self, m: int):
-        """(E_i, F_i) = (M⁻¹SᵀH_iS, M⁻¹SᵀH_i) for the m steps of the cut, shapes (m, n, n), (m, n, d)."""
+        """(E_i, F_i) = (B H_i C, B H_i) for the m steps of the cut, shapes (m, n, n), (m, n, d)."""
         if m not in self._EF:
             edges = self.phi_st + self.cut_angle * np.arange(m + 1) / m
-            H = interval_directional_matrix(edges, self.teeth, self.kt, self.kr, self.phi_st, self.phi_ex)
-            Hd = H[:, self.dirs][:, :, self.dirs]  # (m, d, d): rigid directions drop out
-            Minv = (1.0 / self.mass)[None, :, None]
-            E = Minv * np.einsum("dn,idk,kp->inp", self.S, Hd, self.S)
-            F = Minv * np.einsum("dn,idk->ink", self.S, Hd)
+            H = interval_directional_matrix(edges, self.teeth, self.tangential_coeff, self.radial_ratio,
+                                            self.phi_st, self.phi_ex)
+            Hd = H[:, self.inp][:, :, self.out]  # (m, p, d): rigid directions drop out
+            F = np.einsum("np,ipd->ind", self.Bin, Hd)
+            E = F @ self.C
             self._EF[m] = (E, F)
         return self._EF[m]
+
+    def interp(self, m: int, s: int) -> np.ndarray:
+        if (m, s) not in self._L:
+            self._L[m, s] = _interp_matrix(m, s)
+        return self._L[m, s]
 
     def cut_time(self, rpm):
         """(cut time t_c, free-flight time T − t_c), s."""
@@ -181,87 +208,84 @@ class _System:
         t_cut = self.cut_angle / omega
         return t_cut, np.maximum(2 * np.pi / (self.teeth * omega) - t_cut, 0.0)
 
-    def steps(self, rpm, m=None, steps_per_wave=STEPS_PER_WAVE, m_max=M_MAX):
-        """Steps over the cut per speed: ``m`` if given, else enough for ``steps_per_wave`` per wave.
-
-        A wave is a period of the highest natural frequency +10 % (chatter sits
-        just above a mode), so m = steps_per_wave · 1.1 f_max · t_c, rounded up
-        to a ladder of values (few distinct m keep the batches large) and kept
-        within [20, m_max].
-        """
-        rpm = np.asarray(rpm, float)
-        if m is not None:
-            if int(m) != m or m < 2:
-                raise InputError(f"must be an integer ≥ 2, got {m!r}", field="m")
-            return np.full(rpm.shape, int(m))
-        waves = 1.1 * self.wn.max() / (2 * np.pi) * self.cut_time(rpm)[0]
-        need = np.ceil(steps_per_wave * waves)
-        ladder = _m_ladder(m_max)
-        return ladder[np.minimum(np.searchsorted(ladder, need), ladder.size - 1)]
-
-    def monodromy(self, rpm, depth, m: int, cut_end: bool = False):
+    def monodromy(self, rpm, depth, m: int, s: int = 1, cut_end: bool = False):
         """Floquet transition matrices Φ, shape (B, D, D), for paired 1-D arrays rpm, depth.
 
-        ``cut_end=True`` also returns the map z ↦ y(t_c) to the end of the cut (B, 2n, D).
+        ``m`` steps over the cut; the delayed displacement is carried at every
+        ``s``-th node (m/s + 1 nodes, local Lagrange interpolation of degree
+        ``INTERP_DEGREE`` in between; s = 1: every node — the plain first-order SDM).
+        ``cut_end=True`` also returns the map z ↦ y(t_c) to the end of the cut (B, n, D).
         """
         n, d = self.n, self.d
         E, F = self.directional(m)
+        L = self.interp(m, s)
+        q1 = L.shape[1]
         B = rpm.size
         t_cut, t_free = self.cut_time(rpm)
         dt = t_cut / m
-        na = 2 * n + 2 * d
+        na = n + 2 * d
         X = np.zeros((B, m, na, na))
-        X[:, :, : 2 * n, : 2 * n] = self.A0
-        X[:, :, n : 2 * n, :n] -= depth[:, None, None, None] * E
-        X[:, :, n : 2 * n, 2 * n : 2 * n + d] = depth[:, None, None, None] * F
-        X[:, :, : 2 * n] *= dt[:, None, None, None]
-        X[:, :, 2 * n : 2 * n + d, 2 * n + d :] = np.eye(d)
+        X[:, :, :n, :n] = self.A0
+        X[:, :, :n, :n] -= depth[:, None, None, None] * E
+        X[:, :, :n, n: n + d] = depth[:, None, None, None] * F
+        X[:, :, :n] *= dt[:, None, None, None]
+        # Scale the input columns to the norm of the state block (exact, undone below): the
+        # exponential's cost grows with the log of the block's norm.
+        nm = np.abs(X[:, :, :n, :n]).sum(axis=-2).max(axis=(-2, -1))
+        nf = np.abs(X[:, :, :n, n: n + d]).sum(axis=-2).max(axis=(-2, -1))
+        c = np.maximum(nf / np.maximum(nm, 1e-3), 1.0)
+        X[:, :, :n, n: n + d] /= c[:, None, None, None]
+        X[:, :, n: n + d, n + d:] = np.eye(d)
         Ex = expm_batch(X)
-        P = Ex[:, :, : 2 * n, : 2 * n]
-        G0 = Ex[:, :, : 2 * n, 2 * n : 2 * n + d]
-        G1 = Ex[:, :, : 2 * n, 2 * n + d :]
+        P = Ex[:, :, :n, :n]
+        G1 = Ex[:, :, :n, n + d:] * c[:, None, None, None]
+        G0 = Ex[:, :, :n, n: n + d] * c[:, None, None, None] - G1
         Pfree = expm_batch(self.A0[None] * t_free[:, None, None])
 
-        D = 2 * n + (m + 1) * d
-        Y = np.zeros((B, 2 * n, D))
-        Y[:, :, : 2 * n] = np.eye(2 * n)
+        D = n + q1 * d
+        Y = np.zeros((B, n, D))
+        Y[:, :, :n] = np.eye(n)
         Phi = np.empty((B, D, D))
-        Phi[:, 2 * n : 2 * n + d] = np.einsum("dn,bnk->bdk", self.S, Y[:, :n])
+        Phi[:, n: n + d] = self.C @ Y
+        nz = L != 0
         for i in range(m):  # loop over time steps of the cut (not over speeds or depths)
-            c0 = 2 * n + i * d
             Y = P[:, i] @ Y
-            Y[:, :, c0 : c0 + d] += G0[:, i] - G1[:, i]
-            Y[:, :, c0 + d : c0 + 2 * d] += G1[:, i]
-            Phi[:, c0 + d : c0 + 2 * d] = np.einsum("dn,bnk->bdk", self.S, Y[:, :n])
-        Phi[:, : 2 * n] = Pfree @ Y
+            cols = np.flatnonzero(nz[i] | nz[i + 1])
+            a, b = cols[0], cols[-1] + 1
+            w = (G0[:, i, :, None, :] * L[i, a:b, None] + G1[:, i, :, None, :] * L[i + 1, a:b, None])
+            Y[:, :, n + a * d: n + b * d] += w.reshape(B, n, (b - a) * d)
+            if (i + 1) % s == 0:
+                j = (i + 1) // s
+                Phi[:, n + j * d: n + (j + 1) * d] = self.C @ Y
+        Phi[:, :n] = Pfree @ Y
         return (Phi, Y) if cut_end else Phi
 
-    def multipliers(self, rpm, depth, m):
-        """(spectral radius, critical multiplier) for paired rpm, depth, steps arrays.
+    def multipliers(self, rpm, depth, m, s):
+        """(spectral radius, critical multiplier) for paired rpm, depth, steps, spacing arrays.
 
-        Points are grouped by their step count and processed in memory-bounded chunks.
+        Points are grouped by (m, s) and processed in memory-bounded chunks.
         """
         rpm = np.asarray(rpm, float).reshape(-1)
         depth = np.asarray(depth, float).reshape(-1)
         m = np.broadcast_to(np.asarray(m, int), rpm.shape)
+        s = np.broadcast_to(np.asarray(s, int), rpm.shape)
         crit = np.empty(rpm.size, complex)
-        na = 2 * self.n + 2 * self.d
+        na = self.n + 2 * self.d
         with single_thread_blas():
-            self._multipliers(rpm, depth, m, crit, na)
+            key = m * 1000 + s
+            for kk in np.unique(key):
+                mm, ss = divmod(int(kk), 1000)
+                idx = np.flatnonzero(key == kk)
+                D = self.n + (mm // ss + 1) * self.d
+                chunk = max(1, _CHUNK_FLOATS // max(mm * na * na, D * D))
+                for c in range(0, idx.size, chunk):
+                    j = idx[c: c + chunk]
+                    ev = np.linalg.eigvals(self.monodromy(rpm[j], depth[j], mm, ss))
+                    crit[j] = ev[np.arange(ev.shape[0]), np.argmax(np.abs(ev), axis=1)]
         return np.abs(crit), crit
 
-    def _multipliers(self, rpm, depth, m, crit, na):
-        for mm in np.unique(m):
-            idx = np.flatnonzero(m == mm)
-            D = 2 * self.n + (mm + 1) * self.d
-            chunk = max(1, _CHUNK_FLOATS // max(mm * na * na, D * D))
-            for s in range(0, idx.size, chunk):
-                j = idx[s : s + chunk]
-                ev = np.linalg.eigvals(self.monodromy(rpm[j], depth[j], int(mm)))
-                crit[j] = ev[np.arange(ev.shape[0]), np.argmax(np.abs(ev), axis=1)]
-
-    def critical(self, rpm, depth, m, samples_free: int = 64):
-        """Critical multiplier μ and chatter frequency (Hz) at paired rpm, depth, steps.
+    def critical(self, rpm, depth, m, s, samples_free: int = 64):
+        """Critical multiplier μ and chatter frequency (Hz) at paired rpm, depth, steps, spacing.
 
         μ = e^{iω₀T} fixes the chatter frequency only modulo the tooth-passing
         frequency f_T = 1/T: the critical Floquet solution is
@@ -276,20 +300,24 @@ class _System:
         rpm = np.asarray(rpm, float).reshape(-1)
         depth = np.asarray(depth, float).reshape(-1)
         m = np.broadcast_to(np.asarray(m, int), rpm.shape)
+        s = np.broadcast_to(np.asarray(s, int), rpm.shape)
         n, d = self.n, self.d
         mu = np.empty(rpm.size, complex)
         fc = np.empty(rpm.size)
+        key = m * 1000 + s
         with single_thread_blas():
-            for mm in np.unique(m):
-                idx = np.flatnonzero(m == mm)
-                Phi, Ycut = self.monodromy(rpm[idx], depth[idx], int(mm), cut_end=True)
+            for kk in np.unique(key):
+                mm, ss = divmod(int(kk), 1000)
+                idx = np.flatnonzero(key == kk)
+                Phi, Ycut = self.monodromy(rpm[idx], depth[idx], mm, ss, cut_end=True)
                 ev, vec = np.linalg.eig(Phi)
                 j = np.argmax(np.abs(ev), axis=1)
                 b = np.arange(idx.size)
                 mu[idx] = ev[b, j]
                 v = vec[b, :, j]  # (B, D)
-                # The cut: this period's node values are μ × the stored previous ones.
-                u_cut = mu[idx, None, None] * v[:, 2 * n :].reshape(idx.size, mm + 1, d)
+                # The cut: this period's node values are μ × the stored previous ones (fine nodes by interpolation).
+                coarse = v[:, n:].reshape(idx.size, -1, d)
+                u_cut = mu[idx, None, None] * np.einsum("ij,bjd->bid", self.interp(mm, ss), coarse)
                 t_cut, t_free = self.cut_time(rpm[idx])
                 t = [np.arange(mm + 1)[None, :] * (t_cut / mm)[:, None]]
                 u = [u_cut]
@@ -301,13 +329,13 @@ class _System:
                     uf = np.empty((idx.size, samples_free, d), complex)
                     for k in range(samples_free):  # loop over time samples
                         y = np.einsum("bij,bj->bi", step, y)
-                        uf[:, k] = y[:, :n] @ self.S.T
+                        uf[:, k] = y @ self.C.T
                     t.append(t_cut[:, None] + ds[:, None] * np.arange(1, samples_free + 1)[None, :])
                     u.append(uf)
                 t, u = np.concatenate(t, axis=1), np.concatenate(u, axis=1)
                 period = 60.0 / (self.teeth * rpm[idx])
                 f0 = np.angle(mu[idx]) / (2 * np.pi * period)
-                jmax = int(np.ceil(2.0 * self.wn.max() / (2 * np.pi) * period.max())) + 1
+                jmax = int(np.ceil(2.0 * self.f_max * period.max())) + 1
                 lines = f0[:, None] + np.arange(-jmax, jmax + 1)[None, :] / period[:, None]  # (B, J)
                 phase = np.exp(-2j * np.pi * lines[:, :, None] * t[:, None, :])  # (B, J, S)
                 w = np.diff(t, axis=1)
@@ -319,164 +347,408 @@ class _System:
                 fc[idx] = np.abs(lines[b, np.argmax(power, axis=1)])
         return mu, fc
 
+    def resolution(self, rpm, m=None, accuracy=1.0, m_max=M_MAX, f_wave=None):
+        """(steps m over the cut, node spacing s) per speed.
+
+        A wave is a period of ``f_wave`` (Hz; default the highest natural
+        frequency +10 %, chatter sitting just above a mode):
+        m = accuracy · STEPS_PER_WAVE · f_wave · t_c, on a ladder of values
+        within [20, m_max]; the delayed displacement is carried at every s-th
+        step, s the largest divisor of m leaving NODES_PER_WAVE · accuracy nodes
+        per wave and at least MIN_NODES intervals. A given ``m`` is used as it
+        is, with s = 1.
+        """
+        rpm = np.asarray(rpm, float)
+        if m is not None:
+            if int(m) != m or m < 2:
+                raise InputError(f"must be an integer ≥ 2, got {m!r}", field="m")
+            return np.full(rpm.shape, int(m)), np.ones(rpm.shape, int)
+        waves = (1.1 * self.f_max if f_wave is None else f_wave) * self.cut_time(rpm)[0]
+        need = np.ceil(accuracy * STEPS_PER_WAVE * waves)
+        ladder = _m_ladder(m_max)
+        mm = ladder[np.minimum(np.searchsorted(ladder, need), ladder.size - 1)]
+        # Largest divisor s of m with at least NODES_PER_WAVE nodes per wave and MIN_NODES + 1 nodes.
+        limit = np.minimum(mm / np.maximum(accuracy * NODES_PER_WAVE * waves, 1e-300), mm / MIN_NODES)
+        s = np.ones(mm.shape, int)
+        for c in range(2, 17):  # candidate spacings, a handful
+            s = np.where((mm % c == 0) & (c <= limit), c, s)
+        return mm, s
+
 
 # ------------------------------------------------------------------ public API
+def as_state_space(modes_x, modes_y=None) -> StateSpaceModel:
+    """The tool-point model the SDM works on, from what the caller gave.
+
+    Parameters
+    ----------
+    modes_x : StateSpaceModel or ModalModel or None
+        A complete 2-input 2-output model (then ``modes_y`` must be ``None``),
+        or the real modes in x (``None``: rigid in x).
+    modes_y : ModalModel or None
+        Real modes in y (``None``: rigid in y).
+
+    Returns
+    -------
+    StateSpaceModel
+    """
+    if isinstance(modes_x, StateSpaceModel):
+        if modes_y is not None:
+            raise InputError("give a StateSpaceModel alone (it holds both directions)", field="modes_y")
+        return modes_x
+    return StateSpaceModel.from_modes(modes_x, modes_y)
+
+
+def _check_accuracy(accuracy) -> float:
+    try:
+        acc = float(accuracy)
+    except (TypeError, ValueError):
+        raise InputError(f"must be a number, got {accuracy!r}", field="accuracy") from None
+    if not 0.25 <= acc <= 16:
+        raise InputError(f"must be from 0.25 to 16, got {acc:g}", field="accuracy")
+    return acc
+
+
 def sdm_spectral_radius(
-    modes_x: ModalModel | None,
-    modes_y: ModalModel | None,
+    modes_x,
+    modes_y=None,
+    cutting: CuttingConditions | None = None,
     *,
-    teeth: int,
-    kt: float,
-    kr: float,
-    radial_immersion: float,
-    milling: str = "down",
     rpm,
     depth,
     m: int | None = None,
-    steps_per_wave: float = STEPS_PER_WAVE,
+    accuracy: float = 1.0,
+    **deprecated,
 ) -> np.ndarray:
-    """Spectral radius ρ of the Floquet transition matrix at (rpm, depth m), broadcast.
+    """Spectral radius ρ of the Floquet transition matrix at (rpm, depth), broadcast.
 
     ρ < 1 stable, ρ > 1 chatter. A speed × depth grid is
     ``sdm_spectral_radius(..., rpm=r[None, :], depth=a[:, None])``; its
-    ρ = 1 contour is the stability boundary. ``m``: steps over the cut
-    (default: ``steps_per_wave`` per chatter wave, see :func:`sdm_lobes`).
+    ρ = 1 contour is the stability boundary.
+
+    Parameters
+    ----------
+    modes_x, modes_y : StateSpaceModel, ModalModel or None
+        The tool-point model (see :func:`as_state_space`).
+    cutting : CuttingConditions
+        Teeth, K_t (N/m²), K_r, a_e/D, down/up milling.
+    rpm : array_like
+        Spindle speeds, rpm (> 0).
+    depth : array_like
+        Axial depths, m (≥ 0), broadcast against ``rpm``.
+    m : int, optional
+        Steps over the cut, every node carried (the plain first-order SDM); default: see :func:`sdm_lobes`.
+    accuracy : float
+        Resolution factor of the default discretisation (see :func:`sdm_lobes`).
+    **deprecated
+        Old keywords ``teeth, kt, kr, radial_immersion, milling`` (DeprecationWarning).
+
+    Returns
+    -------
+    numpy.ndarray
+        ρ, dimensionless, shape of the broadcast of ``rpm`` and ``depth``.
+
+    Examples
+    --------
+    At zero depth only free vibration is left: ρ = e^{−ζω_n T}.
+
+    >>> from toolpoint.stability import CuttingConditions, ModalModel, sdm_spectral_radius
+    >>> cut = CuttingConditions(teeth=2, tangential_coeff=6e8, radial_ratio=1/3, radial_immersion=0.05)
+    >>> rho = sdm_spectral_radius(ModalModel([922.0], [0.011], [0.03993]), None, cut, rpm=10000.0, depth=0.0)
+    >>> bool(np.isclose(rho, np.exp(-0.011 * 2 * np.pi * 922.0 * 60 / (2 * 10000.0))))
+    True
     """
-    sysm = _System(modes_x, modes_y, teeth, kt, kr, radial_immersion, milling)
+    cut = resolve_cutting(cutting, deprecated, "sdm_spectral_radius")
+    sysm = _System(as_state_space(modes_x, modes_y), cut)
+    acc = _check_accuracy(accuracy)
     r, a = np.broadcast_arrays(np.asarray(rpm, float), np.asarray(depth, float))
     if np.any(~np.isfinite(r) | (r <= 0)) or np.any(~np.isfinite(a) | (a < 0)):
         raise InputError("speeds must be > 0 rpm and depths finite and ≥ 0 m", field="rpm/depth")
-    rho, _ = sysm.multipliers(r.reshape(-1), a.reshape(-1), sysm.steps(r.reshape(-1), m, steps_per_wave))
+    mm, ss = sysm.resolution(r.reshape(-1), m, acc)
+    rho, _ = sysm.multipliers(r.reshape(-1), a.reshape(-1), mm, ss)
     return rho.reshape(r.shape)
 
 
-def _default_depth_scale(sysm: _System) -> float:
-    """A depth scale (m) for the search: the zero-order absolute minimum of the same modes.
+def _zoa_minimum(sysm: _System, freq_hz: np.ndarray, phi: np.ndarray) -> float:
+    """The zero-order absolute minimum, m: min over ω of −1/(2 Re μ(ω)), μ the eigenvalues of H₀Φ(iω).
 
-    That minimum, min over ω of −1/(2 Re μ(ω)), holds for every speed range
-    (each lobe reaches it), so it is taken straight from the eigenvalues.
+    It holds for every speed range (each lobe reaches it). Without any zero-order
+    lobe: 1/(max |B H_i| / max |B| · max |Φ(f_0)|), a depth at which the cutting
+    stiffness is of the order of the structure's stiffness at the lowest grid frequency f_0.
     """
     from .milling import average_directional_matrix
     from .zoa import depth_and_phase, oriented_eigenvalues
 
-    f = np.linspace(0.0, 2.0 * sysm.wn.max() / (2 * np.pi), 20001)[1:]
-    byd = dict(sysm.modes)
-    phi = [byd[d].frf(f, residuals=False).values if d in byd else np.zeros(f.size, complex) for d in (0, 1)]
-    h0 = average_directional_matrix(sysm.teeth, sysm.kt, sysm.kr, sysm.phi_st, sysm.phi_ex)
-    depth, _, valid = depth_and_phase(oriented_eigenvalues(h0, *phi))
+    h0 = average_directional_matrix(sysm.teeth, sysm.tangential_coeff, sysm.radial_ratio, sysm.phi_st, sysm.phi_ex)
+    depth, _, valid = depth_and_phase(oriented_eigenvalues(h0, phi[:, 0, 0], phi[:, 1, 1], phi[:, 0, 1],
+                                                           phi[:, 1, 0]))
     if valid.any():
         return float(depth[valid].min())
-    # No zero-order lobe at all: the depth at which the cutting stiffness a·|H| matches the softest mode.
-    hmax = np.abs(sysm.directional(M_MIN)[1]).max() * sysm.mass.max()
-    return float((sysm.mass * sysm.wn**2).min() / max(hmax, 1e-30))
+    hmax = np.abs(sysm.directional(M_MIN)[1]).max() / max(np.abs(sysm.Bin).max(), 1e-300)
+    return float(1.0 / max(hmax * np.abs(phi[0]).max(), 1e-300))
+
+
+def _zoa_grid(sysm: _System) -> tuple[np.ndarray, np.ndarray]:
+    """A frequency grid (Hz) resolving every pole (≥ 8 points per half-power band) and Φ on it (F, 2, 2)."""
+    lam = sysm.model.poles
+    fn = np.abs(lam) / (2 * np.pi)
+    bw = np.maximum(-lam.real / (2 * np.pi), 1e-6 * fn)  # half-power half-width, Hz
+    df = max(bw.min() / 8, 1.5 * fn.max() / _ZOA_POINTS)
+    f = np.arange(df, 1.5 * fn.max() + df, df)
+    return f, sysm.model.frf(f)
+
+
+def _zoa_seed(sysm: _System, grid, f, phi):
+    """Zero-order lobes (LobeResult) on ``grid``: limit inf where no lobe covers a speed (all inf if x is rigid)."""
+    from ..frf import FRF
+    from .zoa import zoa_lobes
+
+    if not np.any(phi[:, 0, 0]):
+        return LobeResult(grid, np.full(grid.size, np.inf), np.full(grid.size, np.nan))
+    fx = FRF(f, phi[:, 0, 0])
+    fy = FRF(f, phi[:, 1, 1]) if np.any(phi[:, 1, 1]) else "rigid"
+    cross = {k: FRF(f, phi[:, i, j]) for k, (i, j) in (("frf_xy", (0, 1)), ("frf_yx", (1, 0))) if np.any(phi[:, i, j])}
+    return zoa_lobes(fx, fy, sysm.cut, rpm=grid, **cross)
+
+
+class _Progress:
+    """Speeds finished, reported to a callable(done, total), a tqdm bar (``True``) or nobody."""
+
+    def __init__(self, progress, total):
+        self.bar = None
+        self.fn = None
+        if progress is True:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, unit="speed", desc="semi-discretisation", leave=False)
+        elif callable(progress):
+            self.fn = progress
+        self.total, self.done = total, 0
+
+    def add(self, k):
+        self.done += k
+        if self.bar is not None:
+            self.bar.update(k)
+        elif self.fn is not None:
+            self.fn(self.done, self.total)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
 
 
 def sdm_lobes(
-    modes_x: ModalModel | None,
-    modes_y: ModalModel | None,
+    modes_x,
+    modes_y=None,
+    cutting: CuttingConditions | None = None,
     *,
-    teeth: int,
-    kt: float,
-    kr: float,
-    radial_immersion: float,
-    milling: str = "down",
     rpm,
     m: int | None = None,
-    steps_per_wave: float = STEPS_PER_WAVE,
+    accuracy: float = 1.0,
     m_max: int = M_MAX,
     depth_min: float | None = None,
     depth_max: float | None = None,
     step: float = 1.25,
     rtol: float = 1e-3,
+    seed: bool = True,
+    progress=None,
+    **deprecated,
 ) -> LobeResult:
-    """Stability limit by first-order semi-discretisation, per spindle speed.
+    """Stability limit by semi-discretisation, per spindle speed.
 
     Parameters
     ----------
-    modes_x, modes_y : modes in x (feed) and y; ``None`` for a rigid direction.
-    teeth, kt (N/m²), kr (K_n/K_t), radial_immersion (a_e/D), milling : as in
-        :func:`~toolpoint.stability.zoa.zoa_lobes`.
-    rpm : increasing spindle speeds, rpm.
-    m : steps over the cut, the same at every speed; default ``None`` chooses
-        per speed ``steps_per_wave`` (20) steps per wave of 1.1 × the highest
-        natural frequency, within [20, ``m_max``] (see module docstring).
-    depth_min, depth_max : search range for the axial depth (m); default
-        1/4 and 100 times the zero-order minimum of the same modes. Speeds
-        still stable at ``depth_max`` get ``inf``.
-    step : ratio between successive depths of the upward search; an unstable
-        band thinner than this ratio can be missed.
-    rtol : relative width of the final bracket.
+    modes_x, modes_y : StateSpaceModel, ModalModel or None
+        The tool-point model: a :class:`~toolpoint.stability.statespace.StateSpaceModel`
+        (any complex modes, cross terms) alone, or real modes in x and y
+        (``None`` for a rigid direction).
+    cutting : CuttingConditions
+        Teeth, K_t (N/m²), K_r = K_n/K_t, a_e/D, down/up milling.
+    rpm : array_like
+        Increasing spindle speeds, rpm.
+    m : int, optional
+        Steps over the cut, the same at every speed, every node carried (the
+        plain first-order SDM); default ``None``: chosen per speed from
+        ``accuracy`` (module docstring).
+    accuracy : float
+        Resolution factor (0.25 … 16) of the default discretisation: steps and
+        delayed-displacement nodes per chatter wave scale with it (steps up to
+        ``m_max``), and so does the time.
+    m_max : int
+        Largest default ``m``.
+    depth_min, depth_max : float, optional
+        Search range for the axial depth, m; default 1/4 and 100 times the
+        zero-order minimum of the same model. Speeds still stable at
+        ``depth_max`` get ``inf``.
+    step : float
+        Ratio between successive depths of the upward search; an unstable band
+        thinner than this ratio can be missed.
+    rtol : float
+        Relative width of the final bracket.
+    seed : bool
+        Start the upward search at half the zero-order limit of each speed
+        (module docstring); ``False``: from ``depth_min`` at every speed.
+    progress : bool or callable, optional
+        ``True``: a tqdm bar on stderr; a callable is called as
+        ``progress(speeds_done, speeds_total)`` after each block of 50 speeds.
+    **deprecated
+        Old keywords ``teeth, kt, kr, radial_immersion, milling`` (DeprecationWarning).
 
     Returns
     -------
-    LobeResult (method ``"sdm"``): limit = the lowest unstable depth (upper
-    end of the final bracket), chatter frequency from the critical Floquet
-    multiplier and its eigenvector, lobes = runs of equal k = floor(f_c T);
-    ``params["m"]`` holds the steps used at each speed.
+    LobeResult
+        Method ``"sdm"``: limit = the lowest unstable depth found (upper end
+        of the final bracket, m), chatter frequency (Hz) from the critical
+        Floquet multiplier and its eigenvector, lobes = runs of equal
+        k = floor(f_c T); ``params["m"]`` and ``params["node_spacing"]`` hold
+        the steps and the node spacing used at each speed,
+        ``params["evaluations"]`` the Floquet matrices computed.
+
+    Raises
+    ------
+    InputError
+        Bad model, cutting conditions, speeds or settings.
+
+    Examples
+    --------
+    Insperger & Stépán's benchmark (one mode in x, 2 teeth, a/D = 0.05, down-milling):
+
+    >>> from toolpoint.stability import CuttingConditions, ModalModel, sdm_lobes
+    >>> cut = CuttingConditions(teeth=2, tangential_coeff=6e8, radial_ratio=1/3, radial_immersion=0.05)
+    >>> res = sdm_lobes(ModalModel([922.0], [0.011], [0.03993]), None, cut, rpm=[10000.0])
+    >>> round(float(res.depth_mm[0]), 2)
+    4.09
     """
-    sysm = _System(modes_x, modes_y, teeth, kt, kr, radial_immersion, milling)
+    cut = resolve_cutting(cutting, deprecated, "sdm_lobes")
+    sysm = _System(as_state_space(modes_x, modes_y), cut)
+    acc = _check_accuracy(accuracy)
     grid = check_rpm(rpm)
-    msteps = sysm.steps(grid, m, steps_per_wave, m_max)
+    if not step > 1 or not (0 < rtol < 0.1):
+        raise InputError("need step > 1 and 0 < rtol < 0.1", field="step/rtol")
+    f, phi = _zoa_grid(sysm)
     if depth_min is None or depth_max is None:
-        scale = _default_depth_scale(sysm)
+        scale = _zoa_minimum(sysm, f, phi)
         depth_min = scale / 4 if depth_min is None else depth_min
         depth_max = 100 * scale if depth_max is None else depth_max
     if not (0 < depth_min < depth_max and np.isfinite(depth_max)):
         raise InputError(f"need 0 < depth_min < depth_max, got {depth_min:g}, {depth_max:g} m", field="depth")
-    if not step > 1 or not (0 < rtol < 0.1):
-        raise InputError("need step > 1 and 0 < rtol < 0.1", field="step/rtol")
+    start = np.full(grid.size, float(depth_min))
+    f_wave = None
+    if seed:
+        zoa = _zoa_seed(sysm, grid, f, phi)
+        start = np.clip(np.where(np.isfinite(zoa.depth_m), SEED_FRACTION * zoa.depth_m, depth_min),
+                        depth_min, depth_max)
+        if np.any(np.isfinite(zoa.chatter_hz)):
+            # Chatter waves, not the highest mode, set the resolution: the exponentials integrate any mode exactly.
+            f_wave = WAVE_MARGIN * float(np.nanmax(zoa.chatter_hz))
+    msteps, spacing = sysm.resolution(grid, m, acc, m_max, f_wave)
 
     n = grid.size
     lo = np.zeros(n)  # largest depth known stable
     hi = np.full(n, np.inf)  # smallest depth known unstable
-    # Upward search, all still-stable speeds together at each depth level.
-    a = depth_min
-    todo = np.arange(n)
-    while todo.size:
-        rho, _ = sysm.multipliers(grid[todo], np.full(todo.size, a), msteps[todo])
-        unstable = rho >= 1.0
-        hi[todo[unstable]] = a
-        lo[todo[~unstable]] = a
-        todo = todo[~unstable]
-        if a >= depth_max:
-            break
-        a = min(a * step, depth_max)
-    _refine(sysm, grid, msteps, lo, hi, rtol)
+    rlo, rhi = np.zeros(n), np.full(n, np.inf)  # ρ there
+    count = [0]
+    bar = _Progress(progress, n)
+    try:
+        for blk in np.array_split(np.arange(n), max(1, int(np.ceil(n / _BLOCK_SPEEDS)))):
+            ev = _Evaluator(sysm, grid, msteps, spacing, count)
+            _search(ev, blk, start, depth_min, depth_max, step, lo, hi, rlo, rhi)
+            _refine(ev, blk, lo, hi, rlo, rhi, rtol)
+            bar.add(blk.size)
+    finally:
+        bar.close()
 
     limit = hi
     chatter = np.full(n, np.nan)
     fin = np.isfinite(limit)
     if fin.any():
-        chatter[fin] = sysm.critical(grid[fin], limit[fin], msteps[fin])[1]
+        chatter[fin] = sysm.critical(grid[fin], limit[fin], msteps[fin], spacing[fin])[1]
     lobes = _split_lobes(grid, limit, chatter, sysm.teeth)
-    params = dict(
-        teeth=sysm.teeth, kt=sysm.kt, kr=sysm.kr, radial_immersion=sysm.ri, milling=sysm.milling,
-        phi_st=sysm.phi_st, phi_ex=sysm.phi_ex, m=msteps, depth_min=depth_min, depth_max=depth_max,
-        step=step, rtol=rtol,
-    )
+    params = dict(cut.as_dict(), cutting=cut, phi_st=sysm.phi_st, phi_ex=sysm.phi_ex, m=msteps,
+                  node_spacing=spacing, accuracy=acc, depth_min=depth_min, depth_max=depth_max, step=step,
+                  rtol=rtol, seed=seed, evaluations=count[0], model=sysm.model)
     if not fin.any():
         return LobeResult(grid, limit, chatter, lobes, "sdm", params=params)
     j = int(np.argmin(limit))
     return LobeResult(grid, limit, chatter, lobes, "sdm", float(limit[j]), float(grid[j]), float(chatter[j]), params)
 
 
-def _refine(sysm, grid, msteps, lo, hi, rtol, max_iter=200):
-    """Bisect every finite bracket [lo, hi] (ρ(lo) < 1 ≤ ρ(hi)) to hi − lo ≤ rtol·hi, in place.
+class _Evaluator:
+    """ρ at (speed index, depth) pairs, counting the Floquet matrices computed."""
 
-    Geometric mean while lo > 0, halving while lo = 0 (unstable already at the
-    smallest depth searched). False position on ln ρ was tried and needed as
-    many steps: the critical multiplier below the limit is often not the one
-    that crosses, so ln ρ(ln a) has a kink inside the bracket.
+    def __init__(self, sysm, grid, msteps, spacing, count):
+        self.sysm, self.grid, self.m, self.s, self.count = sysm, grid, msteps, spacing, count
+
+    def __call__(self, idx, depth):
+        self.count[0] += idx.size
+        return self.sysm.multipliers(self.grid[idx], depth, self.m[idx], self.s[idx])[0]
+
+
+def _search(ev, idx, start, depth_min, depth_max, step, lo, hi, rlo, rhi):
+    """Bracket the limit of speeds ``idx``: ρ(lo) < 1 ≤ ρ(hi), in place.
+
+    Upward geometric search (ratio ``step``) from ``start``; a speed already
+    unstable at a seeded start above ``depth_min`` is searched again from
+    ``depth_min`` (the SDM limit can lie far below the zero-order one there).
     """
-    br = np.flatnonzero(np.isfinite(hi) & (hi - lo > rtol * hi))
+    a = start[idx].copy()
+    todo = idx.copy()
+    restarted = np.zeros(lo.size, bool)
+    while todo.size:
+        rho = ev(todo, a)
+        uns = rho >= 1.0
+        again = uns & (a > depth_min * (1 + 1e-12)) & (lo[todo] == 0) & ~restarted[todo]
+        if again.any():  # unstable at its first (seeded) depth: restart from the bottom
+            restarted[todo[again]] = True
+            a[again] = depth_min
+            uns &= ~again
+        hi[todo[uns]], rhi[todo[uns]] = a[uns], rho[uns]
+        st = ~uns & ~again
+        lo[todo[st]], rlo[todo[st]] = a[st], rho[st]
+        keep = ~uns & ~(st & (a >= depth_max))
+        todo, a = todo[keep], np.where(again, a, np.minimum(a * step, depth_max))[keep]
+
+
+def _refine(ev, idx, lo, hi, rlo, rhi, rtol, max_iter=200):
+    """Shrink every finite bracket [lo, hi] (ρ(lo) < 1 ≤ ρ(hi)) to hi − lo ≤ rtol·hi, in place.
+
+    Illinois (modified false position) on ln ρ against ln a, with a
+    bisection step (geometric mean; halving while lo = 0) whenever the last
+    step did not halve the bracket: the critical multiplier below the limit is
+    often not the one that crosses, so ln ρ(ln a) can have a kink inside the
+    bracket, where plain false position stalls.
+    """
+    br = idx[np.isfinite(hi[idx]) & (hi[idx] - lo[idx] > rtol * hi[idx])]
+    glo = np.log(np.maximum(rlo, 1e-300))
+    ghi = np.log(np.maximum(rhi, 1e-300))
+    bisect = np.zeros(lo.size, bool)
+    last = np.zeros(lo.size, int)
     for _ in range(max_iter):  # ends long before unless ρ ≥ 1 down to depth 0 (undamped)
         if not br.size:
             break
-        mid = np.where(lo[br] > 0, np.sqrt(lo[br] * hi[br]), 0.5 * hi[br])
-        rho, _ = sysm.multipliers(grid[br], mid, msteps[br])
+        l, h = lo[br], hi[br]  # noqa: E741
+        width = np.log(h) - np.log(np.where(l > 0, l, h / 2))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xl, xh = np.log(l), np.log(h)
+            x = xl - glo[br] * (xh - xl) / (ghi[br] - glo[br])
+            # Stay inside the bracket, at least a quarter of the tolerance from its ends.
+            eps = 0.25 * rtol
+            x = np.clip(x, xl + eps, xh - eps)
+        geo = np.where(l > 0, np.sqrt(l * h), 0.5 * h)
+        mid = np.where(bisect[br] | (l <= 0) | ~np.isfinite(x), geo, np.exp(x))
+        rho = ev(br, mid)
+        g = np.log(np.maximum(rho, 1e-300))
         uns = rho >= 1.0
-        hi[br[uns]] = mid[uns]
-        lo[br[~uns]] = mid[~uns]
+        b_u, b_s = br[uns], br[~uns]
+        hi[b_u], ghi[b_u] = mid[uns], g[uns]
+        lo[b_s], glo[b_s] = mid[~uns], g[~uns]
+        # Illinois: the end kept twice in a row has its ln ρ halved.
+        side = np.where(uns, 1, -1)
+        twice = side == last[br]
+        glo[b_u[twice[uns]]] *= 0.5
+        ghi[b_s[twice[~uns]]] *= 0.5
+        last[br] = side
+        new_width = np.log(hi[br]) - np.log(np.where(lo[br] > 0, lo[br], hi[br] / 2))
+        bisect[br] = new_width > 0.5 * width
         br = br[hi[br] - lo[br] > rtol * hi[br]]
 
 

@@ -5,17 +5,16 @@ milling", CIRP Annals 44(1):357–362.
 
 Replacing the periodic directional matrix H(t) of (1) in
 :mod:`~toolpoint.stability.milling` by its tooth-pass average H₀ (N/m²) and
-writing the tool-point receptance matrix Φ(iω) = diag(Φ_xx, Φ_yy) (m/N; the
-cross receptances Φ_xy, Φ_yx are neglected, as usual for a tool point), a
-chatter vibration at ω_c is a non-trivial solution of
+writing the tool-point receptance matrix Φ(iω) = [[Φ_xx, Φ_xy], [Φ_yx, Φ_yy]]
+(m/N; the cross terms default to 0), a chatter vibration at ω_c is a
+non-trivial solution of
 
     det[ I + a (1 − e^{−iω_c T}) H₀ Φ(iω_c) ] = 0.                      (2)
 
 Let μ be an eigenvalue of the oriented FRF H₀Φ (1/m). It is found in closed
 form at all frequency points at once,
 
-    μ = tr/2 ± √(tr²/4 − det),  tr = h_xx Φ_xx + h_yy Φ_yy,
-                                det = (h_xx h_yy − h_xy h_yx) Φ_xx Φ_yy.
+    μ = tr/2 ± √(tr²/4 − det),  tr = trace(H₀Φ),  det = det(H₀) det(Φ).
 
 (2) then needs a (1 − e^{−iε}) = −1/μ with a real and positive. That holds
 only where Re μ < 0 — Altintas' Λ = −(N/4π) a K_t (1 − e^{−iωT}) = −1/λ with
@@ -25,15 +24,18 @@ only where Re μ < 0 — Altintas' Λ = −(N/4π) a K_t (1 − e^{−iωT}) = �
     ε     = π + 2 arg(−μ) ∈ (0, 2π)                   (phase between waves)
     T     = (ε + 2kπ) / ω_c,  n = 60 / (N T)          (rpm), lobe k = 0, 1, 2, …
 
-Altintas writes the same as a_lim = −2πΛ_R(1 + κ²)/(N K_t), κ = Λ_I/Λ_R,
-ψ = arctan κ, ε = π − 2ψ. a_lim depends on ω_c only; each k maps the same
-depth curve to another speed range, which is why all lobes cost one
-eigenvalue evaluation. The limit at a speed is the minimum over lobes (and
-over both eigenvalue branches).
+a_lim depends on ω_c only; each k maps the same depth curve to another speed
+range, which is why all lobes cost one eigenvalue evaluation. The limit at a
+speed is the minimum over lobes and over both eigenvalue branches.
 
-Between neighbouring FRF points f, ε and a_lim are interpolated linearly, so
-a lobe is only as fine as the FRF: near a sharp mode the k = 0 lobe can move
-by a thousand rpm per 1 Hz step, and there a finer FRF grid is the remedy.
+Between neighbouring FRF points μ is interpolated linearly (complex), so Re μ
+and 1/a_lim are linear in frequency there and ε follows from the interpolated
+μ exactly. Where Re μ changes sign between two points the lobe is kept up to
+the crossing, where a_lim → ∞ and ε → 0 or 2π: the lobe flank rises to its
+vertical asymptote instead of being cut off at the last sampled point (which
+would leave the speeds under the flank too optimistic). For a grid speed n on
+a piece of lobe k, the parameter of the crossing solves
+c(t) = n (k + ε(t)/2π), c = 60 f/N, by safeguarded Newton steps.
 
 Single mode in x only: μ = h_xx Φ_xx, so a_lim = −1/(2 h_xx Re Φ_xx) and its
 minimum is 2kζ(1+ζ)/h_xx (k = m ω_n² the modal stiffness), with
@@ -45,34 +47,47 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..frf import FRF
-from .milling import (
-    Lobe,
-    LobeResult,
-    average_directional_matrix,
-    check_cutting,
-    check_rpm,
-    immersion_angles,
-)
+from ..frf import FRF, check_freq_hz
+from .cutting import CuttingConditions, resolve_cutting
+from .milling import Lobe, LobeResult, average_directional_matrix, check_rpm
 
-__all__ = ["zoa_lobes", "oriented_eigenvalues", "depth_and_phase"]
+__all__ = ["zoa_lobes", "oriented_eigenvalues", "depth_and_phase", "MAX_LOBE_POINTS"]
 
-# Largest number of (lobe, segment) pairs handled at once; guards memory when a
-# wide FRF band meets a very low minimum speed (thousands of lobes).
-_MAX_PAIRS = 4_000_000
+# Work is streamed over blocks of at most this many (segment, lobe) pairs, so
+# memory stays bounded however fine the FRF or low the minimum speed.
+_BLOCK = 500_000
+# The lobes kept in the result (for plots and --lobes-out) are thinned, every
+# s-th FRF point, to at most this many points; the limit uses every point.
+MAX_LOBE_POINTS = 1_000_000
 
 
-def oriented_eigenvalues(h0: np.ndarray, phi_xx: np.ndarray, phi_yy: np.ndarray) -> np.ndarray:
-    """Both eigenvalues μ of H₀·diag(Φ_xx, Φ_yy) at every frequency, shape (2, n), 1/m.
+def oriented_eigenvalues(h0: np.ndarray, phi_xx: np.ndarray, phi_yy: np.ndarray, phi_xy=None,
+                         phi_yx=None) -> np.ndarray:
+    """Both eigenvalues μ of the oriented FRF H₀Φ at every frequency, 1/m.
 
-    Closed-form 2×2 eigenvalues. The sign of the square root is chosen so the
-    two branches are continuous in frequency: NumPy's principal root flips sign
-    wherever the discriminant crosses the negative real axis; a flip is seen as
-    the root turning by more than 90° between neighbours and undone with a
-    cumulative parity, without a loop over frequencies.
+    Parameters
+    ----------
+    h0 : numpy.ndarray
+        (2, 2) average directional matrix, N/m².
+    phi_xx, phi_yy : numpy.ndarray
+        (n,) direct receptances, m/N.
+    phi_xy, phi_yx : numpy.ndarray, optional
+        (n,) cross receptances, m/N (default 0).
+
+    Returns
+    -------
+    numpy.ndarray
+        (2, n) complex. Closed-form 2×2 eigenvalues; the sign of the square
+        root is chosen so the two branches are continuous in frequency: NumPy's
+        principal root flips sign wherever the discriminant crosses the
+        negative real axis; a flip is seen as the root turning by more than 90°
+        between neighbours and undone with a cumulative parity.
     """
-    tr = h0[0, 0] * phi_xx + h0[1, 1] * phi_yy
-    det = (h0[0, 0] * h0[1, 1] - h0[0, 1] * h0[1, 0]) * phi_xx * phi_yy
+    zero = 0.0
+    pxy = zero if phi_xy is None else phi_xy
+    pyx = zero if phi_yx is None else phi_yx
+    tr = h0[0, 0] * phi_xx + h0[0, 1] * pyx + h0[1, 0] * pxy + h0[1, 1] * phi_yy
+    det = (h0[0, 0] * h0[1, 1] - h0[0, 1] * h0[1, 0]) * (phi_xx * phi_yy - pxy * pyx)
     s = np.sqrt(tr * tr / 4 - det)
     flip = np.zeros(s.shape, dtype=int)
     flip[1:] = (s[1:] * np.conj(s[:-1])).real < 0
@@ -81,104 +96,173 @@ def oriented_eigenvalues(h0: np.ndarray, phi_xx: np.ndarray, phi_yy: np.ndarray)
 
 
 def depth_and_phase(mu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(a_lim m, ε rad, valid) from eigenvalues μ; valid where Re μ < 0 (a > 0)."""
+    """Depth limit, phase and validity from eigenvalues μ.
+
+    Parameters
+    ----------
+    mu : numpy.ndarray
+        Eigenvalues of H₀Φ, 1/m, shape (n,) or (branches, n).
+
+    Returns
+    -------
+    depth : numpy.ndarray
+        a_lim = −1/(2 Re μ), m (inf where not valid).
+    eps : numpy.ndarray
+        ε = π + 2 arg(−μ), rad.
+    valid : numpy.ndarray
+        Re μ < 0 beyond round-off (a > 0).
+    """
+    valid = _negative(mu)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        depth = np.where(valid, -0.5 / mu.real, np.inf)
+    return depth, _phase(mu), valid
+
+
+def _negative(mu):
     # Re μ must be negative beyond round-off (a zero eigenvalue, e.g. a rigid
     # direction, comes out as ±1e-15 and would give absurd "lobes").
     scale = np.abs(mu).max(axis=0, keepdims=True) if mu.ndim > 1 else np.abs(mu)
-    valid = np.isfinite(mu) & (mu.real < -1e-9 * scale)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        depth = np.where(valid, -0.5 / mu.real, np.inf)
-        eps = np.pi + 2 * np.arctan(mu.imag / mu.real)  # arg(−μ) = arctan(μ_I/μ_R) when μ_R < 0
-    return depth, eps, valid
+    return np.isfinite(mu) & (mu.real < -1e-9 * scale)
+
+
+def _phase(mu):
+    """ε = π + 2 arg(−μ), rad; at Re μ = 0 the limit from the side Re μ < 0 (0 or 2π)."""
+    return np.pi + 2 * np.arctan2(-mu.imag, -mu.real)
 
 
 def _as_receptance(frf, name: str) -> FRF:
     if not isinstance(frf, FRF):
         raise InputError(f"expected an FRF, got {type(frf).__name__}", field=name)
+    check_freq_hz(frf.freq_hz, field=name, min_points=3)
+    if not np.all(np.isfinite(frf.values)):
+        raise InputError(f"FRF values must be finite ({int((~np.isfinite(frf.values)).sum())} are not)", field=name)
     try:
-        frf = frf.to_receptance()
+        return frf.to_receptance()
     except ValueError as err:
         raise InputError(str(err), field=name) from None
-    if len(frf) < 3:
-        raise InputError("FRF needs at least 3 frequency points", field=name)
-    if np.any(np.diff(frf.freq_hz) <= 0) or not np.all(np.isfinite(frf.values)):
-        raise InputError("FRF frequencies must increase and values be finite", field=name)
-    return frf
 
 
-def _common_grid(frf_x: FRF, frf_y) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(f, Φ_xx, Φ_yy) on the x grid (restricted to the band both FRFs cover)."""
-    if frf_y is None:
-        return frf_x.freq_hz, frf_x.values, frf_x.values
-    if isinstance(frf_y, str) and frf_y == "rigid":
-        return frf_x.freq_hz, frf_x.values, np.zeros_like(frf_x.values)
-    frf_y = _as_receptance(frf_y, "frf_y")
-    if len(frf_y) == len(frf_x) and np.allclose(frf_y.freq_hz, frf_x.freq_hz, rtol=1e-12, atol=0):
-        return frf_x.freq_hz, frf_x.values, frf_y.values
-    x = frf_x.band(frf_y.freq_hz[0], frf_y.freq_hz[-1])
+def _common_grid(frf_x: FRF, others: dict) -> tuple[np.ndarray, dict]:
+    """(f, {name: Φ on f}) on the x grid, restricted to the band every FRF covers.
+
+    ``others`` maps "frf_y", "frf_xy", "frf_yx" to an FRF, ``None`` or
+    ``"rigid"``; ``None`` means Φ_yy = Φ_xx (y) or 0 (cross terms).
+    """
+    given = {k: _as_receptance(v, k) for k, v in others.items() if isinstance(v, FRF)}
+    for k, v in others.items():
+        if v is not None and not isinstance(v, FRF) and not (k == "frf_y" and isinstance(v, str) and v == "rigid"):
+            allowed = "an FRF, None or 'rigid'" if k == "frf_y" else "an FRF or None"
+            raise InputError(f"expected {allowed}, got {v!r}", field=k)
+    lo = max([frf_x.freq_hz[0]] + [g.freq_hz[0] for g in given.values()])
+    hi = min([frf_x.freq_hz[-1]] + [g.freq_hz[-1] for g in given.values()])
+    x = frf_x.band(lo, hi)
     if len(x) < 3:
-        raise InputError(
-            f"x FRF ({frf_x.freq_hz[0]:g}–{frf_x.freq_hz[-1]:g} Hz) and y FRF "
-            f"({frf_y.freq_hz[0]:g}–{frf_y.freq_hz[-1]:g} Hz) share no frequency band",
-            field="frf_y",
-        )
-    return x.freq_hz, x.values, frf_y.at(x.freq_hz).values
+        names = ", ".join(given)
+        raise InputError(f"x FRF ({frf_x.freq_hz[0]:g}–{frf_x.freq_hz[-1]:g} Hz) and {names} share no "
+                         "frequency band of 3 points", field=next(iter(given)))
+    f = x.freq_hz
+    out = {"xx": x.values}
+    for k, name in (("frf_y", "yy"), ("frf_xy", "xy"), ("frf_yx", "yx")):
+        v = others.get(k)
+        if isinstance(v, FRF):
+            g = given[k]
+            same = len(g) == len(f) and np.allclose(g.freq_hz, f, rtol=1e-12, atol=0)
+            out[name] = g.values if same else g.at(f).values
+        elif name == "yy":
+            out[name] = np.zeros_like(x.values) if isinstance(v, str) else x.values
+        else:
+            out[name] = None
+    return f, out
+
+
+def _check_not_zero(phi: dict, f) -> None:
+    """An all-zero flexible FRF would read as 'no chatter'; refuse it instead."""
+    if not np.any(phi["xx"][f > 0]):
+        raise InputError("the x FRF is zero at every frequency (a rigid tool cannot be analysed: "
+                         "no chatter is not a result here)", field="frf_x")
 
 
 def zoa_lobes(
     frf_x: FRF,
     frf_y: FRF | str | None = None,
+    cutting: CuttingConditions | None = None,
     *,
-    teeth: int,
-    kt: float,
-    kr: float,
-    radial_immersion: float,
-    milling: str = "down",
     rpm,
+    frf_xy: FRF | None = None,
+    frf_yx: FRF | None = None,
+    **deprecated,
 ) -> LobeResult:
     """Stability lobes by the zero-order approximation, from tool-point receptances.
 
     Parameters
     ----------
-    frf_x : receptance in the feed direction x (m/N; mobility/accelerance are converted).
-    frf_y : receptance in y; ``None`` for a symmetric tool (Φ_yy = Φ_xx),
+    frf_x : FRF
+        Receptance Φ_xx in the feed direction x, m/N (mobility/accelerance are converted).
+    frf_y : FRF or "rigid" or None
+        Receptance Φ_yy; ``None`` for a symmetric tool (Φ_yy = Φ_xx),
         ``"rigid"`` for Φ_yy = 0. Interpolated onto the x grid if it differs.
-    teeth : number of teeth N.
-    kt : tangential cutting coefficient K_t, N/m².
-    kr : K_n/K_t.
-    radial_immersion : a_e/D ∈ (0, 1].
-    milling : ``"down"`` or ``"up"``.
-    rpm : increasing spindle speeds (rpm) on which the limit is returned.
+    cutting : CuttingConditions
+        Teeth, K_t (N/m²), K_r = K_n/K_t, a_e/D and down/up milling.
+    rpm : array_like
+        Increasing spindle speeds, rpm, on which the limit is returned.
+    frf_xy, frf_yx : FRF, optional
+        Cross receptances Φ_xy (x response to a y force) and Φ_yx, m/N; default 0.
+    **deprecated
+        The old keywords ``teeth, kt, kr, radial_immersion, milling``: still
+        accepted for one release, with a :class:`DeprecationWarning`.
 
     Returns
     -------
-    LobeResult with the limit (minimum over lobes k = 0, 1, … and both
-    eigenvalue branches) and chatter frequency on ``rpm``, every lobe's own
-    points inside the range, and the absolute minimum refined between
-    frequency points (parabola through the three lowest-depth neighbours).
+    LobeResult
+        The limit (minimum over lobes k = 0, 1, … and both eigenvalue
+        branches, m) and chatter frequency (Hz) on ``rpm``, every lobe's own
+        points inside the range (thinned to :data:`MAX_LOBE_POINTS`), and the
+        absolute minimum refined between frequency points (parabola through the
+        three lowest-depth neighbours).
+
+    Raises
+    ------
+    InputError
+        Bad cutting conditions or speeds, non-finite FRF values, FRF bands that
+        do not overlap, an x FRF that is zero everywhere.
+
+    Examples
+    --------
+    One mode in x (922 Hz, ζ = 0.011, 0.03993 kg), rigid in y, slotting with
+    two teeth: the minimum of the limit is 2kζ(1+ζ)/(N K_n/4) = 0.298 mm.
+
+    >>> import numpy as np
+    >>> from toolpoint.frf import FRF
+    >>> from toolpoint.stability import CuttingConditions, zoa_lobes
+    >>> f = np.arange(1.0, 3001.0)                     # Hz
+    >>> w, wn, zeta, m = 2 * np.pi * f, 2 * np.pi * 922.0, 0.011, 0.03993
+    >>> frf = FRF(f, 1 / (m * (wn**2 - w**2 + 2j * zeta * wn * w)))
+    >>> cut = CuttingConditions(teeth=2, tangential_coeff=6e8, radial_ratio=1/3, radial_immersion=1.0)
+    >>> res = zoa_lobes(frf, "rigid", cut, rpm=np.linspace(5000, 25000, 200))
+    >>> round(res.min_depth_m * 1e3, 3)                # mm
+    0.298
     """
-    teeth, kt, kr, ri, milling = check_cutting(teeth, kt, kr, radial_immersion, milling)
+    cut = resolve_cutting(cutting, deprecated, "zoa_lobes")
     grid = check_rpm(rpm)
     frf_x = _as_receptance(frf_x, "frf_x")
-    f, pxx, pyy = _common_grid(frf_x, frf_y)
-    phi_st, phi_ex = immersion_angles(ri, milling)
-    h0 = average_directional_matrix(teeth, kt, kr, phi_st, phi_ex)
+    f, phi = _common_grid(frf_x, {"frf_y": frf_y, "frf_xy": frf_xy, "frf_yx": frf_yx})
+    _check_not_zero(phi, f)
+    phi_st, phi_ex = cut.immersion_angles
+    h0 = average_directional_matrix(cut.teeth, cut.tangential_coeff, cut.radial_ratio, phi_st, phi_ex)
 
-    mu = oriented_eigenvalues(h0, pxx, pyy)  # (2, nf)
+    mu = oriented_eigenvalues(h0, phi["xx"], phi["yy"], phi["xy"], phi["yx"])  # (2, nf)
     depth, eps, valid = depth_and_phase(mu)
     valid &= f[None, :] > 0
     # Waves per tooth period at lobe k: f_c T = k + ε/2π; speed n = 60 f_c / (N (k + ε/2π)).
-    c = 60.0 * f[None, :] / teeth  # (1, nf): rpm·(waves per tooth period)
+    c = 60.0 * f / cut.teeth  # rpm·(waves per tooth period)
     frac = eps / (2 * np.pi)
 
-    limit, chatter = _envelope(grid, c, frac, depth, valid, f)
-    lobes, pts = _lobe_points(grid, c, frac, depth, valid, f)
-    min_d, min_r, min_f = _absolute_minimum(grid, limit, chatter, pts, c, frac, depth, valid, f)
-    params = dict(
-        teeth=teeth, kt=kt, kr=kr, radial_immersion=ri, milling=milling,
-        phi_st=phi_st, phi_ex=phi_ex, h0=h0, freq_band_hz=(float(f[0]), float(f[-1])),
-    )
-    return LobeResult(grid, limit, chatter, lobes, "zoa", min_d, min_r, min_f, params)
+    limit, chatter, knum = _envelope(grid, 60.0 / cut.teeth, f, mu, valid)
+    lobes, best = _lobe_points(grid, c, frac, depth, valid, f)
+    min_d, min_r, min_f = _absolute_minimum(grid, limit, chatter, best, c, frac, depth, valid, f)
+    params = dict(cut.as_dict(), cutting=cut, phi_st=phi_st, phi_ex=phi_ex, h0=h0,
+                  freq_band_hz=(float(f[0]), float(f[-1])), cross=phi["xy"] is not None or phi["yx"] is not None)
+    return LobeResult(grid, limit, chatter, lobes, "zoa", min_d, min_r, min_f, params, knum)
 
 
 # ---------------------------------------------------------------- internals
@@ -189,83 +273,175 @@ def _k_range(c, frac, rmin, rmax):
     return klo, khi
 
 
+def _blocks(counts, budget):
+    """Slices of consecutive items whose counts sum to about ``budget`` at most (one item at least)."""
+    cum = np.cumsum(counts)
+    start = 0
+    while start < counts.size:
+        base = cum[start - 1] if start else 0
+        stop = max(int(np.searchsorted(cum, base + budget, "right")), start + 1)
+        yield slice(start, stop)
+        start = stop
+
+
 def _pairs(klo, khi):
     """Expand index ranges [klo_s, khi_s] into (s, k) pairs without a Python loop."""
     cnt = np.maximum(khi - klo + 1, 0).astype(np.int64)
     total = int(cnt.sum())
-    if total > _MAX_PAIRS:
-        raise InputError(
-            f"{total} lobe segments in this speed range (FRF band too wide for so low a minimum "
-            "speed): raise the minimum rpm or limit the FRF band",
-            field="rpm",
-        )
     s = np.repeat(np.arange(cnt.size), cnt)
     start = np.cumsum(cnt) - cnt
     k = klo.reshape(-1)[s] + (np.arange(total) - start[s])
     return s, k
 
 
-def _envelope(grid, c, frac, depth, valid, f):
-    """Minimum over lobes of the lobe curves, sampled on ``grid``.
+def _pieces(mu, valid, f):
+    """Pieces of lobe curve between neighbouring FRF points: (branch, i, t_a, t_b).
 
-    Every pair of neighbouring valid frequency points is a segment of lobe k
-    (f, ε and a_lim interpolated linearly between them); a lobe may fold back
-    in speed, so each segment is intersected with the grid on its own
-    (searchsorted over its speed range, which n(t) spans monotonically) and
-    the minimum per grid speed taken over all segments that cover it.
+    μ is linear in t ∈ [0, 1] between points i and i + 1. A piece is where
+    Re μ < 0: the whole interval when both ends are valid, else up to the
+    crossing t* = Re μ_i / (Re μ_i − Re μ_{i+1}) of zero, where a_lim → ∞.
+    """
+    v0, v1 = valid[:, :-1], valid[:, 1:]
+    usable = np.isfinite(mu[:, :-1]) & np.isfinite(mu[:, 1:]) & (f[None, :-1] > 0)
+    b, i = np.nonzero((v0 | v1) & usable)
+    m0, m1 = mu[b, i].real, mu[b, i + 1].real
+    both = v0[b, i] & v1[b, i]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tstar = np.clip(np.where(both, 0.5, m0 / (m0 - m1)), 0.0, 1.0)
+    left = v0[b, i] & ~both  # valid at i only: the piece ends at the crossing
+    ta = np.where(both | left, 0.0, tstar)
+    tb = np.where(both, 1.0, np.where(left, tstar, 1.0))
+    keep = tb > ta
+    return b[keep], i[keep], ta[keep], tb[keep]
+
+
+def _at(mu, f, b, i, t):
+    """(μ(t), f(t)) on the piece of branch b between points i, i + 1."""
+    mt = mu[b, i] + t * (mu[b, i + 1] - mu[b, i])
+    ft = f[i] + t * (f[i + 1] - f[i])
+    return mt, ft
+
+
+def _envelope(grid, teeth_c, f, mu, valid):
+    """Minimum over lobes of the lobe curves, sampled on ``grid``: (limit m, chatter Hz, lobe k).
+
+    ``teeth_c`` is 60/N (rpm per Hz and wave per tooth period). Every piece
+    (see :func:`_pieces`) of every lobe k whose speed span meets
+    the grid contributes at the grid speeds it spans (a lobe may fold back in
+    speed, so each piece is intersected with the grid on its own), streamed
+    in blocks of at most ``_BLOCK`` (piece, k) pairs.
     """
     rmin, rmax = grid[0], grid[-1]
-    seg = valid[:, :-1] & valid[:, 1:] & (np.abs(np.diff(frac, axis=1)) < 0.5)
-    b, i = np.nonzero(seg)
-    cc0, cc1 = c[0, i], c[0, i + 1]
-    fr0, fr1 = frac[b, i], frac[b, i + 1]
-    klo0, khi0 = _k_range(cc0, fr0, rmin, rmax)
-    klo1, khi1 = _k_range(cc1, fr1, rmin, rmax)
-    # A segment matters for k unless both ends lie on the same side of the range.
-    s, k = _pairs(np.minimum(klo0, klo1), np.maximum(khi0, khi1))
-    r0 = cc0[s] / (k + fr0[s])
-    r1 = cc1[s] / (k + fr1[s])
-    lo, hi = np.minimum(r0, r1), np.maximum(r0, r1)
-    j0 = np.searchsorted(grid, lo, "left")
-    j1 = np.searchsorted(grid, hi, "right")
-    cnt = np.maximum(j1 - j0, 0)
-    q = np.repeat(np.arange(cnt.size), cnt)
-    start = np.cumsum(cnt) - cnt
-    g = j0[q] + (np.arange(q.size) - start[q])
-    # Along a segment f, ε and a_lim vary linearly in t ∈ [0, 1]; the speed
-    # n(t) = c(t)/(k + ε(t)/2π) is then a ratio of linear functions, inverted
-    # exactly. (Straight lines in the (rpm, depth) plane would cut corners
-    # where one frequency step spans a wide speed range: low k, sharp modes.)
-    sq = s[q]
-    r = grid[g]
-    kk = k[q]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        den = r * (fr1 - fr0)[sq] - (cc1 - cc0)[sq]
-        t = np.where(den != 0, (cc0[sq] - r * (kk + fr0[sq])) / den, 0.0)
-    t = np.clip(t, 0.0, 1.0)
-    a0, a1 = depth[b[sq], i[sq]], depth[b[sq], i[sq] + 1]
-    d = a0 + t * (a1 - a0)
-    fc = f[i[sq]] + t * (f[i[sq] + 1] - f[i[sq]])
+    b, i, ta, tb = _pieces(mu, valid, f)
+    mua, fa = _at(mu, f, b, i, ta)
+    mub, fb = _at(mu, f, b, i, tb)
+    # Ends at a crossing have Re μ = 0 exactly (round-off would put ε on the wrong side).
+    mua = np.where(valid[b, i] | (ta == 0), mua, 1j * mua.imag)
+    mub = np.where(valid[b, i + 1] | (tb == 1), mub, 1j * mub.imag)
+    fra, frb = _phase(mua) / (2 * np.pi), _phase(mub) / (2 * np.pi)
+    ca, cb = teeth_c * fa, teeth_c * fb
+    klo_a, khi_a = _k_range(ca, fra, rmin, rmax)
+    klo_b, khi_b = _k_range(cb, frb, rmin, rmax)
+    klo, khi = np.minimum(klo_a, klo_b), np.maximum(khi_a, khi_b)
+    counts = np.maximum(khi - klo + 1, 0)
+
     limit = np.full(grid.size, np.inf)
     chatter = np.full(grid.size, np.nan)
-    if g.size:
+    knum = np.full(grid.size, -1)
+    for sl in _blocks(counts, _BLOCK):
+        s, k = _pairs(klo[sl], khi[sl])
+        s = s + sl.start
+        with np.errstate(divide="ignore"):
+            r0 = ca[s] / (k + fra[s])
+            r1 = cb[s] / (k + frb[s])
+        lo, hi = np.minimum(r0, r1), np.maximum(r0, r1)
+        j0 = np.searchsorted(grid, lo, "left")
+        j1 = np.searchsorted(grid, hi, "right")
+        cnt = np.maximum(j1 - j0, 0)
+        if not cnt.any():
+            continue
+        q = np.repeat(np.arange(cnt.size), cnt)
+        start = np.cumsum(cnt) - cnt
+        g = j0[q] + (np.arange(q.size) - start[q])
+        p, kk, r = s[q], k[q], grid[g]
+        t = _solve_speed(mu, f, teeth_c, b[p], i[p], ta[p], tb[p], fra[p], frb[p], kk, r)
+        mt, ft = _at(mu, f, b[p], i[p], t)
+        with np.errstate(divide="ignore"):
+            d = np.where(mt.real < 0, -0.5 / mt.real, np.inf)
         order = np.lexsort((d, g))  # by grid index, then depth
-        g_sorted = g[order]
-        first = np.r_[True, g_sorted[1:] != g_sorted[:-1]]
-        sel = order[first]
+        gs = g[order]
+        sel = order[np.r_[True, gs[1:] != gs[:-1]]]
+        better = d[sel] < limit[g[sel]]
+        sel = sel[better]
         limit[g[sel]] = d[sel]
-        chatter[g[sel]] = fc[sel]
-    return limit, chatter
+        chatter[g[sel]] = ft[sel]
+        knum[g[sel]] = kk[sel]
+    return limit, chatter, knum
+
+
+def _solve_speed(mu, f, teeth_c, b, i, ta, tb, fra, frb, k, r, iters=40):
+    """Parameter t ∈ [t_a, t_b] of each piece where lobe k passes speed r.
+
+    Root of h(t) = c(t) − r (k + ε(t)/2π), c = 60 f/N: start from the exact
+    root when ε is linear in t, then Newton steps (dε/dt = 2 Im(μ'/μ)) kept
+    inside a bracket that bisection shrinks when a step leaves it.
+    """
+    dmu = mu[b, i + 1] - mu[b, i]
+    df = f[i + 1] - f[i]
+
+    def h(t):
+        mt = mu[b, i] + t * dmu
+        return teeth_c * (f[i] + t * df) - r * (k + _phase(mt) / (2 * np.pi)), mt
+
+    lo, hi = ta.copy(), tb.copy()
+    hlo = h(lo)[0]
+    # Initial guess: ε linear between the piece ends (exact root of a linear-ε model).
+    ca, cb = teeth_c * (f[i] + ta * df), teeth_c * (f[i] + tb * df)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        den = r * (frb - fra) - (cb - ca)
+        u = np.where(den != 0, (ca - r * (k + fra)) / den, 0.5)
+    t = ta + np.clip(np.nan_to_num(u, nan=0.5), 0.0, 1.0) * (tb - ta)
+    for _ in range(iters):
+        ht, mt = h(t)
+        # Keep the bracket [lo, hi] with a sign change.
+        same = np.sign(ht) == np.sign(hlo)
+        lo, hlo = np.where(same, t, lo), np.where(same, ht, hlo)
+        hi = np.where(same, hi, t)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            deps = 2 * (np.conj(mt) * dmu).imag / np.abs(mt) ** 2
+            dh = teeth_c * df - r * deps / (2 * np.pi)
+            tn = t - ht / dh
+        bad = ~np.isfinite(tn) | (tn <= lo) | (tn >= hi)
+        tn = np.where(bad, 0.5 * (lo + hi), tn)
+        if np.all(np.abs(tn - t) <= 1e-13):
+            t = tn
+            break
+        t = tn
+    return t
 
 
 def _lobe_points(grid, c, frac, depth, valid, f):
-    """Each lobe's own points with speed inside the grid range, grouped by (k, branch)."""
+    """Each lobe's own points with speed inside the grid range, grouped by (k, branch).
+
+    Returns the lobes (thinned to at most ``MAX_LOBE_POINTS`` points) and the
+    lowest-depth point (b, i, k) of all, found before thinning.
+    """
     rmin, rmax = grid[0], grid[-1]
     b, i = np.nonzero(valid)
-    klo, khi = _k_range(c[0, i], frac[b, i], rmin, rmax)
+    klo, khi = _k_range(c[i], frac[b, i], rmin, rmax)
+    counts = np.maximum(khi - klo + 1, 0)
+    best = None
+    has = counts > 0
+    if has.any():
+        p = int(np.argmin(np.where(has, depth[b, i], np.inf)))
+        best = (int(b[p]), int(i[p]), int(klo[p]))
+    stride = max(1, int(np.ceil(counts.sum() / MAX_LOBE_POINTS)))
+    if stride > 1:
+        keep = (i % stride) == 0
+        b, i, klo, khi = b[keep], i[keep], klo[keep], khi[keep]
     s, k = _pairs(klo, khi)
     bb, ii = b[s], i[s]
-    r = c[0, ii] / (k + frac[bb, ii])
+    r = c[ii] / (k + frac[bb, ii])
     keep = (r >= rmin) & (r <= rmax)  # guards rounding at the range ends
     bb, ii, k, r = bb[keep], ii[keep], k[keep], r[keep]
     order = np.lexsort((ii, bb, k))
@@ -277,10 +453,10 @@ def _lobe_points(grid, c, frac, depth, valid, f):
         for kk, bq, rr, dd, ff in zip(*(np.split(x, cuts) for x in (k, bb, r, d, fc)))
         if kk.size
     ]
-    return lobes, (bb, ii, k, r, d)
+    return lobes, best
 
 
-def _absolute_minimum(grid, limit, chatter, pts, c, frac, depth, valid, f):
+def _absolute_minimum(grid, limit, chatter, best_point, c, frac, depth, valid, f):
     """Lowest limit in the range: the lowest lobe point, refined by a parabola in frequency.
 
     Lobe depth depends on the chatter frequency only, so near its lowest
@@ -293,13 +469,12 @@ def _absolute_minimum(grid, limit, chatter, pts, c, frac, depth, valid, f):
     if finite.any():
         j = int(np.argmin(np.where(finite, limit, np.inf)))
         best = (float(limit[j]), float(grid[j]), float(chatter[j]))
-    bb, ii, k, r, d = pts
-    if d.size == 0:
+    if best_point is None:
         return best
-    p = int(np.argmin(d))
-    if d[p] < best[0]:
-        best = (float(d[p]), float(r[p]), float(f[ii[p]]))
-    b, i, kk = bb[p], ii[p], k[p]
+    b, i, kk = best_point
+    r = c[i] / (kk + frac[b, i])
+    if depth[b, i] < best[0]:
+        best = (float(depth[b, i]), float(r), float(f[i]))
     if 0 < i < f.size - 1 and valid[b, i - 1] and valid[b, i + 1]:
         x = f[i - 1 : i + 2]
         y = depth[b, i - 1 : i + 2]
@@ -311,7 +486,7 @@ def _absolute_minimum(grid, limit, chatter, pts, c, frac, depth, valid, f):
             if x[0] < xv < x[2]:
                 yv = y[1] + d1 * (xv - x[1]) + curv * (xv - x[0]) * (xv - x[1])
                 fr = np.interp(xv, x, frac[b, i - 1 : i + 2])
-                rv = (c[0, i] / f[i]) * xv / (kk + fr)  # c/f = 60/N
+                rv = (c[i] / f[i]) * xv / (kk + fr)  # c/f = 60/N
                 if 0 < yv <= best[0] and grid[0] <= rv <= grid[-1]:
                     best = (float(yv), float(rv), float(xv))
     return best

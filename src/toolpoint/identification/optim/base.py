@@ -1,40 +1,248 @@
-"""What the optimisers share: termination criteria, progress tracking, result.
+"""What the optimisers share: stopping rules, status codes, progress tracking, result.
 
 In pymoo's spirit the *problem* (:class:`toolpoint.identification.objective.JointProblem`:
-``evaluate(X)``, bounds ``xl``/``xu``, ``nfev``), the *algorithm* (GA, PSO, SA,
-DE, hybrid; options in ``__init__``) and the *termination* are separate. Every
-algorithm works on the unit cube internally and reports a scipy-style
-``OptimizeResult``.
+``evaluate(X)``, bounds ``xl``/``xu``, ``nfev``) and the *algorithm* (GA, PSO,
+SA, DE, hybrid) are separate. Every option of an algorithm, the stopping rules
+included, is an argument of its ``__init__`` (scipy style, scipy's names:
+``maxiter``, ``maxfev``, ``popsize``, ``tol``); :class:`Termination` is only
+the read-only summary of the stopping rules that the algorithm derives from
+them (:meth:`Optimizer.termination`).
+
+Every algorithm works on the unit cube of x = log10 p internally and returns a
+``scipy.optimize.OptimizeResult`` whose ``x`` and ``fun`` are in the
+optimiser's own space (log10 of the parameters; objective in m/N) and whose
+``success``/``status``/``message`` give the actual reason it stopped:
+
+====== ====================================================================
+status meaning
+====== ====================================================================
+0      converged: the stall test held (the best objective changed by at most
+       ``tol``, relative, over the last ``stall_iter`` iterations), the
+       objective target ``f_target`` was reached, or (DE) scipy's own
+       convergence test held, or (hybrid) least squares converged
+1      iteration limit ``maxiter`` reached
+2      evaluation limit ``maxfev`` reached (hybrid: least squares hit its
+       ``local_maxfev``)
+3      stopped for another reason (the message says which)
+====== ====================================================================
+
+``success`` is ``status == 0``: a run that hits a cap is not a success even
+if its answer is good, unless a convergence test held at the same iteration.
 """
 
 from __future__ import annotations
 
+import math
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+__all__ = ["CONVERGED", "MAXITER", "MAXFEV", "OTHER", "STATUS_MESSAGES", "Termination", "Optimizer", "Tracker",
+           "horizon", "to_unit", "from_unit"]
 
-@dataclass(frozen=True)
+CONVERGED, MAXITER, MAXFEV, OTHER = 0, 1, 2, 3
+#: One-line meaning of each status code (the ``message`` adds the details).
+STATUS_MESSAGES = {
+    CONVERGED: "converged",
+    MAXITER: "maximum number of iterations reached",
+    MAXFEV: "maximum number of evaluations reached",
+    OTHER: "stopped",
+}
+
+# Old Termination field names (one release of grace).
+_OLD_TERMINATION = {"max_iter": "maxiter", "max_evals": "maxfev", "ftol": "tol"}
+
+
+def warn_renamed(owner: str, old: str, new: str, extra: str = "", stacklevel: int = 3) -> None:
+    """Emit the :class:`DeprecationWarning` for an option renamed from ``old`` to ``new``."""
+    warnings.warn(f"{owner}: option {old!r} is deprecated, use {new!r}{extra}", DeprecationWarning,
+                  stacklevel=stacklevel)
+
+
+@dataclass(frozen=True, init=False)
 class Termination:
-    """When to stop (whichever comes first).
+    """Stopping rules of one run (whichever holds first), derived from the algorithm's options.
 
-    max_iter : iterations (generations); max_evals : model evaluations (points);
-    stall_iter / ftol : stop when the best objective improved by less than
-    ftol (relative) over the last ``stall_iter`` iterations (MATLAB's
-    MaxStallGenerations / FunctionTolerance); f_target : stop when reached.
+    Parameters
+    ----------
+    maxiter : int or None
+        Iteration (generation) limit; the initial population counts as iteration 1.
+    maxfev : int or None
+        Model-evaluation limit (points evaluated, :attr:`JointProblem.nfev`).
+    stall_iter : int or None
+        Stall window, iterations; None disables the stall test.
+    tol : float, default 1e-6
+        Stall test: stop (converged) when the best objective f improved by at
+        most ``tol`` relative to its value ``stall_iter`` iterations ago,
+        f_old − f_best ≤ tol · f_old.
+    f_target : float or None
+        Stop (converged) when the best objective is ≤ this value, m/N.
+
+    Notes
+    -----
+    The old field names ``max_iter``, ``max_evals`` and ``ftol`` are accepted for one release with a
+    :class:`DeprecationWarning`. Passing a Termination to ``minimize`` or ``identify`` is deprecated: set the
+    same options on the algorithm.
+
+    Examples
+    --------
+    >>> Termination(maxiter=100, stall_iter=10, tol=1e-6).maxfev is None
+    True
     """
 
-    max_iter: int | None = None
-    max_evals: int | None = None
+    maxiter: int | None
+    maxfev: int | None
+    stall_iter: int | None
+    tol: float
+    f_target: float | None
+
+    def __init__(self, maxiter: int | None = None, maxfev: int | None = None, stall_iter: int | None = None,
+                 tol: float = 1e-6, f_target: float | None = None, **old):
+        given = {"maxiter": maxiter, "maxfev": maxfev, "tol": tol}
+        for name, value in old.items():
+            if name not in _OLD_TERMINATION:
+                raise TypeError(f"Termination: unknown field {name!r}")
+            warn_renamed("Termination", name, _OLD_TERMINATION[name])
+            given[_OLD_TERMINATION[name]] = value
+        object.__setattr__(self, "maxiter", given["maxiter"])
+        object.__setattr__(self, "maxfev", given["maxfev"])
+        object.__setattr__(self, "stall_iter", stall_iter)
+        object.__setattr__(self, "tol", float(given["tol"]))
+        object.__setattr__(self, "f_target", f_target)
+
+    def as_options(self) -> dict:
+        """The same rules as algorithm options (``maxiter``, ``maxfev``, ``stall_iter``, ``tol``, ``f_target``)."""
+        return {"maxiter": self.maxiter, "maxfev": self.maxfev, "stall_iter": self.stall_iter, "tol": self.tol,
+                "f_target": self.f_target}
+
+
+def horizon(term: Termination, first: int, per_iter: int) -> int | None:
+    """Iterations a run can last under ``term``: the smaller of ``maxiter`` and what ``maxfev`` affords.
+
+    Parameters
+    ----------
+    term : Termination
+    first : int
+        Evaluations of the first iteration (the initial population).
+    per_iter : int
+        Evaluations of each later iteration.
+
+    Returns
+    -------
+    int or None
+        H such that the run stops at iteration H at the latest (None: unbounded). With an evaluation budget
+        B ≥ ``first`` the last iteration is 1 + ⌈(B − first) / per_iter⌉ (the last may evaluate only part of
+        the population, to stay within B).
+
+    Examples
+    --------
+    >>> horizon(Termination(maxiter=280), 120, 120), horizon(Termination(maxiter=280, maxfev=1200), 120, 120)
+    (280, 10)
+    """
+    caps = []
+    if term.maxiter is not None:
+        caps.append(int(term.maxiter))
+    if term.maxfev is not None:
+        caps.append(1 + math.ceil(max(term.maxfev - first, 0) / max(per_iter, 1)))
+    return max(min(caps), 1) if caps else None
+
+
+class Optimizer:
+    """Shared machinery of the optimisers: options, stopping rules and the ``minimize`` entry point.
+
+    Subclasses set ``name``, ``_OPTIONS`` (their ``__init__`` arguments, in order), ``_RENAMED`` (old option
+    name → new) and implement ``_minimize(problem, rng, callback)``.
+    """
+
+    name = ""
+    _OPTIONS: tuple[str, ...] = ()
+    _RENAMED: dict[str, str] = {}
+
+    # These stopping options exist on every population method (DE and the hybrid override the defaults).
+    maxiter: int | None = None
+    maxfev: int | None = None
     stall_iter: int | None = None
-    ftol: float = 1e-6
+    tol: float = 0.0
     f_target: float | None = None
+
+    def _renamed(self, old: dict) -> dict:
+        """Map deprecated option names in ``old`` to the new ones (with a DeprecationWarning each)."""
+        cls = type(self).__name__
+        out = {}
+        for name, value in old.items():
+            if name not in self._RENAMED:
+                raise TypeError(f"{cls}: unknown option {name!r} (options: {', '.join(self._OPTIONS)})")
+            warn_renamed(cls, name, self._RENAMED[name], stacklevel=4)
+            out[self._RENAMED[name]] = value
+        return out
+
+    def options(self) -> dict:
+        """The options of this instance, as keyword arguments of its class."""
+        return {k: getattr(self, k) for k in self._OPTIONS}
+
+    def with_options(self, **changes):
+        """A copy with some options changed (new names only)."""
+        unknown = set(changes) - set(self._OPTIONS)
+        if unknown:
+            raise TypeError(f"{type(self).__name__}: unknown option(s) {', '.join(sorted(unknown))}")
+        return type(self)(**{**self.options(), **changes})
+
+    def _with_termination(self, term: Termination) -> "Optimizer":
+        """A copy whose stopping options are replaced by ``term`` (the deprecated API)."""
+        return self.with_options(**{k: v for k, v in term.as_options().items() if k in self._OPTIONS})
+
+    def termination(self) -> Termination:
+        """The stopping rules these options define."""
+        return Termination(maxiter=self.maxiter, maxfev=self.maxfev, stall_iter=self.stall_iter, tol=self.tol,
+                           f_target=self.f_target)
+
+    def minimize(self, problem, rng: np.random.Generator, termination: Termination | None = None,
+                 callback=None) -> OptimizeResult:
+        """Minimise ``problem`` from the random state ``rng``.
+
+        Parameters
+        ----------
+        problem : JointProblem
+            ``evaluate(X)`` for X (N, 4) in log10 space, bounds ``xl``/``xu``, counter ``nfev``.
+        rng : numpy.random.Generator
+            The only source of randomness: the same seed gives the same run.
+        termination : Termination, optional
+            Deprecated: replaces this instance's stopping options for this run (as the old API did).
+        callback : callable, optional
+            ``callback(nit, best_f, nfev)`` after every iteration.
+
+        Returns
+        -------
+        scipy.optimize.OptimizeResult
+            ``x`` (log10 p), ``fun`` (m/N), ``nfev``, ``nit``, ``success``, ``status`` (see the module
+            table), ``message``, ``history`` (best objective per iteration, m/N), ``seconds``, ``method``.
+        """
+        if termination is not None:
+            warnings.warn("minimize(termination=…) is deprecated: set maxiter, maxfev, stall_iter, tol and "
+                          "f_target on the algorithm", DeprecationWarning, stacklevel=2)
+            return self._with_termination(termination)._minimize(problem, rng, callback)
+        return self._minimize(problem, rng, callback)
+
+    def _minimize(self, problem, rng, callback) -> OptimizeResult:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({', '.join(f'{k}={v!r}' for k, v in self.options().items())})"
 
 
 class Tracker:
-    """Best point so far, per-iteration history, termination and callback."""
+    """Best point so far, per-iteration history, stopping rules and callback of one run.
+
+    Parameters
+    ----------
+    problem : JointProblem (or a wrapper with ``nfev``)
+    termination : Termination
+    callback : callable, optional
+        ``callback(nit, best_f, nfev)`` after every iteration.
+    """
 
     def __init__(self, problem, termination: Termination, callback=None):
         self.problem = problem
@@ -46,60 +254,81 @@ class Tracker:
         self.best_f = np.inf
         self.history: list[float] = []
         self.nit = 0
-        self.message = "maximum number of iterations reached"
+        self.status: int | None = None  # set when a stopping rule held
+        self.message = ""
 
     @property
     def nfev(self) -> int:
+        """Model evaluations since the run started."""
         return self.problem.nfev - self.nfev0
 
+    @property
+    def budget(self) -> float:
+        """Evaluations left before ``maxfev`` (inf without a budget)."""
+        return np.inf if self.term.maxfev is None else self.term.maxfev - self.nfev
+
     def offer(self, X: np.ndarray, F: np.ndarray) -> None:
-        """Consider evaluated points X (N, 4) with objectives F (N,)."""
+        """Consider evaluated points X (N, 4), log10 space, with objectives F (N,), m/N."""
+        if len(F) == 0:
+            return
         k = int(np.argmin(F))
         if F[k] < self.best_f:
             self.best_f = float(F[k])
             self.best_x = np.array(X[k], float)
 
+    def stop(self, status: int, message: str) -> bool:
+        """Record why the run stops; returns True."""
+        self.status, self.message = status, message
+        return True
+
     def next_iteration(self) -> bool:
-        """Record the iteration; True when a termination criterion is met."""
+        """Record the iteration just finished; True when a stopping rule holds.
+
+        Convergence tests are checked before the caps, so a run that converges
+        on its last allowed iteration is a success.
+        """
         self.nit += 1
         self.history.append(self.best_f)
         if self.callback is not None:
             self.callback(self.nit, self.best_f, self.nfev)
         t = self.term
         if t.f_target is not None and self.best_f <= t.f_target:
-            self.message = "objective target reached"
-            return True
-        if t.max_evals is not None and self.nfev >= t.max_evals:
-            self.message = "maximum number of evaluations reached"
-            return True
-        if t.max_iter is not None and self.nit >= t.max_iter:
-            self.message = "maximum number of iterations reached"
-            return True
+            return self.stop(CONVERGED, f"converged: objective target {t.f_target:g} m/N reached")
         if t.stall_iter and len(self.history) > t.stall_iter:
             old = self.history[-1 - t.stall_iter]
-            if old - self.best_f <= t.ftol * max(abs(old), 1e-300):
-                self.message = f"best objective changed less than ftol={t.ftol:g} over {t.stall_iter} iterations"
-                return True
+            if old - self.best_f <= t.tol * max(abs(old), 1e-300):
+                return self.stop(CONVERGED, f"converged: the best objective changed by at most tol={t.tol:g} "
+                                            f"(relative) over the last {t.stall_iter} iterations")
+        if t.maxfev is not None and self.nfev >= t.maxfev:
+            return self.stop(MAXFEV, STATUS_MESSAGES[MAXFEV])
+        if t.maxiter is not None and self.nit >= t.maxiter:
+            return self.stop(MAXITER, STATUS_MESSAGES[MAXITER])
         return False
 
-    def result(self, method: str, success: bool = True, **extra) -> OptimizeResult:
+    def result(self, method: str, **extra) -> OptimizeResult:
+        """The run's ``OptimizeResult`` (x in log10 space; success = status 0)."""
+        status = OTHER if self.status is None else self.status
+        message = self.message or STATUS_MESSAGES[status]
         return OptimizeResult(
             x=self.best_x,
             fun=self.best_f,
             nfev=self.nfev,
             nit=self.nit,
+            success=status == CONVERGED,
+            status=status,
+            message=message,
             seconds=time.perf_counter() - self.t0,
             history=np.array(self.history),
-            message=self.message,
-            success=success,
             method=method,
             **extra,
         )
 
 
 def to_unit(problem, X):
+    """Map log10 points X to the unit cube of the problem's bounds."""
     return (np.asarray(X) - problem.xl) / (problem.xu - problem.xl)
 
 
 def from_unit(problem, U):
+    """Map unit-cube points U to log10 points within the problem's bounds."""
     return problem.xl + np.asarray(U) * (problem.xu - problem.xl)

@@ -12,6 +12,7 @@
 
 Least squares converges quadratically near the minimum, which is why the
 hybrid needs orders of magnitude fewer model evaluations than GA/SA/PSO.
+See :class:`Hybrid`.
 """
 
 from __future__ import annotations
@@ -19,12 +20,14 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import least_squares
 
-from .base import Termination, Tracker
+from .base import CONVERGED, MAXFEV, OTHER, Optimizer, Termination, Tracker
 from .de import DE
+
+__all__ = ["Hybrid"]
 
 
 class _Recorder:
-    """Wraps a problem to remember every point the global stage evaluates."""
+    """Wraps a problem to remember every point the global stage evaluates (start points for least squares)."""
 
     def __init__(self, problem):
         self.p = problem
@@ -56,25 +59,67 @@ class _Recorder:
         return X[chosen]
 
 
-class Hybrid:
-    name = "hybrid"
+class Hybrid(Optimizer):
+    """A short global search, then ``scipy.optimize.least_squares`` from its best distinct points.
 
-    def __init__(self, global_stage=None, starts: int = 3, tol: float = 1e-14, max_local_iterations: int = 200):
-        self.global_stage = global_stage or DE(popsize=10, maxiter=40, tol=1e-3)
+    Parameters
+    ----------
+    global_stage : optimiser, default ``DE(popsize=10, maxiter=40, tol=1e-3)``
+        Any of GA, SA, PSO, DE (an instance), run first with its own options.
+    starts : int, default 3
+        Least-squares runs, from the best global-stage points at least 0.1 apart (unit cube).
+    tol : float, default 1e-14
+        ``ftol``, ``xtol`` and ``gtol`` of ``least_squares`` (trust-region reflective).
+    local_maxfev : int, default 200
+        ``max_nfev`` of each ``least_squares`` run (residual evaluations).
+    maxiter, maxfev : int or None, default None
+        When given, replace the global stage's ``maxiter`` / ``maxfev``.
+
+    Notes
+    -----
+    Deprecated option name (one release): ``max_local_iterations`` → ``local_maxfev``.
+
+    Result: ``x``, ``fun`` of the best least-squares end point; ``success`` = that run converged
+    (``least_squares`` status > 0), ``status`` 0 then, 2 if it hit ``local_maxfev``, 3 otherwise (scipy's
+    own code is in ``status_local``); ``nit`` = global-stage iterations, ``nit_local`` = least-squares
+    residual evaluations summed over the starts, ``nfev`` = all model evaluations (a Jacobian counts 4),
+    ``global_nfev`` and ``global_stage`` (the global stage's result).
+
+    Examples
+    --------
+    >>> Hybrid().global_stage.maxiter, Hybrid(maxiter=10).global_stage.maxiter
+    (40, 10)
+    """
+
+    name = "hybrid"
+    _OPTIONS = ("global_stage", "starts", "tol", "local_maxfev", "maxiter", "maxfev")
+    _RENAMED = {"max_local_iterations": "local_maxfev"}
+
+    def __init__(self, global_stage=None, starts: int = 3, tol: float = 1e-14, local_maxfev: int = 200,
+                 maxiter: int | None = None, maxfev: int | None = None, **deprecated):
+        new = self._renamed(deprecated)
+        stage = global_stage or DE(popsize=10, maxiter=40, tol=1e-3)
+        changes = {k: v for k, v in (("maxiter", maxiter), ("maxfev", maxfev)) if v is not None}
+        self.global_stage = stage.with_options(**changes) if changes else stage
         self.starts = starts
         self.tol = tol
-        self.max_local_iterations = max_local_iterations
+        self.local_maxfev = new.get("local_maxfev", local_maxfev)
+        self.maxiter = maxiter
+        self.maxfev = maxfev
 
     def termination(self) -> Termination:
+        """The global stage's stopping rules (the local stage stops on ``tol`` / ``local_maxfev``)."""
         return self.global_stage.termination()
 
-    def minimize(self, problem, rng: np.random.Generator, termination: Termination | None = None, callback=None):
-        tr = Tracker(problem, termination or Termination(max_iter=1), callback)
+    def _with_termination(self, term: Termination) -> "Hybrid":
+        return self.with_options(global_stage=self.global_stage._with_termination(term), maxiter=None,
+                                 maxfev=None)
+
+    def _minimize(self, problem, rng: np.random.Generator, callback=None):
+        tr = Tracker(problem, Termination(), callback)
         rec = _Recorder(problem)
-        g = self.global_stage.minimize(rec, rng, termination, callback)
-        tr.history = list(g.history)
-        tr.nit = g.nit
-        best_x, best_f = g.x, g.fun
+        g = self.global_stage.minimize(rec, rng, callback=callback)
+        best, best_f, nit_local, njev_local = None, np.inf, 0, 0
         for x0 in rec.best_distinct(self.starts):
             r = least_squares(
                 problem.residuals,
@@ -86,13 +131,19 @@ class Hybrid:
                 ftol=self.tol,
                 xtol=self.tol,
                 gtol=self.tol,
-                max_nfev=self.max_local_iterations,
+                max_nfev=self.local_maxfev,
             )
             f = float(np.sqrt(2 * r.cost)) * problem.residual_scale
-            tr.nit += r.nfev
-            if f < best_f:
-                best_x, best_f = r.x, f
-        tr.best_x, tr.best_f = best_x, best_f
-        tr.history.append(best_f)
-        tr.message = f"global stage ({self.global_stage.name}): {g.message}; then least squares from {self.starts} starts"
-        return tr.result(self.name, global_nfev=g.nfev)
+            nit_local += r.nfev
+            njev_local += r.njev
+            if best is None or f < best_f:
+                best, best_f = r, f
+        # least squares never ends above its start, so its best end point is the best point found
+        tr.best_x, tr.best_f = best.x, best_f
+        tr.nit = g.nit
+        tr.history = [*g.history, best_f]
+        status = CONVERGED if best.status > 0 else (MAXFEV if best.status == 0 else OTHER)
+        tr.stop(status, f"least squares (best of {self.starts} starts): {best.message}; "
+                        f"global stage ({self.global_stage.name}): {g.message}")
+        return tr.result(self.name, nit_local=nit_local, njev_local=njev_local, status_local=int(best.status),
+                         global_nfev=g.nfev, global_stage=g)

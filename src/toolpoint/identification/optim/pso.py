@@ -1,62 +1,125 @@
-"""Particle swarm optimisation (global-best topology).
-
-    v ← w v + c1 r1 ⊙ (p_best − x) + c2 r2 ⊙ (g_best − x),   x ← x + v
-
-with r1, r2 ~ U(0, 1) per particle and dimension, cognitive c1 = 0.5 and social
-c2 = 1.35 (the paper's values), and the inertia weight w decreasing linearly
-from ``inertia[0]`` = 0.9 to ``inertia[1]`` = 0.4 over the iterations (Shi &
-Eberhart 1998), so the swarm explores first and converges later. Velocities
-are limited to ``max_velocity`` of the bound range per iteration; a particle
-that leaves the box is put back on the bound and its velocity component zeroed.
-Unit cube of the log10 parameters; the swarm is evaluated in one vectorised call.
-"""
+"""Particle swarm optimisation, global-best topology (see :class:`PSO`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .base import Termination, Tracker, from_unit
+from .base import Optimizer, Tracker, from_unit, horizon
+
+__all__ = ["PSO"]
 
 
-class PSO:
+class PSO(Optimizer):
+    r"""Particle swarm on the unit cube of x = log10 [kt, ct, kr, cr].
+
+    .. math::
+
+        v \leftarrow w_k v + c_1 r_1 \odot (p_{best} - x) + c_2 r_2 \odot (g_{best} - x), \qquad
+        x \leftarrow x + v
+
+    with r1, r2 ~ U(0, 1) per particle and dimension, cognitive c1 and social c2 (the paper's 0.5 and 1.35).
+    The inertia weight decreases linearly (Shi & Eberhart 1998),
+    w_k = w0 + (w1 − w0)·min(k / (H − 1), 1) at velocity update k = 0, 1, …, where H is the number of
+    iterations the run can last: ``maxiter``, or fewer when the budget ``maxfev`` affords fewer (see
+    :func:`~toolpoint.identification.optim.base.horizon`), so the swarm explores first and converges by the
+    end of the run it actually has. Velocities are limited to ``max_velocity`` of the bound range per
+    iteration; a particle that leaves the box is put back on the bound and its velocity component zeroed.
+    The swarm is evaluated in one vectorised call per iteration; with ``maxfev`` the last iteration moves
+    only the particles that fit, so the budget is never exceeded.
+
+    Parameters
+    ----------
+    popsize : int, default 120
+        Particles in the swarm (the paper's value).
+    maxiter : int or None, default 280
+        Iteration limit (the paper's); the initial swarm is iteration 1. Also the inertia schedule's length.
+    maxfev : int or None, default None
+        Evaluation budget (model evaluations); never exceeded.
+    stall_iter : int or None, default None
+        Stall window, iterations; None (default) disables the stall test, so the run lasts ``maxiter``
+        iterations and reports ``success=False`` (status 1) unless ``f_target`` is reached.
+    tol : float, default 1e-6
+        Converged when the best objective improved by at most ``tol`` (relative) over the last
+        ``stall_iter`` iterations.
+    f_target : float or None, default None
+        Converged when the best objective is ≤ this value, m/N.
+    cognitive : float, default 0.5
+        c1.
+    social : float, default 1.35
+        c2.
+    inertia : (float, float), default (0.9, 0.4)
+        (w0, w1), start and end of the inertia schedule.
+    max_velocity : float, default 0.2
+        Velocity limit per iteration, fraction of the bound range.
+
+    Notes
+    -----
+    Deprecated option names (one release): ``swarm_size`` → ``popsize``, ``iterations`` → ``maxiter``,
+    ``stall_iterations`` → ``stall_iter``, ``function_tolerance`` → ``tol`` (same meaning here).
+
+    The result carries ``popsize`` and ``inertia``, the last inertia weight used.
+
+    Examples
+    --------
+    >>> pso = PSO(maxiter=100, maxfev=1200)
+    >>> pso.inertia_weight(0, 10), pso.inertia_weight(9, 10)
+    (0.9, 0.4)
+    """
+
     name = "pso"
+    _OPTIONS = ("popsize", "maxiter", "maxfev", "stall_iter", "tol", "f_target", "cognitive", "social", "inertia",
+                "max_velocity")
+    _RENAMED = {"swarm_size": "popsize", "iterations": "maxiter", "stall_iterations": "stall_iter",
+                "function_tolerance": "tol"}
 
     def __init__(
         self,
-        swarm_size: int = 120,
-        iterations: int = 280,
+        popsize: int = 120,
+        maxiter: int | None = 280,
+        maxfev: int | None = None,
+        stall_iter: int | None = None,
+        tol: float = 1e-6,
+        f_target: float | None = None,
         cognitive: float = 0.5,
         social: float = 1.35,
         inertia: tuple[float, float] = (0.9, 0.4),
         max_velocity: float = 0.2,
-        stall_iterations: int | None = None,
-        function_tolerance: float = 1e-6,
+        **deprecated,
     ):
-        self.swarm_size = swarm_size
-        self.iterations = iterations
+        new = self._renamed(deprecated)
+        self.popsize = new.get("popsize", popsize)
+        self.maxiter = new.get("maxiter", maxiter)
+        self.maxfev = maxfev
+        self.stall_iter = new.get("stall_iter", stall_iter)
+        self.tol = new.get("tol", tol)
+        self.f_target = f_target
         self.cognitive = cognitive
         self.social = social
         self.inertia = inertia
         self.max_velocity = max_velocity
-        self.stall_iterations = stall_iterations
-        self.function_tolerance = function_tolerance
 
-    def termination(self) -> Termination:
-        return Termination(max_iter=self.iterations, stall_iter=self.stall_iterations, ftol=self.function_tolerance)
+    def inertia_weight(self, k: int, H: int | None) -> float:
+        """w_k = w0 + (w1 − w0)·min(k / (H − 1), 1) at velocity update k of an H-iteration run (w0 if H is None)."""
+        if H is None:
+            return self.inertia[0]
+        return self.inertia[0] + (self.inertia[1] - self.inertia[0]) * min(k / max(H - 1, 1), 1.0)
 
-    def minimize(self, problem, rng: np.random.Generator, termination: Termination | None = None, callback=None):
-        term = termination or self.termination()
+    def _minimize(self, problem, rng: np.random.Generator, callback=None):
+        term = self.termination()
         tr = Tracker(problem, term, callback)
-        n, d = self.swarm_size, problem.n_var
-        iters = term.max_iter or self.iterations
+        n, d = self.popsize, problem.n_var
+        if term.maxfev is not None:
+            n = max(1, min(n, term.maxfev))
+        H = horizon(term, n, n)  # the inertia schedule follows the run's real length
         X = rng.random((n, d))
         V = rng.uniform(-self.max_velocity, self.max_velocity, (n, d))
         F = problem.evaluate(from_unit(problem, X))
         P, PF = X.copy(), F.copy()
         tr.offer(from_unit(problem, X), F)
         k = 0
+        w = None
         while not tr.next_iteration():
-            w = self.inertia[0] + (self.inertia[1] - self.inertia[0]) * min(k / max(iters - 1, 1), 1.0)
+            w = self.inertia_weight(k, H)
             g = P[np.argmin(PF)]
             r1, r2 = rng.random((n, d)), rng.random((n, d))
             V = w * V + self.cognitive * r1 * (P - X) + self.social * r2 * (g - X)
@@ -65,9 +128,10 @@ class PSO:
             out = (X < 0) | (X > 1)
             X = np.clip(X, 0, 1)
             V[out] = 0.0
-            F = problem.evaluate(from_unit(problem, X))
-            better = F < PF
-            P[better], PF[better] = X[better], F[better]
-            tr.offer(from_unit(problem, X), F)
+            m = int(min(n, tr.budget))  # particles evaluated (all but at the end of a budget)
+            F = problem.evaluate(from_unit(problem, X[:m]))
+            better = F < PF[:m]
+            P[:m][better], PF[:m][better] = X[:m][better], F[better]
+            tr.offer(from_unit(problem, X[:m]), F)
             k += 1
-        return tr.result(self.name, swarm_size=n)
+        return tr.result(self.name, popsize=n, inertia=w)

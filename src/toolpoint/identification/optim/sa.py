@@ -1,102 +1,108 @@
-"""Simulated annealing with reannealing, after MATLAB's ``simulannealbnd``.
+"""Simulated annealing with reannealing, after MATLAB's ``simulannealbnd`` (see :class:`SA`).
 
-Several independent chains run side by side so that each iteration is one
-vectorised evaluation. Each chain has a point x (unit cube of the log10
-parameters), orthonormal move directions v_1 … v_d (the coordinate axes until
-the first reannealing) and one temperature per direction,
-T_k = T0 · c^a_k (MATLAB ``temperatureexp``, c = ``cooling`` 0.95), the
-annealing parameter a_k counting iterations. Below τ_k = T_k / T0 ∈ (0, 1].
-
-* **Move** (``annealingfast``): y = x + s Σ_k τ_k u_k v_k, u a random unit
-  vector, s = ``step`` (0.5 of the range). A coordinate that leaves the box is
-  placed uniformly between x and the bound it crossed (MATLAB ``sahonorbds``).
-* **Acceptance** (``acceptancesa``): always if better, else with probability
-  1 / (1 + exp(Δ / min_k τ_k)), Δ = ln f(y) − ln f(x).
-* **Reannealing** after every ``reanneal_interval`` accepted moves of a chain:
-  forward differences of g = f² (2d + d(d−1)/2 = 14 points, counted as
-  evaluations, steps equal to the chain's current move lengths) give the
-  gradient ∇g and curvature matrix H = Σ_k λ_k v_k v_kᵀ at x. The eigenvectors
-  become the move directions and each temperature is reset from the
-  sensitivity along its direction,
-
-      τ_k = min(1, w_k / s),   w_k = √(2 e / |λ_k|),
-      e = Σ_k (∇g·v_k)² / (2 λ_k)  (clipped to [1e-12 g, g]; e = g if some λ_k ≤ 0),
-
-  e being the excess of g over the minimum of its quadratic model, so w_k is
-  the distance along v_k over which g changes by that excess: about the
-  distance to the minimum (noise-free, e ≈ g) or to the noise floor.
-
-Stopping: after ``max_iterations``, or when the average relative change of the
-best objective over ``stall_iterations`` is at most ``function_tolerance``.
-An evaluation budget (``Termination.max_evals``) is never exceeded: the last
-iteration moves only the chains that fit, and a reannealing that does not fit
-is skipped.
-
-Departures from MATLAB, and why:
-
-* Δ is taken on ln f. MATLAB compares the raw change with T (T0 = 300 in
-  objective units); our objective is ~1e-5 m/N at the start and falls by ten
-  decades, so any fixed unit makes the acceptance a random walk or greedy.
-  On ln f a temperature means a relative worsening at every stage. T0 only
-  sets the unit of the temperatures: the search depends on T/T0.
-* Reannealing uses the principal directions of the curvature, not the
-  coordinate axes. The valley is long, thin and oblique: the Gauss–Newton
-  curvatures (unit cube) are 2e-5, 2e-9, 5e-12 and 6e-15, and kt–kr and
-  ct–cr are correlated at −0.999, so a move along any single axis must be
-  about 22 times shorter than the valley is wide along that axis. With
-  coordinate directions (otherwise identical) 6 of 20 seeds beat the paper
-  (worst ct 49 %, kr 50 %); with the curvature directions 100 of 100 reach
-  the round-off floor.
-* The acceptance temperature is the coolest, min_k τ_k (MATLAB: the
-  hottest). After reannealing the temperatures differ by the valley's aspect
-  ratio (up to 6e4), and the hottest belongs to a direction the objective
-  barely sees. Noise-free both work; with 1 % and 5 % complex noise the
-  hottest stops 2e-5–1e-3 (relative) above the least-squares minimum, the
-  coolest 4e-9–1e-4 (seeds 0–5).
-* Reannealing only re-shapes the temperatures to the local widths; it does
-  not reheat towards T0 as MATLAB's does. The committed version (coordinate
-  sensitivities, reheating to T0, Δ relative to the starting objective) never
-  cooled: the chains' objectives stayed 1e-6–6e-5 and the best point was a
-  lucky draw (seeds 0–4: ct 0.25–21 %, kr 14–200 %).
-
-The paper's settings are the defaults: T0 = 300, reannealing interval 50.
+Why it departs from MATLAB (acceptance on ln f, reannealing along the curvature, the coolest temperature
+for acceptance, no reheating) and the evidence: ``docs/design/identification.md``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .base import Termination, Tracker, from_unit
+from .base import Optimizer, Tracker, from_unit, warn_renamed
+
+__all__ = ["SA"]
 
 
-class SA:
+class SA(Optimizer):
+    r"""Simulated annealing with reannealing on the unit cube of x = log10 [kt, ct, kr, cr].
+
+    ``chains`` independent chains run side by side, so that each iteration is one vectorised evaluation.
+    Each chain has a point x, orthonormal move directions v_1 … v_d (the coordinate axes until the first
+    reannealing) and one temperature per direction, T_k = T0 · c^a_k (MATLAB ``temperatureexp``,
+    c = ``cooling``), the annealing parameter a_k counting iterations; τ_k = T_k / T0 ∈ (0, 1].
+
+    * **Move** (``annealingfast``): y = x + s Σ_k τ_k u_k v_k, u a random unit vector, s = ``step``.
+      A coordinate that leaves the box is placed uniformly between x and the bound it crossed.
+    * **Acceptance**: always if better, else with probability 1 / (1 + exp(Δ / min_k τ_k)),
+      Δ = ln f(y) − ln f(x).
+    * **Reannealing** after every ``reanneal_interval`` accepted moves of a chain: forward differences of
+      g = f² (2d + d(d−1)/2 = 14 points, counted as evaluations) give the gradient ∇g and curvature
+      H = Σ_k λ_k v_k v_kᵀ at x; the eigenvectors become the move directions and
+      τ_k = min(1, w_k / s), w_k = √(2 e / |λ_k|), e = Σ_k (∇g·v_k)² / (2 λ_k) (clipped to [1e-12 g, g];
+      e = g if some λ_k ≤ 0), the excess of g over its quadratic model's minimum.
+
+    With ``maxfev`` the budget is never exceeded: the last iteration moves only the chains that fit, and a
+    reannealing that does not fit is skipped.
+
+    Parameters
+    ----------
+    maxiter : int or None, default 4000
+        Iteration limit; the initial points are iteration 1.
+    maxfev : int or None, default None
+        Evaluation budget (model evaluations, finite-difference points included); never exceeded.
+    stall_iter : int or None, default 500
+        Stall window, iterations; None disables the stall test.
+    tol : float, default 5e-4
+        Converged when the best objective improved by at most ``tol`` (relative) over the last
+        ``stall_iter`` iterations (1e-6 per iteration × 500).
+    f_target : float or None, default None
+        Converged when the best objective is ≤ this value, m/N.
+    initial_temperature : float, default 300.0
+        T0 (the paper's); it only sets the unit of the temperatures, the search depends on T/T0.
+    reanneal_interval : int, default 50
+        Accepted moves of a chain between reannealings (the paper's).
+    chains : int, default 16
+        Chains run side by side.
+    step : float, default 0.5
+        s, move length at τ = 1, fraction of the bound range.
+    cooling : float, default 0.95
+        c of T = T0 · c^a.
+
+    Notes
+    -----
+    Deprecated option names (one release): ``max_iterations`` → ``maxiter``, ``stall_iterations`` →
+    ``stall_iter``, ``function_tolerance`` (average change per iteration) → ``tol`` =
+    function_tolerance × stall_iter (total change over the window).
+
+    The result carries ``chains`` (chains used) and ``reanneals`` (reannealings done, over all chains).
+    """
+
     name = "sa"
+    _OPTIONS = ("maxiter", "maxfev", "stall_iter", "tol", "f_target", "initial_temperature", "reanneal_interval",
+                "chains", "step", "cooling")
+    _RENAMED = {"max_iterations": "maxiter", "stall_iterations": "stall_iter"}
 
     def __init__(
         self,
+        maxiter: int | None = 4000,
+        maxfev: int | None = None,
+        stall_iter: int | None = 500,
+        tol: float = 5e-4,
+        f_target: float | None = None,
         initial_temperature: float = 300.0,
         reanneal_interval: int = 50,
         chains: int = 16,
-        max_iterations: int = 4000,
         step: float = 0.5,
         cooling: float = 0.95,
-        stall_iterations: int | None = 500,
-        function_tolerance: float = 1e-6,
+        **deprecated,
     ):
+        ftol = deprecated.pop("function_tolerance", None)
+        new = self._renamed(deprecated)
+        maxiter = new.get("maxiter", maxiter)
+        stall_iter = new.get("stall_iter", stall_iter)
+        if ftol is not None:
+            warn_renamed("SA", "function_tolerance", "tol", " (tol = function_tolerance × stall_iter)")
+            tol = ftol * max(stall_iter or 0, 1)
+        self.maxiter = maxiter
+        self.maxfev = maxfev
+        self.stall_iter = stall_iter
+        self.tol = tol
+        self.f_target = f_target
         self.initial_temperature = initial_temperature
         self.reanneal_interval = reanneal_interval
         self.chains = chains
-        self.max_iterations = max_iterations
         self.step = step
         self.cooling = cooling
-        self.stall_iterations = stall_iterations
-        self.function_tolerance = function_tolerance
-
-    def termination(self) -> Termination:
-        # average relative change ≤ tol over the window ⇔ total relative change ≤ window · tol
-        window = self.stall_iterations or 0
-        return Termination(max_iter=self.max_iterations, stall_iter=self.stall_iterations,
-                           ftol=self.function_tolerance * max(window, 1))
 
     @staticmethod
     def _quadratic(lnf, X, L, h):
@@ -120,16 +126,16 @@ class SA:
         H[:, i, j] = H[:, j, i] = (g3 - g1[:, i] - g1[:, j] + g0) / (hs[:, i] * hs[:, j])
         return grad, H
 
-    def minimize(self, problem, rng: np.random.Generator, termination: Termination | None = None, callback=None):
-        term = termination or self.termination()
+    def _minimize(self, problem, rng: np.random.Generator, callback=None):
+        term = self.termination()
         tr = Tracker(problem, term, callback)
         d = problem.n_var
-        n = self.chains if term.max_evals is None else max(1, min(self.chains, term.max_evals))
+        n = self.chains if term.maxfev is None else max(1, min(self.chains, term.maxfev))
         n_curv = 2 * d + d * (d - 1) // 2
         log_c = np.log(self.cooling)
 
         def budget() -> float:
-            return np.inf if term.max_evals is None else term.max_evals - tr.nfev
+            return tr.budget
 
         def lnf(U):
             X = np.clip(from_unit(problem, U), problem.xl, problem.xu)

@@ -1,0 +1,62 @@
+"""``toolpoint library LIB --campaign CAMP --models MODELS --out DIR [--dask ADDRESS] [--workers N] [--report]``.
+
+For every tool of a tool library (CSV, :mod:`toolpoint.recommend.library`):
+the predicted joint with its uncertainty, the tool-point FRF band, the
+stability lobes with their 5/50/95 % limits and probability of stability, and
+the recommended operating points, in ``DIR/recommendations.csv`` (one row per
+tool, written as tools finish; a killed run is resumed) and ``DIR/tools/``.
+A bad row gives one line on stderr naming its id (and a ``failed`` row); the
+other tools go on. An unreadable or empty library is one line, exit 2.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from ..errors import InputError
+
+
+def register(sub) -> None:
+    """Add the ``library`` sub-command."""
+    p = sub.add_parser("library", help="safe spindle speeds and depths for every tool of a tool library",
+                       description="Predicted FRF, lobes with their uncertainty, and recommended operating points "
+                       "for every tool of a library CSV. Depths in mm, speeds in rpm.")
+    p.add_argument("library", help="tool library CSV (columns: see docs/design/recommend.md)")
+    p.add_argument("--campaign", required=True, help="campaign folder (tool family, holders)")
+    p.add_argument("--models", required=True, help="models folder of 'campaign learn'")
+    p.add_argument("--out", required=True, help="output folder (recommendations.csv, tools/)")
+    p.add_argument("--workers", type=int, help="local processes (default: all cores)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run on an existing Dask scheduler")
+    p.add_argument("--samples", type=int, default=200, help="joint samples per tool (default 200)")
+    p.add_argument("--rpm-points", type=int, default=500, help="speeds per tool (default 500)")
+    p.add_argument("--margin", type=float, default=0.1,
+                   help="recommended depth = robust 5 %% limit × (1 − margin) (default 0.1)")
+    p.add_argument("--rpm-tolerance", type=float, default=0.01,
+                   help="relative spindle-speed tolerance of the robust limit (default 0.01)")
+    p.add_argument("--outside", choices=("widen", "refuse"), default="widen",
+                   help="a tool outside the learned (D, L) range: widen its uncertainty (default) or refuse it")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--report", action="store_true", help="also write DIR/report.html")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    """Run ``toolpoint library``."""
+    from ..recommend.run import run_library
+
+    def say(line):
+        print(line, file=sys.stderr)
+
+    counts = run_library(args.library, args.campaign, args.models, args.out, workers=args.workers, dask=args.dask,
+                         n_samples=args.samples, rpm_points=args.rpm_points, seed=args.seed, margin=args.margin,
+                         rpm_tolerance=args.rpm_tolerance, outside=args.outside, on_bad=say)
+    print(f"{counts['ok']} tools ok, {counts['failed']} failed, {counts['skipped']} already done, "
+          f"{counts['seconds']:.1f} s → {counts['path']}")
+    if args.report:
+        from ..recommend.report import write_report
+
+        try:
+            print(f"report → {write_report(args.out)}")
+        except OSError as e:
+            raise InputError(f"cannot write the report: {e}", file=args.out) from None
+    return 0

@@ -1,0 +1,156 @@
+"""``toolpoint modal FRF... [--quantity Q] [--band LO:HI] [--modes N|auto] --out modes.csv [--plot PNG]``.
+
+A common-pole modal fit (:func:`toolpoint.dynamics.modal.fit_frfs`) of one or
+several FRFs of one structure to one input, all on one frequency grid. The fit
+is weighted in the quantity the files hold (a hammer test: accelerance, whose
+noise is white), or by the files' coherence when every file has one.
+
+``modes.csv`` has one row per mode, header
+``freq_hz,damping_ratio,A1_real,A1_imag,…,Am_real,Am_imag``: the natural
+frequency f_r = |λ_r|/2π (Hz), the damping ratio ζ_r = −Re λ_r/|λ_r| and, per
+FRF k in the order given, the complex modal constant A_kr of the *receptance*
+(whatever quantity the file holds), in m/N × rad/s = m/(N s), such that
+
+    H_k(ω) = Σ_r [ A_kr / (iω − λ_r) + conj(A_kr) / (iω − conj λ_r) ] + residual terms      (m/N)
+
+with λ_r = −ζ_r ω_r + iω_r √(1 − ζ_r²), ω_r = 2π f_r. (Mobility and
+accelerance are iω H and −ω² H.)
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..dynamics.modal import fit_frfs
+from ..errors import InputError
+from ..frf import FRF
+from ..io.atomic import atomic_open
+from ..io.frf_files import read_frf
+from .common import out_path, save_figure, use_agg, warnings_to_stderr
+
+QUANTITIES = ("receptance", "mobility", "accelerance")
+
+
+def register(sub) -> None:
+    """Add the ``modal`` sub-command to the argparse sub-parsers ``sub``."""
+    p = sub.add_parser("modal", help="common-pole modal fit of one or several FRFs → natural frequencies, damping, "
+                                     "modal constants")
+    p.add_argument("frf", nargs="+", metavar="FRF",
+                   help="FRF files of one structure to one input, on one frequency grid (.csv, .uff, .frf, .txt)")
+    p.add_argument("--quantity", choices=QUANTITIES,
+                   help="what the files hold (default: as each file says; CSV means receptance); the fit is "
+                   "weighted in it (noise white in the measured quantity)")
+    p.add_argument("--band", metavar="LO:HI", help="fit only from LO to HI Hz (default: all points above 0 Hz)")
+    p.add_argument("--modes", default="auto", metavar="N|auto",
+                   help="number of modes, or auto (default: chosen by the Bayesian information criterion)")
+    p.add_argument("--out", required=True,
+                   help="modes CSV: freq_hz,damping_ratio, then A{k}_real,A{k}_imag per FRF k (1, 2, …): modal "
+                   "constants of the receptance, m/N × rad/s = m/(N s)")
+    p.add_argument("--plot", help="figure: measured vs fitted magnitude and phase per FRF (PNG/PDF/SVG)")
+    p.set_defaults(func=run)
+
+
+def parse_band(text: str | None) -> tuple[float, float] | None:
+    """``"LO:HI"`` → (LO, HI) Hz with 0 ≤ LO < HI finite; None → None; otherwise an InputError."""
+    if text is None:
+        return None
+    lo, sep, hi = text.partition(":")
+    try:
+        band = (float(lo), float(hi))
+    except ValueError:
+        band = None
+    if not sep or band is None or not (np.all(np.isfinite(band)) and 0 <= band[0] < band[1]):
+        raise InputError(f"expected LO:HI in Hz with 0 ≤ LO < HI, got {text!r}", file="command line",
+                         field="--band")
+    return band
+
+
+def parse_modes(text: str) -> int | None:
+    """``"auto"`` → None; a positive integer → that integer; otherwise an InputError."""
+    if text == "auto":
+        return None
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise InputError(f"expected a positive integer or auto, got {text!r}", file="command line", field="--modes")
+    return n
+
+
+def run(args) -> int:
+    """Fit the FRF files, write ``--out`` (and ``--plot``); returns exit code 0.
+
+    Bad input raises :class:`~toolpoint.errors.InputError` before anything is written
+    (the CLI turns it into one line and exit code 2).
+    """
+    out = out_path(args.out, "--out", inputs=args.frf)
+    plot = out_path(args.plot, "--plot", inputs=args.frf) if args.plot else None
+    band = parse_band(args.band)
+    n_modes = parse_modes(args.modes)
+    with warnings_to_stderr():
+        frfs = [read_frf(path, quantity=args.quantity) for path in args.frf]
+        _check(frfs, args.frf, band)
+        try:
+            fit = fit_frfs(frfs, band=band, n_modes=n_modes)
+        except InputError as e:
+            if e.field != "band":
+                raise
+            raise InputError(e.message, file="command line", field="--band") from None
+    if plot:  # render first: a plotting failure must not leave a CSV without its figure
+        fig = _figure(frfs, fit, args.frf)
+    _write_modes(out, fit)
+    if plot:
+        save_figure(fig, plot)
+    print(fit.table())
+    print(f"{fit.n_modes} modes, {fit.band_hz[0]:g}–{fit.band_hz[1]:g} Hz, {len(frfs)} FRFs → {out}")
+    return 0
+
+
+def _check(frfs, paths, band) -> None:
+    """Name the file: another grid, or an FRF that is zero everywhere in the band."""
+    f = frfs[0].freq_hz
+    for g, path in zip(frfs, paths):
+        if not np.array_equal(g.freq_hz, f):
+            raise InputError(f"frequency grid ({g.freq_hz.size} points, {g.freq_hz[0]:g}–{g.freq_hz[-1]:g} Hz) "
+                             f"differs from that of {paths[0]} ({f.size} points, {f[0]:g}–{f[-1]:g} Hz)",
+                             file=path, field="freq_hz")
+        lo, hi = band or (0.0, np.inf)
+        sel = (f >= lo) & (f <= hi)
+        if sel.any() and not np.any(g.values[sel]):
+            raise InputError("the FRF is zero everywhere in the band: nothing to fit", file=path, field="values")
+
+
+def _write_modes(path: Path, fit) -> None:
+    m = fit.residues.shape[1]
+    head = ["freq_hz", "damping_ratio"] + [f"A{k + 1}_{part}" for k in range(m) for part in ("real", "imag")]
+    cols = [fit.fn_hz[:, None], fit.zeta[:, None], np.stack([fit.residues.real, fit.residues.imag], -1).reshape(
+        fit.n_modes, 2 * m)]
+    with atomic_open(path, "w", newline="") as fh:
+        np.savetxt(fh, np.hstack(cols).reshape(-1, 2 + 2 * m), fmt="%.17g", delimiter=",", header=",".join(head),
+                   comments="")
+
+
+def _figure(frfs, fit, paths):
+    """Magnitude (top) and phase (bottom) per FRF, measured and fitted, in the quantity each file held."""
+    use_agg()
+    import matplotlib.pyplot as plt
+
+    m = len(frfs)
+    fig, ax = plt.subplots(2, m, sharex=True, squeeze=False, figsize=(4.5 * m + 1, 5.5), constrained_layout=True)
+    lo, hi = fit.band_hz
+    for k, (g, path) in enumerate(zip(frfs, paths)):
+        q = g.meta.get("file_quantity", g.quantity)
+        f = g.freq_hz[(g.freq_hz >= lo) & (g.freq_hz <= hi)]
+        measured = g.band(lo, hi)
+        factor = (2j * np.pi * f) ** {"receptance": 0, "mobility": 1, "accelerance": 2}[q]
+        measured = FRF(f, measured.values * factor, q, measured.label)
+        measured.plot(ax=ax[:, k], label="measured", color="0.55", lw=1.0)
+        fit.frf(f, k, q).plot(ax=ax[:, k], label=f"modal fit ({fit.n_modes} modes)", color="C3", lw=1.2)
+        for a in ax[:, k]:
+            for fn in fit.fn_hz:
+                a.axvline(fn, color="C0", lw=0.5, alpha=0.4)
+        ax[0, k].set_title(f"{Path(str(path)).name} (fit error {100 * fit.fit_error[k]:.3g} %)", fontsize="medium")
+    return fig

@@ -1,0 +1,24 @@
+"""``toolpoint report DIR [--out FILE]``: one self-contained HTML page of a ``toolpoint library`` run."""
+
+from __future__ import annotations
+
+
+def register(sub) -> None:
+    """Add the ``report`` sub-command."""
+    p = sub.add_parser("report", help="HTML report of a 'toolpoint library' run",
+                       description="One self-contained HTML page (no network): a sortable, filterable overview "
+                       "of all tools, and per tool the FRF band, lobes with the probability map, and the joint.")
+    p.add_argument("dir", help="output folder of 'toolpoint library'")
+    p.add_argument("--out", help="HTML file (default DIR/report.html)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    """Run ``toolpoint report``."""
+    from .common import out_path, use_agg
+    from ..recommend.report import write_report
+
+    use_agg()
+    out = out_path(args.out, "--out") if args.out else None
+    print(f"report → {write_report(args.dir, out)}")
+    return 0

@@ -1,0 +1,718 @@
+"""Common-pole modal fit of one or several FRFs: complex modes, residual terms, a noise model, automatic order.
+
+All FRFs of one linear structure to one input share its poles. With n modes in
+the band, the receptance of FRF e (e = 1 … m) is modelled as
+
+    H_e(ω) = Σ_r [ A_er / (iω − λ_r) + conj(A_er) / (iω − conj λ_r) ] + U_e − L_e / ω²      (m/N)
+
+with shared complex poles λ_r = −σ_r + iω_dr (rad/s; natural frequency
+ω_r = |λ_r|, damping ratio ζ_r = σ_r / ω_r), complex modal constants A_er
+(so non-proportional damping and cross FRFs are represented), and real
+residual terms for modes outside the band: U_e (m/N, modes above) and L_e
+(1/kg, modes below). Mobility and accelerance are iω H and −ω² H.
+
+Noise model. The fit minimises the weighted error in the quantity the data
+were *measured* in, where the noise is white: a hammer test measures
+accelerance, so its receptance noise grows like 1/ω², and fitting receptance
+would chase that noise at low frequency. Each FRF is weighted by
+1 / max |y_e| in that quantity (noise proportional to each FRF's level), or,
+when the coherence γ² of the measurement is known, point by point by
+1 / σ_e(ω) with σ_e ∝ |y_e| √((1 − γ²) / γ²) (the standard deviation of the
+H1 estimate).
+
+Fit. (1) Starting poles from the least-squares complex-frequency estimator
+(LSCF, a common-denominator rational fit in z = exp(iωΔt)) at orders 2 … P;
+a pole is a candidate when it is stable over the higher orders of this
+stabilisation diagram (frequency within 1 %, damping within 20 %).
+(2) Variable projection: for given poles the real coefficients of all FRFs
+follow from one linear least-squares solve per FRF, and
+:func:`scipy.optimize.least_squares` (Levenberg–Marquardt, Kaufman's
+Jacobian) moves only the poles (ln σ_r, ln ω_dr). (3) Order: modes whose
+removal lowers the Bayesian information criterion are removed, then a mode
+is added where the weighted residual is largest while that lowers it, then
+broad poles beyond the band (residual terms of the modes there) while that
+lowers it; an in-band pole at a damping limit (ζ ≤ 1e-6 or ≥ 0.5), or any
+pole beyond 0.25 f_lo … 4 f_hi, is removed and the rest refitted. Poles
+outside the band are never reported as modes.
+
+Examples
+--------
+Two receptances of a two-mode structure (300 and 800 Hz, 2 % damping):
+
+>>> import numpy as np
+>>> f = np.arange(50.0, 1200.0, 2.0)
+>>> w = 2 * np.pi * f
+>>> q = [1 / ((2 * np.pi * fn) ** 2 - w**2 + 2j * 0.02 * 2 * np.pi * fn * w) for fn in (300.0, 800.0)]
+>>> Y = np.stack([q[0] + 0.5 * q[1], 0.3 * q[0] - q[1]], -1) / 1e3
+>>> fit = fit_modal(f, Y)
+>>> fit.fn_hz.round(6).tolist(), fit.zeta.round(6).tolist(), bool(fit.fit_error.max() < 1e-8)
+([300.0, 800.0], [0.02, 0.02], True)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.signal import find_peaks
+
+from ..blas import single_thread_blas
+from ..errors import InputError
+from ..frf import FRF, QUANTITIES, check_freq_hz
+
+__all__ = ["ModalFit", "fit_modal", "fit_frfs", "ZETA_LIMITS"]
+
+ZETA_LIMITS = (1e-6, 0.5)
+"""A fitted pole with a damping ratio outside these limits is not a mode (it is removed)."""
+
+_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}  # quantity = (iω)^k × receptance
+_MIN_POINTS = 10
+
+
+@dataclass(frozen=True)
+class ModalFit:
+    """A fitted common-pole model of m FRFs (receptance form; see the module docstring).
+
+    Attributes
+    ----------
+    poles : numpy.ndarray
+        (n,) complex poles λ_r = −σ_r + iω_dr, rad/s, Im > 0, sorted by frequency.
+    residues : numpy.ndarray
+        (n, m) complex modal constants A_er of the receptances, m/(N s).
+    upper_residual : numpy.ndarray
+        (m,) U_e, m/N (constant compliance of modes above the band).
+    lower_residual : numpy.ndarray
+        (m,) L_e, 1/kg (−L_e/ω² of modes below the band).
+    band_hz : tuple of float
+        (f_lo, f_hi), Hz, the fitted band.
+    quantity : str
+        The quantity the fit was weighted in (the one the noise is white in).
+    fit_error : numpy.ndarray
+        (m,) relative RMS error ‖fit − y_e‖ / ‖y_e‖ per FRF over the band, in ``quantity``.
+    labels : tuple of str
+        Names of the m FRFs.
+    residual_poles, residual_residues : numpy.ndarray
+        (k,) poles outside the band (within 0.25 f_lo … 4 f_hi, any damping) and their (k, m)
+        modal constants: residual terms of out-of-band modes, not reported as modes.
+    velocity_residual : numpy.ndarray, optional
+        (m,) V_e in a further residual term iω V_e, s·m/N (damping of out-of-band modes); None = 0.
+    """
+
+    poles: np.ndarray
+    residues: np.ndarray
+    upper_residual: np.ndarray
+    lower_residual: np.ndarray
+    band_hz: tuple
+    quantity: str
+    fit_error: np.ndarray
+    labels: tuple = ()
+    residual_poles: np.ndarray = field(default_factory=lambda: np.empty(0, complex))
+    residual_residues: np.ndarray | None = None
+    velocity_residual: np.ndarray | None = None
+
+    @property
+    def n_modes(self) -> int:
+        """Number of modes n."""
+        return self.poles.size
+
+    @property
+    def omega_n(self) -> np.ndarray:
+        """Natural angular frequencies ω_r = |λ_r|, rad/s, (n,)."""
+        return np.abs(self.poles)
+
+    @property
+    def fn_hz(self) -> np.ndarray:
+        """Natural frequencies f_r = |λ_r| / 2π, Hz, (n,)."""
+        return self.omega_n / (2 * np.pi)
+
+    @property
+    def zeta(self) -> np.ndarray:
+        """Damping ratios ζ_r = −Re λ_r / |λ_r|, (n,)."""
+        return -self.poles.real / self.omega_n
+
+    def values(self, freq_hz, quantity: str = "receptance", *, residuals: bool = True) -> np.ndarray:
+        """The fitted FRFs (F, m) at ``freq_hz`` (Hz) in ``quantity`` (receptance m/N by default).
+
+        Parameters
+        ----------
+        freq_hz : array_like
+            Frequencies, Hz (> 0 Hz when ``residuals`` and a lower residual is present).
+        quantity : str
+            ``"receptance"``, ``"mobility"`` or ``"accelerance"``.
+        residuals : bool
+            Include U_e − L_e/ω².
+
+        Returns
+        -------
+        numpy.ndarray
+            (F, m) complex.
+        """
+        w = 2 * np.pi * np.asarray(freq_hz, float).reshape(-1)
+        poles, residues = self.poles, self.residues
+        if residuals and self.residual_poles.size:
+            poles = np.r_[poles, self.residual_poles]
+            residues = np.vstack([residues, self.residual_residues])
+        D = _basis(w, poles, residuals)
+        n = poles.size
+        c = np.vstack([residues.real, residues.imag])
+        c = c.reshape(2, n, -1).transpose(1, 0, 2).reshape(2 * n, -1)
+        if residuals:
+            vel = np.zeros_like(self.upper_residual) if self.velocity_residual is None else self.velocity_residual
+            c = np.vstack([c, self.upper_residual[None], vel[None], self.lower_residual[None]])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return (D @ c) * _factor(w, _power(quantity))[:, None]
+
+    def __call__(self, freq_hz) -> np.ndarray:
+        """The fitted receptances (F, m), m/N, at ``freq_hz`` (Hz): ``values(freq_hz)``."""
+        return self.values(freq_hz)
+
+    def frf(self, freq_hz, index: int = 0, quantity: str = "receptance") -> FRF:
+        """FRF ``index`` of the fit at ``freq_hz`` (Hz) as an :class:`~toolpoint.frf.FRF` in ``quantity``."""
+        label = self.labels[index] if index < len(self.labels) else f"FRF {index}"
+        return FRF(freq_hz, self.values(freq_hz, quantity)[:, index], quantity, f"{label}, modal fit")
+
+    def real_modes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Second-order form of each mode: H_e = Σ_r (a_er + iω b_er) / (ω_r² − ω² + 2iζ_r ω_r ω).
+
+        A_er/(iω − λ_r) + c.c. = (−2 Re(A_er conj λ_r) + iω 2 Re A_er) / (ω_r² − ω² + 2iζ_r ω_r ω), so
+        a_er = −2 Re(A_er conj λ_r) (N⁻¹ s⁻² m… i.e. 1/kg for a driving point: 1/modal mass) and
+        b_er = 2 Re A_er (m/(N s)), which is 0 for a proportionally damped (real) mode.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (a, b), each (n, m): a in 1/kg, b in s/kg.
+        """
+        a = -2 * (self.residues * np.conj(self.poles)[:, None]).real
+        return a, 2 * self.residues.real
+
+    def modal_mass(self, index: int = 0) -> np.ndarray:
+        """Real-mode-equivalent modal masses 1 / a_r (kg), (n,), of the driving-point FRF ``index``.
+
+        Exact for proportional damping (b_r = 0); otherwise the iω b_r part of each
+        mode is neglected (see :meth:`real_modes`).
+        """
+        a, _ = self.real_modes()
+        return 1.0 / a[:, index]
+
+    def state_space(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """A real state-space form (A, B, C) of the modes (residual terms left out).
+
+        Per mode the states are (q_r, q̇_r) with q̈_r + 2ζ_r ω_r q̇_r + ω_r² q_r = u and
+        output y_e = Σ_r a_er q_r + b_er q̇_r, so C (sI − A)⁻¹ B reproduces
+        Σ_r (a_er + s b_er) / (s² + 2ζ_r ω_r s + ω_r²), i.e. the fitted modes exactly,
+        non-proportional damping included (s = iω).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            A (2n, 2n) in 1/s and 1/s², B (2n, 1), C (m, 2n) (m/N per unit of u).
+
+        Examples
+        --------
+        >>> fit = ModalFit(np.array([-10 + 600j]), np.array([[1e-6 - 2e-5j]]), np.zeros(1), np.zeros(1),
+        ...                (10.0, 200.0), "receptance", np.zeros(1))
+        >>> A, B, C = fit.state_space()
+        >>> s = 2j * np.pi * 95.0
+        >>> h = (C @ np.linalg.solve(s * np.eye(2) - A, B))[0, 0]
+        >>> bool(np.isclose(h, fit.values([95.0])[0, 0], rtol=1e-12))
+        True
+        """
+        n, m = self.residues.shape
+        a, b = self.real_modes()
+        wn, ze = self.omega_n, self.zeta
+        A = np.zeros((2 * n, 2 * n))
+        B = np.zeros((2 * n, 1))
+        C = np.zeros((m, 2 * n))
+        for r in range(n):  # a handful of modes: block assembly
+            A[2 * r: 2 * r + 2, 2 * r: 2 * r + 2] = [[0.0, 1.0], [-wn[r] ** 2, -2 * ze[r] * wn[r]]]
+            B[2 * r + 1, 0] = 1.0
+            C[:, 2 * r], C[:, 2 * r + 1] = a[r], b[r]
+        return A, B, C
+
+    def table(self) -> str:
+        """Human-readable table: one line per mode (frequency Hz, damping %)."""
+        lines = [f"{'mode':>4} {'fn [Hz]':>10} {'zeta [%]':>9}"]
+        lines += [f"{r + 1:>4} {self.fn_hz[r]:>10.3f} {100 * self.zeta[r]:>9.4f}" for r in range(self.n_modes)]
+        lines.append("fit error (relative RMS, " + self.quantity + "): "
+                     + ", ".join(f"{100 * e:.3g} %" for e in self.fit_error))
+        return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------- model pieces
+def _power(quantity: str) -> int:
+    if quantity not in _POWER:
+        raise InputError(f"unknown quantity {quantity!r} (one of {', '.join(QUANTITIES)})", field="quantity")
+    return _POWER[quantity]
+
+
+def _factor(w, k: int) -> np.ndarray:
+    """(iω)^k: receptance → mobility (k = 1) or accelerance (k = 2)."""
+    return (1j * w) ** k
+
+
+def _basis(w, poles, residuals) -> np.ndarray:
+    """Receptance columns (F, 2n + k): per mode u + v and i(u − v), u = 1/(iω − λ), v = 1/(iω − conj λ).
+
+    ``residuals``: bool (all residual columns 1, iω and −1/ω², or none) or three
+    bools (upper, velocity, lower) choosing each.
+    """
+    up, vel, low = (residuals,) * 3 if isinstance(residuals, bool) else residuals
+    s = 1j * w[:, None]
+    u, v = 1.0 / (s - poles), 1.0 / (s - np.conj(poles))
+    cols = [np.stack([u + v, 1j * (u - v)], -1).reshape(w.size, -1)]
+    if up:
+        cols.append(np.ones((w.size, 1)))
+    if vel:
+        cols.append(s)
+    if low:
+        with np.errstate(divide="ignore"):
+            cols.append((-1.0 / w**2)[:, None])
+    return np.hstack(cols).astype(complex)
+
+
+class _Problem:
+    """The weighted data and the variable-projection residual / Jacobian for a set of poles."""
+
+    def __init__(self, w, Yq, Wt, k, residuals):
+        self.w, self.k = w, k
+        self.residuals = (residuals,) * 3 if isinstance(residuals, bool) else tuple(residuals)
+        self.fac = _factor(w, k)
+        self.Wt = Wt  # (F, m) real weights
+        self.B = np.concatenate([(Yq * Wt).real, (Yq * Wt).imag], 0).T[..., None]  # (m, 2F, 1)
+        self.N = 2 * Yq.size
+        # Round-off floor of the residual: below it, noise-free data are fitted exactly and
+        # the criterion must not reward further poles.
+        self.floor = 1e-20 * float(np.sum(self.B**2))
+        self.plim = (np.log(1e-7 * w.min()), np.log(10 * w.max()))  # range of ln σ and ln ω_d, rad/s
+        self._cache = {}
+
+    def design(self, poles):
+        """Weighted stacked real design matrices (m, 2F, P) of the fit quantity."""
+        D = _basis(self.w, poles, self.residuals) * self.fac[:, None]
+        DW = D[None] * self.Wt.T[:, :, None]
+        return np.concatenate([DW.real, DW.imag], 1)
+
+    def solve(self, poles):
+        """Coefficients (m, P), residual (m, 2F) and Q (m, 2F, P) for the poles."""
+        A = self.design(poles)
+        s = np.linalg.norm(A, axis=1, keepdims=True)
+        s[s == 0] = 1.0
+        Q, R = np.linalg.qr(A / s)
+        c = (np.linalg.pinv(R, rcond=1e-13) @ (Q.transpose(0, 2, 1) @ self.B)) / s.transpose(0, 2, 1)
+        r = (A @ c - self.B)[..., 0]
+        return c[..., 0], r, Q
+
+    def rss(self, poles) -> float:
+        """Weighted residual sum of squares."""
+        return float(np.sum(self.solve(poles)[1] ** 2))
+
+    def bic(self, rss: float, n: int) -> float:
+        """Bayesian information criterion of a fit with n modes."""
+        m = self.B.shape[0]
+        kpar = 2 * n + m * (2 * n + sum(self.residuals))
+        return self.N * np.log(max(rss, self.floor) / self.N) + kpar * np.log(self.N)
+
+    def both(self, p):
+        """Residual vector and Kaufman Jacobian at parameters p = (ln σ_r, ln ω_dr)."""
+        key = p.tobytes()
+        if key in self._cache:
+            return self._cache[key]
+        n = p.size // 2
+        # A residual pole may run off towards 0 or ∞ rad/s: clip (ln σ, ln ω_d) to a range where
+        # exp and the basis stay finite; such a pole is then removed as invalid (_valid).
+        pc = np.clip(p, *self.plim)
+        sig, wd = np.exp(pc[:n]), np.exp(pc[n:])
+        lam = -sig + 1j * wd
+        c, r, Q = self.solve(lam)
+        s = 1j * self.w[:, None]
+        u2, v2 = (1.0 / (s - lam)) ** 2, (1.0 / (s - np.conj(lam))) ** 2
+        Vs = []
+        for g in (-sig + 0j, 1j * wd):  # dλ/d ln σ, dλ/d ln ω_d
+            d1 = u2 * g + v2 * np.conj(g)  # d(u + v)
+            d2 = 1j * (u2 * g - v2 * np.conj(g))  # d(i(u − v))
+            # (F, n) per column type → (m, F, n) with each FRF's coefficients
+            Vs.append((d1[None] * c[:, None, 0:2 * n:2] + d2[None] * c[:, None, 1:2 * n:2])
+                      * (self.fac[:, None] * self.Wt.T[:, :, None]))
+        V = np.concatenate(Vs, 2)  # (m, F, 2n)
+        V = np.concatenate([V.real, V.imag], 1)
+        V = V - Q @ (Q.transpose(0, 2, 1) @ V)
+        V[..., pc != p] = 0.0  # the clipped residual is flat in a clipped parameter
+        out = (r.ravel(), V.reshape(-1, 2 * n))
+        self._cache.clear()
+        self._cache[key] = out
+        return out
+
+    def refine(self, poles):
+        """Poles moved by Levenberg–Marquardt on the variable-projection residual."""
+        if poles.size == 0:
+            return poles
+        p0 = np.r_[np.log(-poles.real), np.log(poles.imag)]
+        sol = least_squares(lambda p: self.both(p)[0], p0, jac=lambda p: self.both(p)[1], method="lm",
+                            xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=40 * (p0.size + 1))
+        n = poles.size
+        x = np.clip(sol.x, *self.plim)
+        return -np.exp(x[:n]) + 1j * np.exp(x[n:])
+
+
+# --------------------------------------------------------------------------- starting poles
+def _lscf(w, Yq, Wt, order: int, dt: float) -> list[np.ndarray]:
+    """Poles (Im > 0, Re < 0) of the LSCF common-denominator fit at orders 1 … ``order``.
+
+    Per FRF e the equation error W_e (N_e(z) − y_e d(z)) with z = exp(iωΔt) and real
+    polynomial coefficients is minimised; eliminating each numerator leaves the
+    reduced normal matrix M = Σ_e (T_e − S_eᵀ R_e⁻¹ S_e) for the denominator (its
+    leading coefficient fixed to 1). All orders use leading blocks of one set of
+    products.
+    """
+    # Each product Re(X_eᴴ X_e) etc. is Toeplitz: (Ωᴴ diag(d) Ω)_kl = Σ_f d_f z_f^(l−k), so only the
+    # 2P + 1 moments Σ_f d_f z_f^j are needed (O(F P) instead of O(F P²)).
+    j = np.arange(-order, order + 1)
+    E = np.exp(1j * np.outer(w * dt, j))  # (F, 2P+1)
+    W2 = Wt**2
+    mom = np.concatenate([W2, -W2 * Yq, W2 * np.abs(Yq) ** 2], 1).T @ E  # (3m, 2P+1)
+    idx = np.arange(order + 1)
+    lag = idx[None, :] - idx[:, None] + order  # l − k, shifted
+    G = mom.real[:, lag]  # (3m, P+1, P+1)
+    m = Yq.shape[1]
+    Rm, Sm, Tm = G[:m], G[m:2 * m], G[2 * m:]
+    out = []
+    for p in range(1, order + 1):
+        b = slice(0, p + 1)
+        R, S, T = Rm[:, b, b], Sm[:, b, b], Tm[:, b, b]
+        M = np.sum(T - S.transpose(0, 2, 1) @ np.linalg.solve(R, S), 0)
+        try:
+            alpha = np.r_[-np.linalg.solve(M[:p, :p], M[:p, p]), 1.0]
+        except np.linalg.LinAlgError:
+            out.append(np.empty(0, complex))
+            continue
+        z = np.roots(alpha[::-1])
+        z = z[np.abs(z) > 0]
+        lam = np.log(z.astype(complex)) / dt
+        out.append(lam[(lam.imag > 0) & (lam.real < 0)])
+    return out
+
+
+def _stable_poles(diagram, f_lo, f_hi) -> np.ndarray:
+    """Poles of the top order that recur (f within 1 %, ζ within 20 %) in ≥ 60 % of the upper half of orders."""
+    def ok(lam):
+        wn = np.abs(lam)
+        ze = -lam.real / wn
+        keep = (wn >= 2 * np.pi * _OUT[0] * f_lo) & (wn <= 2 * np.pi * _OUT[1] * f_hi) & (ze > ZETA_LIMITS[0]) \
+            & (ze < 0.3)
+        return lam[keep]
+
+    top = ok(diagram[-1])
+    lower = [ok(d) for d in diagram[len(diagram) // 2:-1]]
+    if not lower:
+        return top
+    keep = []
+    for lam in top:
+        wn, ze = abs(lam), -lam.real / abs(lam)
+        hits = 0
+        for d in lower:
+            if d.size:
+                wd, zd = np.abs(d), -d.real / np.abs(d)
+                hits += bool(np.any((abs(wd - wn) < 0.01 * wn) & (abs(zd - ze) < 0.2 * ze)))
+        if hits >= 0.6 * len(lower):
+            keep.append(lam)
+    return np.array(keep, complex)
+
+
+# --------------------------------------------------------------------------- order selection
+_OUT = (0.5, 1.5)  # starting poles from 0.5 f_lo to 1.5 f_hi; those outside the band only as residual terms
+_RESIDUAL = (0.25, 4.0)  # residual poles are kept from 0.25 f_lo to 4 f_hi
+
+
+def _valid(poles, f_lo, f_hi) -> np.ndarray:
+    """Mask of poles the fit keeps.
+
+    In the band: damping inside ZETA_LIMITS (a mode). Outside it, from 0.25 f_lo to 4 f_hi:
+    any damping (a residual term of out-of-band modes, which may be as broad as critical).
+    """
+    wn = np.abs(poles)
+    ze = -poles.real / wn
+    inband = (wn >= 2 * np.pi * f_lo) & (wn <= 2 * np.pi * f_hi)
+    zmax = np.where(inband, ZETA_LIMITS[1], np.inf)
+    return ((wn >= 2 * np.pi * _RESIDUAL[0] * f_lo) & (wn <= 2 * np.pi * _RESIDUAL[1] * f_hi)
+            & (ze > ZETA_LIMITS[0]) & (ze < zmax) & np.isfinite(wn))
+
+
+def _refine_clean(prob, poles, f_lo, f_hi):
+    """Refine; remove poles that left the band or reached a damping limit; repeat until all are modes."""
+    while True:
+        poles = prob.refine(poles)
+        ok = _valid(poles, f_lo, f_hi)
+        if ok.all():
+            return poles
+        poles = poles[ok]
+
+
+def _drop_one(prob, poles):
+    """The poles without the mode whose removal (others fixed) raises the residual least; and that rss."""
+    trials = [prob.rss(np.delete(poles, r)) for r in range(poles.size)]
+    r = int(np.argmin(trials))
+    return np.delete(poles, r), trials[r]
+
+
+def _new_pole(prob, poles, f, tried=None):
+    """A trial pole (ζ = 1 %) where the smoothed weighted residual is largest (outside ``tried``); its index."""
+    _, r, _ = prob.solve(poles)
+    F = f.size
+    mag = np.convolve(np.sqrt(np.sum(r[:, :F] ** 2 + r[:, F:] ** 2, 0)), np.ones(5) / 5, "same")
+    if tried is not None:
+        mag = np.where(tried, -1.0, mag)
+    j = int(np.argmax(mag))
+    wn = 2 * np.pi * f[j]
+    return np.r_[poles, wn * (-0.01 + 1j * np.sqrt(1 - 1e-4))], j
+
+
+def _select(prob, poles, f, f_lo, f_hi, n_modes, max_modes):
+    poles = _refine_clean(prob, poles, f_lo, f_hi)
+    rss = prob.rss(poles)
+    if n_modes is not None:
+        while poles.size > n_modes:
+            poles, _ = _drop_one(prob, poles)
+            poles = _refine_clean(prob, poles, f_lo, f_hi)
+        for _ in range(3 * n_modes):
+            if poles.size >= n_modes:
+                break
+            poles = _refine_clean(prob, _new_pole(prob, poles, f)[0], f_lo, f_hi)
+        return poles
+    # backward: remove modes the criterion does not want
+    while poles.size:
+        trial, rss_t = _drop_one(prob, poles)
+        if prob.bic(rss_t, trial.size) >= prob.bic(rss, poles.size):
+            break
+        poles = _refine_clean(prob, trial, f_lo, f_hi)
+        rss = prob.rss(poles)
+    # forward: add a mode where the residual is largest while the criterion improves
+    tried = np.zeros(f.size, bool)
+    misses = 0
+    while poles.size < max_modes and misses < 2:
+        trial, j = _new_pole(prob, poles, f, tried)
+        trial = _refine_clean(prob, trial, f_lo, f_hi)
+        rss_t = prob.rss(trial)
+        if trial.size <= poles.size or prob.bic(rss_t, trial.size) >= prob.bic(rss, poles.size):
+            misses += 1  # try the next-largest residual elsewhere once more
+            tried |= np.abs(f - f[j]) <= 0.02 * f[j]
+            continue
+        poles, rss, misses, tried = trial, rss_t, 0, np.zeros(f.size, bool)
+    return _add_residual_poles(prob, poles, f_lo, f_hi)
+
+
+def _add_residual_poles(prob, poles, f_lo, f_hi, most: int = 4):
+    """Add broad poles beyond the band (start 1.5 f_hi or 0.5 f_lo, ζ = 0.3) while the criterion improves.
+
+    Why: the constant, iω and 1/ω² residual terms describe modes far outside the band; modes just
+    above it (a stiff blank's bending modes above 3 kHz) need a pole of their own, which the forward
+    step, seeding only at in-band residual peaks, would not try.
+    """
+    rss = prob.rss(poles)
+    for _ in range(most):
+        best = None
+        for fs in (1.5 * f_hi, 0.5 * f_lo):
+            trial = np.r_[poles, 2 * np.pi * fs * (-0.3 + 1j * np.sqrt(0.91))]  # |λ| = ω_s, ζ = 0.3
+            trial = _refine_clean(prob, trial, f_lo, f_hi)
+            if trial.size <= poles.size:
+                continue
+            b = prob.bic(prob.rss(trial), trial.size)
+            if best is None or b < best[0]:
+                best = (b, trial)
+        if best is None or best[0] >= prob.bic(rss, poles.size):
+            return poles
+        poles = best[1]
+        rss = prob.rss(poles)
+    return poles
+
+
+# --------------------------------------------------------------------------- entry points
+def fit_modal(freq_hz, Y, *, quantity: str = "receptance", noise: str | None = None, band=None,
+              n_modes: int | None = None, coherence=None, weights=None, residuals: bool = True,
+              max_order: int | None = None, max_modes: int = 30, labels=()) -> ModalFit:
+    """Fit common complex poles, modal constants and residual terms to the columns of ``Y``.
+
+    Parameters
+    ----------
+    freq_hz : array_like
+        (F,) frequencies, Hz, strictly increasing.
+    Y : array_like
+        (F, m) or (F,) complex FRFs of one structure to one input, in ``quantity``.
+    quantity : str
+        What ``Y`` holds: ``"receptance"`` (m/N), ``"mobility"`` or ``"accelerance"``.
+    noise : str, optional
+        The quantity the measurement noise is white in, i.e. the one that was
+        measured (default ``quantity``); the fit is weighted in it.
+    band : (float, float), optional
+        (f_lo, f_hi) Hz to fit; default all points above 0 Hz.
+    n_modes : int, optional
+        Number of modes; default (None) chosen by the information criterion.
+    coherence : array_like, optional
+        (F,) or (F, m) coherence γ² in [0, 1] of the measurement: point weights 1/σ_e(ω).
+    weights : array_like, optional
+        (m,) weight per FRF instead of 1 / max |y_e| (in the ``noise`` quantity).
+    residuals : bool
+        Fit the residual terms U_e, L_e of out-of-band modes.
+    max_order : int, optional
+        Highest LSCF order of the stabilisation diagram (default from the number of peaks).
+    max_modes : int
+        Most modes the automatic order may reach.
+    labels : sequence of str
+        Names of the FRFs.
+
+    Returns
+    -------
+    ModalFit
+        Poles sorted by frequency, every one inside the band with damping inside :data:`ZETA_LIMITS`.
+
+    Raises
+    ------
+    InputError
+        One line: bad grid, band outside the data, fewer than 10 points in the band,
+        non-finite or all-zero FRF, bad coherence, weights or ``n_modes``.
+    """
+    f = check_freq_hz(freq_hz, field="freq_hz")
+    Y = np.asarray(Y, dtype=complex)
+    if Y.ndim == 1:
+        Y = Y[:, None]
+    if Y.ndim != 2 or Y.shape[0] != f.size:
+        raise InputError(f"shape {Y.shape} does not match {f.size} frequencies: need ({f.size},) or ({f.size}, m)",
+                         field="values")
+    k_in, k = _power(quantity), _power(noise or quantity)
+    if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
+        raise InputError(f"must be a positive integer, got {n_modes!r}", field="n_modes")
+    lo, hi = (0.0, np.inf) if band is None else (float(band[0]), float(band[1]))
+    if not (np.isfinite(lo) and lo < hi):
+        raise InputError(f"band must be LO < HI, got {lo:g}:{hi:g}", field="band")
+    sel = (f >= lo) & (f <= hi) & (f > 0)
+    if sel.sum() < _MIN_POINTS:
+        raise InputError(f"needs at least {_MIN_POINTS} frequencies > 0 Hz in the band {lo:g}–{hi:g} Hz, got "
+                         f"{int(sel.sum())} (data cover {f[0]:g}–{f[-1]:g} Hz)" if f.size else "no frequencies",
+                         field="band")
+    f, Y = f[sel], Y[sel]
+    bad = ~np.isfinite(Y)
+    if bad.any():
+        j = int(np.flatnonzero(bad.any(1))[0])
+        raise InputError(f"values must be finite (first non-finite value at {f[j]:g} Hz)", field="values")
+    zero = np.flatnonzero(np.abs(Y).max(0) == 0)
+    if zero.size:
+        raise InputError(f"FRF {int(zero[0])} is zero everywhere in the band: nothing to fit", field="values")
+    w = 2 * np.pi * f
+    Yq = Y * _factor(w, k - k_in)[:, None]  # into the measured quantity
+    Wt = _weights(Yq, coherence, weights, sel)
+    with single_thread_blas():  # tall-skinny QRs: threads only add overhead
+        return _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, tuple(labels),
+                    noise or quantity)
+
+
+def _weights(Yq, coherence, weights, sel) -> np.ndarray:
+    F, m = Yq.shape
+    if weights is not None:
+        wt = np.asarray(weights, float).reshape(-1)
+        if wt.size != m or not np.all(np.isfinite(wt) & (wt > 0)):
+            raise InputError(f"need {m} finite weights > 0, got {wt.size}", field="weights")
+    else:
+        wt = 1.0 / np.abs(Yq).max(0)
+    W = np.broadcast_to(wt, (F, m)).copy()
+    if coherence is not None:
+        g = np.asarray(coherence, float)
+        g = g.reshape(sel.size, -1) if g.size in (sel.size, sel.size * m) else None
+        if g is None or not np.all(np.isfinite(g) & (g >= 0) & (g <= 1)):
+            raise InputError("coherence must be (F,) or (F, m) values in [0, 1] on the FRF's grid", field="coherence")
+        g = np.clip(np.broadcast_to(g[sel], (F, m)), 1e-3, 1 - 1e-6)
+        # σ_e(ω) ∝ |y_e| √((1 − γ²)/γ²): relative, so the weight is the level-free 1/σ,
+        # with |y| floored at 1 % of the peak so antiresonances are not over-weighted.
+        lev = np.maximum(np.abs(Yq), 0.01 * np.abs(Yq).max(0))
+        W = 1.0 / (lev * np.sqrt((1 - g) / g))
+        W = W / np.median(W, 0) * wt
+    return W
+
+
+def _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, labels, quantity) -> ModalFit:
+    f_lo, f_hi = float(f[0]), float(f[-1])
+    prob = _Problem(w, Yq, Wt, k, residuals)
+    mag = np.sqrt(np.sum(np.abs(Yq * Wt) ** 2, 1))
+    pk, _ = find_peaks(mag, prominence=0.02 * mag.max())
+    if max_order is None:
+        want = max(pk.size, n_modes or 0)
+        max_order = int(np.clip(4 * want + 16, 24, 80))
+    dt = 1.0 / (2.0 * f_hi)
+    poles = _stable_poles(_lscf(w, Yq, Wt, int(max_order), dt), f_lo, f_hi)
+    if poles.size == 0:  # nothing stable: start from the peaks
+        wn = w[pk] if pk.size else w[[int(np.argmax(mag))]]
+        poles = wn * (-0.02 + 1j * np.sqrt(1 - 4e-4))
+    poles = _select(prob, poles, f, f_lo, f_hi, n_modes, max_modes)
+    if residuals:
+        # Each residual term only where the criterion wants it: a lower residual fitted to
+        # accelerance noise at low frequency would become a large −L/ω² receptance error.
+        best = min(((u, v, lw) for u in (True, False) for v in (True, False) for lw in (True, False)),
+                   key=lambda ul: _with(prob, ul).bic(_with(prob, ul).rss(poles), poles.size))
+        if best != prob.residuals:
+            prob = _with(prob, best)
+            poles = _refine_clean(prob, poles, f_lo, f_hi)
+    poles = poles[np.argsort(np.abs(poles))]
+    c, _, _ = prob.solve(poles)
+    n = poles.size
+    res = c[:, 0:2 * n:2] + 1j * c[:, 1:2 * n:2]  # (m, n)
+    UVL = np.zeros((3, c.shape[0]))
+    j = 2 * n
+    for t in range(3):
+        if prob.residuals[t]:
+            UVL[t], j = c[:, j], j + 1
+    U, V, L = UVL
+    res = res.T.copy()
+    fn = np.abs(poles) / (2 * np.pi)
+    mode = (fn >= f_lo) & (fn <= f_hi)
+    kw = dict(residual_poles=poles[~mode], residual_residues=res[~mode])
+    fit = ModalFit(poles[mode], res[mode], U, L, (f_lo, f_hi), quantity, np.zeros(c.shape[0]), labels,
+                   velocity_residual=V, **kw)
+    err = np.linalg.norm(fit.values(f, quantity) - Yq, axis=0) / np.linalg.norm(Yq, axis=0)
+    return ModalFit(fit.poles, fit.residues, U, L, fit.band_hz, quantity, err, labels, velocity_residual=V, **kw)
+
+
+def _with(prob, residuals):
+    """The same problem with other residual columns (a shallow copy)."""
+    out = object.__new__(_Problem)
+    out.__dict__.update(prob.__dict__)
+    out.residuals, out._cache = tuple(residuals), {}
+    return out
+
+
+def fit_frfs(frfs, *, noise: str | None = None, band=None, n_modes: int | None = None, **kw) -> ModalFit:
+    """:func:`fit_modal` of FRF objects (one structure, one input, one grid).
+
+    The noise quantity is, in order: ``noise``; the quantity the file held
+    (``frf.meta["file_quantity"]``, set by the readers, which convert to receptance);
+    the FRF's own ``quantity``. ``frf.meta["coherence"]`` ((F,) γ²), when every FRF
+    has it, gives the point weights.
+
+    Parameters
+    ----------
+    frfs : FRF or sequence of FRF
+        SISO FRFs on one frequency grid.
+    noise, band, n_modes, **kw
+        As in :func:`fit_modal`.
+
+    Returns
+    -------
+    ModalFit
+    """
+    frfs = [frfs] if isinstance(frfs, FRF) else list(frfs)
+    if not frfs:
+        raise InputError("no FRF given", field="frf")
+    for g in frfs:
+        if not isinstance(g, FRF) or not g.is_siso:
+            raise InputError("expected SISO FRFs", field="frf")
+        if not np.array_equal(g.freq_hz, frfs[0].freq_hz):
+            raise InputError(f"FRF {g.label!r} is on another frequency grid than {frfs[0].label!r}", field="frf")
+    q = noise or frfs[0].meta.get("file_quantity", frfs[0].quantity)
+    Y = np.stack([g.values for g in frfs], -1)
+    quantity = frfs[0].quantity
+    if any(g.quantity != quantity for g in frfs):
+        Y = np.stack([g.to_receptance().values for g in frfs], -1)
+        quantity = "receptance"
+    if "coherence" not in kw and all("coherence" in g.meta for g in frfs):
+        kw["coherence"] = np.stack([np.asarray(g.meta["coherence"], float).reshape(-1) for g in frfs], -1)
+    return fit_modal(frfs[0].freq_hz, Y, quantity=quantity, noise=q, band=band, n_modes=n_modes,
+                     labels=[g.label for g in frfs], **kw)

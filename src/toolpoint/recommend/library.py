@@ -1,0 +1,223 @@
+"""A tool library: the CSV a shop keeps of its end mills and the cut each one is meant for.
+
+Columns (one tool per row; lengths in mm, speeds in rpm):
+
+====================== =========================================================================
+``id``                 tool identifier (unique, non-empty)
+``diameter_mm``        tool diameter D, mm
+``overhang_mm``        overhang (gauge length out of the holder) L, mm
+``teeth``              number of teeth N
+``holder``             holder name: one of the campaign's ``[holders]``
+``tangential_coeff_n_mm2``, ``radial_ratio``
+                       cutting coefficients K_t (N/mm²) and K_r = K_n/K_t; or leave them empty and
+                       name a preset in ``material`` (:mod:`~toolpoint.recommend.materials`)
+``radial_immersion``   a_e/D in (0, 1] (1 = slotting)
+``milling``            ``down`` or ``up``
+``rpm_min``, ``rpm_max`` the spindle's usable speed range, rpm
+``flute_length_mm``    optional: flute length, mm (default: the campaign's tool family rule)
+``material``           optional: work material (a preset name when the coefficients are empty)
+====================== =========================================================================
+
+A file that cannot be read, has no header or no rows, or lacks a required
+column is an :class:`~toolpoint.errors.InputError`. A bad *row* (a missing
+or non-numeric value, no cutting data, an unknown preset) does not stop the
+others: :func:`read_library` returns it as a :class:`BadRow` naming the id and
+the problem.
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> p = pathlib.Path(tempfile.mkdtemp()) / "tools.csv"
+>>> _ = p.write_text("id,diameter_mm,overhang_mm,teeth,holder,tangential_coeff_n_mm2,radial_ratio,"
+...                  "radial_immersion,milling,rpm_min,rpm_max,material\\n"
+...                  "E1,16,50,3,ER40,,,0.5,down,3000,20000,al7075\\n"
+...                  "E2,12,40,2,ER40,,,1,up,3000,20000,\\n")
+>>> tools, bad = read_library(p)
+>>> tools[0].id, tools[0].cutting.tangential_coeff, [b.id for b in bad]
+('E1', 796000000.0, ['E2'])
+>>> bad[0].error
+'E2: no cutting data: give tangential_coeff_n_mm2 and radial_ratio, or a material preset (al7075, aluminium, steel)'
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import InputError
+from ..stability.cutting import CuttingConditions
+from .materials import PRESETS, preset
+
+__all__ = ["REQUIRED", "OPTIONAL", "LibraryTool", "BadRow", "read_library"]
+
+#: Required columns.
+REQUIRED = ("id", "diameter_mm", "overhang_mm", "teeth", "holder", "radial_immersion", "milling", "rpm_min",
+            "rpm_max")
+#: Optional columns (the cutting coefficients are needed unless ``material`` names a preset).
+OPTIONAL = ("tangential_coeff_n_mm2", "radial_ratio", "flute_length_mm", "material")
+
+
+@dataclass(frozen=True)
+class LibraryTool:
+    """One valid row of a tool library (SI inside except D, L in mm as the models take them).
+
+    Attributes
+    ----------
+    id, holder, material : str
+        Tool id, holder name, work material ('' if not given).
+    diameter_mm, overhang_mm : float
+        D and L, mm.
+    flute_length_mm : float or None
+        Flute length, mm (None: the campaign's tool family rule).
+    cutting : CuttingConditions
+        Teeth, K_t (N/m²), K_r, immersion, milling.
+    rpm_min, rpm_max : float
+        Speed range, rpm.
+    cutting_source : str
+        Where K_t, K_r come from (``library`` or the preset's source).
+    line : int
+        Line in the file.
+    """
+
+    id: str
+    holder: str
+    material: str
+    diameter_mm: float
+    overhang_mm: float
+    flute_length_mm: float | None
+    cutting: CuttingConditions
+    rpm_min: float
+    rpm_max: float
+    cutting_source: str
+    line: int
+
+
+@dataclass(frozen=True)
+class BadRow:
+    """A library row that cannot be used, and why (one line starting with its id).
+
+    Attributes
+    ----------
+    id : str
+        The row's id (``line N`` if it has none).
+    error : str
+        One line: ``<id>: <problem>``.
+    line : int
+        Line in the file.
+    """
+
+    id: str
+    error: str
+    line: int
+
+
+def _number(row: dict, name: str, *, positive=True, required=True) -> float | None:
+    cell = (row.get(name) or "").strip()
+    if not cell:
+        if required:
+            raise ValueError(f"{name}: missing value")
+        return None
+    try:
+        v = float(cell)
+    except ValueError:
+        raise ValueError(f"{name}: {cell!r} is not a number") from None
+    if not math.isfinite(v) or (positive and v <= 0):
+        raise ValueError(f"{name}: must be a finite number > 0, got {cell}")
+    return v
+
+
+def _tool(row: dict, line: int, tid: str) -> LibraryTool:
+    D, L = _number(row, "diameter_mm"), _number(row, "overhang_mm")
+    flute = _number(row, "flute_length_mm", required=False)
+    teeth_v = _number(row, "teeth")
+    if teeth_v != int(teeth_v):
+        raise ValueError(f"teeth: must be a whole number, got {row['teeth'].strip()}")
+    holder = (row.get("holder") or "").strip()
+    if not holder:
+        raise ValueError("holder: missing value")
+    material = (row.get("material") or "").strip()
+    kt = _number(row, "tangential_coeff_n_mm2", required=False)
+    kr = _number(row, "radial_ratio", positive=False, required=False)
+    if kt is not None and kr is not None:
+        kt_si, source = kt * 1e6, "library"
+    elif kt is None and kr is None and material and preset(material) is not None:
+        kt_si, kr, source = preset(material)
+    elif kt is None and kr is None:
+        known = ", ".join(PRESETS)
+        if material:
+            raise ValueError(f"no cutting data: material {material!r} is not a preset ({known}); give "
+                             "tangential_coeff_n_mm2 and radial_ratio")
+        raise ValueError(f"no cutting data: give tangential_coeff_n_mm2 and radial_ratio, or a material preset "
+                         f"({known})")
+    else:
+        raise ValueError("give both tangential_coeff_n_mm2 and radial_ratio (or neither, with a material preset)")
+    ri = _number(row, "radial_immersion")
+    milling = (row.get("milling") or "").strip().lower()
+    try:
+        cut = CuttingConditions(int(teeth_v), kt_si, kr, ri, milling)
+    except InputError as e:
+        raise ValueError(str(e)) from None
+    lo, hi = _number(row, "rpm_min"), _number(row, "rpm_max")
+    if not lo < hi:
+        raise ValueError(f"rpm_min ({lo:g}) must be below rpm_max ({hi:g})")
+    return LibraryTool(tid, holder, material, D, L, flute, cut, lo, hi, source, line)
+
+
+def read_library(path: str | os.PathLike) -> tuple[list[LibraryTool], list[BadRow]]:
+    """Read a tool library CSV (module docstring).
+
+    Parameters
+    ----------
+    path : path-like
+        The CSV file.
+
+    Returns
+    -------
+    tools : list of LibraryTool
+        The usable rows, in file order.
+    bad : list of BadRow
+        The rows that are not (one line each, naming the id).
+
+    Raises
+    ------
+    InputError
+        The file is missing or unreadable, has no header, lacks a required
+        column, or has no data rows.
+    """
+    path = Path(path)
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            reader = csv.DictReader(fh)
+            header = [h.strip() for h in (reader.fieldnames or [])]
+            reader.fieldnames = header
+            rows = [(reader.line_num, r) for r in reader if any((v or "").strip() for v in r.values() if
+                                                              isinstance(v, str))]
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise InputError(f"cannot read the tool library: {getattr(err, 'strerror', None) or err}",
+                         file=path) from None
+    if not header:
+        raise InputError("empty file (no header row)", file=path)
+    for name in REQUIRED:
+        if name not in header:
+            raise InputError(f"no such column (columns: {', '.join(header)})", file=path, field=name)
+    if not rows:
+        raise InputError("no tools (a header but no rows)", file=path)
+    tools, bad, seen = [], [], set()
+    for line, row in rows:
+        tid = (row.get("id") or "").strip()
+        try:
+            if not tid:
+                tid = f"line {line}"
+                raise ValueError("empty id")
+            if tid in seen:
+                raise ValueError(f"id appears more than once (line {line})")
+            if None in row:
+                raise ValueError(f"line {line} has more cells than the header")
+            seen.add(tid)
+            tools.append(_tool(row, line, tid))
+        except ValueError as e:
+            bad.append(BadRow(tid, f"{tid}: {' '.join(str(e).split())}", line))
+    return tools, bad

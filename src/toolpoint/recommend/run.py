@@ -1,0 +1,262 @@
+"""``library``: recommend speeds and depths for every tool of a library, resumably.
+
+Rows go to ``OUT/recommendations.csv`` as tools finish (flushed and synced),
+each after the tool's files ``OUT/tools/<id>.npz`` (arrays) and
+``OUT/tools/<id>.json`` (summary) were written atomically; a killed run loses at
+most the tools being computed. A re-run keeps the ``ok`` rows whose files
+exist, and computes the rest (bad rows are checked again). Tools run in a local
+process pool or on an existing Dask cluster, like ``campaign run``.
+
+``recommendations.csv`` columns (:data:`COLUMNS`; depths mm, speeds rpm, joint SI):
+``id, status`` (``ok``/``failed``), ``holder, diameter_mm, overhang_mm, teeth, material, cutting_source,
+outside_range`` (δ, range widths), ``<p>_p05, <p>_p50, <p>_p95`` for kt, ct, kr, cr, ``rpm, kind``
+(``pocket``/``edge``), ``limit_nominal_mm, limit_p50_mm, limit_p05_mm, depth_mm`` (recommended),
+``p_stable`` (at the recommended point), ``min_limit_p05_mm`` (stable at every speed with 95 %),
+``notes, error``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import sys
+import time
+import warnings
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from ..campaign.config import load_campaign
+from ..campaign.run import execute
+from ..errors import ExtrapolationWarning, InputError
+from ..identification.params import PARAMS
+from ..io.atomic import atomic_open, atomic_path
+from .engine import ToolJob, evaluate_tool
+from .library import read_library
+from .uncertainty import JointPredictor
+
+__all__ = ["COLUMNS", "FILE_NAME", "run_library"]
+
+FILE_NAME = "recommendations.csv"
+COLUMNS = (["id", "status", "holder", "diameter_mm", "overhang_mm", "teeth", "material", "cutting_source",
+            "outside_range"] + [f"{p}_{q}" for p in PARAMS for q in ("p05", "p50", "p95")]
+           + ["rpm", "kind", "limit_nominal_mm", "limit_p50_mm", "limit_p05_mm", "depth_mm", "p_stable",
+              "min_limit_p05_mm", "notes", "error"])
+
+
+def _resume(path: Path, tools_dir: Path, ids: set) -> set:
+    """Rewrite ``path`` with its finished ok rows of ``ids`` whose files exist; their ids."""
+    keep = []
+    if path.exists():
+        try:
+            with open(path, newline="", encoding="utf-8") as fh:
+                rows = list(csv.DictReader(fh))
+        except (OSError, UnicodeDecodeError, csv.Error) as e:
+            raise InputError(f"cannot read the results to resume ({e})", file=path) from None
+        keep = [r for r in rows if r.get("status") == "ok" and r.get("id") in ids and r.get("error") is not None
+                and (tools_dir / f"{r['id']}.npz").exists() and (tools_dir / f"{r['id']}.json").exists()]
+    with atomic_open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.DictWriter(fh, COLUMNS, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(keep)
+    return {r["id"] for r in keep}
+
+
+def _seed(seed: int, tool_id: str) -> int:
+    return int(np.random.SeedSequence([seed, zlib.crc32(tool_id.encode())]).generate_state(1)[0])
+
+
+def _fmt(v) -> str:
+    return f"{v:.6g}" if isinstance(v, (float, np.floating)) else str(v)
+
+
+def _row(tool, status, **cells) -> dict:
+    row = dict.fromkeys(COLUMNS, "")
+    row.update(id=tool.id, status=status)
+    if hasattr(tool, "cutting"):
+        row.update(holder=tool.holder, diameter_mm=_fmt(tool.diameter_mm), overhang_mm=_fmt(tool.overhang_mm),
+                   teeth=tool.cutting.teeth, material=tool.material, cutting_source=tool.cutting_source)
+    row.update({k: _fmt(v) for k, v in cells.items()})
+    return row
+
+
+def _ok_row(tool, summary, delta, notes) -> dict:
+    best = summary["points"][0]
+    cells = {f"{p}_{q}": summary["joint"][p][q] for p in PARAMS for q in ("p05", "p50", "p95")}
+    cells.update({k: best[k] for k in ("rpm", "kind", "limit_nominal_mm", "limit_p50_mm", "limit_p05_mm",
+                                       "depth_mm", "p_stable")})
+    return _row(tool, "ok", outside_range=float(delta), min_limit_p05_mm=summary["min_limit_mm"]["p05"],
+                notes="; ".join(notes), **cells)
+
+
+def _write_tool(tools_dir: Path, tool_id: str, result: dict, extra: dict) -> None:
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **result["arrays"])
+    with atomic_path(tools_dir / f"{tool_id}.npz") as tmp:
+        Path(tmp).write_bytes(buf.getvalue())
+    with atomic_open(tools_dir / f"{tool_id}.json", "w", encoding="utf-8") as fh:
+        json.dump({**result["summary"], **extra}, fh, indent=1, allow_nan=True)
+
+
+def run_library(library, campaign, models, out_dir, *, workers: int | None = None, dask: str | None = None,
+                n_samples: int = 200, rpm_points: int = 500, seed: int = 0, margin: float = 0.1,
+                rpm_tolerance: float = 0.01, outside: str = "widen", progress: bool = True,
+                on_bad=None) -> dict:
+    """Recommend operating points for every tool of a library (module docstring).
+
+    Parameters
+    ----------
+    library : path-like
+        Tool library CSV (:mod:`.library`).
+    campaign : path-like
+        Campaign folder (tool family, holders' subassemblies).
+    models : path-like
+        ``campaign learn`` models folder (``identified.csv`` beside it).
+    out_dir : path-like
+        Output folder (made if missing; an existing run is resumed).
+    workers : int, optional
+        Local processes (default all cores; 1 runs here).
+    dask : str, optional
+        Address of a running Dask scheduler.
+    n_samples : int, default 200
+        Joint samples per tool.
+    rpm_points : int, default 500
+        Speeds per tool, evenly spaced over the tool's [rpm_min, rpm_max].
+    seed : int, default 0
+        Seed (each tool gets its own from it and its id).
+    margin : float, default 0.1
+        Recommended depth = robust 5 % limit × (1 − margin).
+    rpm_tolerance : float, default 0.01
+        Relative spindle-speed tolerance of the robust limit.
+    outside : {"widen", "refuse"}
+        A tool outside the learned (D, L) range: widen its σ (warn) or refuse it.
+    progress : bool
+        Progress bar on stderr.
+    on_bad : callable, optional
+        Called with one line per bad tool (default: warnings are not emitted; lines are in the table).
+
+    Returns
+    -------
+    dict
+        ``ok``, ``failed``, ``skipped`` counts, ``seconds``, ``path``.
+
+    Raises
+    ------
+    InputError
+        An unreadable or empty library, a bad campaign or models folder, a bad
+        setting, a Dask scheduler that does not answer (before anything is written).
+    """
+    if outside not in ("widen", "refuse"):
+        raise InputError(f"must be 'widen' or 'refuse', got {outside!r}", field="outside")
+    for name, v, lo in (("n_samples", n_samples, 2), ("rpm_points", rpm_points, 3)):
+        if not isinstance(v, (int, np.integer)) or v < lo:
+            raise InputError(f"must be a whole number ≥ {lo}, got {v!r}", field=name)
+    if not (0 <= margin < 1):
+        raise InputError(f"must be in [0, 1), got {margin!r}", field="margin")
+    if not (0 <= rpm_tolerance < 0.5):
+        raise InputError(f"must be in [0, 0.5), got {rpm_tolerance!r}", field="rpm_tolerance")
+    tools, bad = read_library(library)
+    c = load_campaign(campaign)
+    predictor = JointPredictor(models)
+    from ..campaign.run import dask_client
+
+    client = dask_client(dask) if dask else None
+    out = Path(out_dir)
+    tools_dir = out / "tools"
+    tools_dir.mkdir(parents=True, exist_ok=True)
+    path = out / FILE_NAME
+    done = _resume(path, tools_dir, {t.id for t in tools})
+    todo = [t for t in tools if t.id not in done]
+    t0 = time.perf_counter()
+    report = on_bad or (lambda line: None)
+    failed_rows = [_row(b, "failed", error=b.error) for b in bad]
+    jobs, notes_of = [], {}
+    dist = predictor.predict([t.diameter_mm for t in todo], [t.overhang_mm for t in todo]) if todo else None
+    subs = {}
+    for k, t in enumerate(todo):
+        notes = []
+        if t.holder not in c.holders:
+            failed_rows.append(_row(t, "failed", error=f"{t.id}: holder {t.holder!r} is not in the campaign "
+                                                          f"(it has {', '.join(c.holders)})"))
+            continue
+        if not np.all(np.isfinite(dist.log10_median[k])):
+            failed_rows.append(_row(t, "failed", error=f"{t.id}: a model predicts a value ≤ 0 at D {t.diameter_mm:g}"
+                                                          f" mm, L {t.overhang_mm:g} mm"))
+            continue
+        delta = float(dist.outside[k])
+        if delta > 0:
+            where = (f"D {t.diameter_mm:g} mm, L {t.overhang_mm:g} mm is outside the learned range (D "
+                     f"{predictor.lo[0]:g}–{predictor.hi[0]:g} mm, L {predictor.lo[1]:g}–{predictor.hi[1]:g} mm)")
+            if outside == "refuse":
+                failed_rows.append(_row(t, "failed", outside_range=delta, error=f"{t.id}: {where}: refused "
+                                                                                "(--outside widen to allow)"))
+                continue
+            notes.append(f"{where}: σ widened ×{1 + 5 * delta:.2g}")
+            report(f"warning: {t.id}: {notes[-1]}")
+        if t.holder not in subs:
+            kind = c.holders[t.holder].kind
+            if kind == "model":
+                lo, hi = c.band_hz
+                subs[t.holder] = c.subassembly(t.holder, np.arange(lo, hi + 0.5))
+            else:
+                subs[t.holder] = c.subassembly(t.holder, None)
+        sub = subs[t.holder]
+        keep = sub.freq_hz > 0
+        notes_of[t.id] = (t, notes, delta)
+        jobs.append(ToolJob(t.id, c.family, t.diameter_mm, t.overhang_mm, t.flute_length_mm, sub.freq_hz[keep],
+                            sub.R[keep], t.holder, t.cutting, np.linspace(t.rpm_min, t.rpm_max, rpm_points),
+                            dist.log10_median[k], dist.sigma_log10[k], n_samples, _seed(seed, t.id), margin,
+                            rpm_tolerance))
+    counts = {"ok": 0, "failed": 0, "skipped": len(done)}
+    from tqdm import tqdm
+
+    bar = tqdm(total=len(todo) + len(bad), desc="library", unit="tool", disable=not progress or None,
+               file=sys.stderr)
+    try:
+        with open(path, "a", newline="", encoding="utf-8") as fh:
+            w = csv.DictWriter(fh, COLUMNS)
+
+            def append(row):
+                w.writerow(row)
+                fh.flush()
+                os.fsync(fh.fileno())
+                counts[row["status"]] += 1
+                bar.update(1)
+
+            for row in failed_rows:
+                report(f"error: {row['error']}")
+                append(row)
+            for job, result in _execute(jobs, workers, client):
+                t, notes, delta = notes_of[job.id]
+                if isinstance(result, Exception):
+                    msg = f"{t.id}: {' '.join(f'{type(result).__name__}: {result}'.split())}"
+                    report(f"error: {msg}")
+                    append(_row(t, "failed", error=msg))
+                    continue
+                _write_tool(tools_dir, t.id, result, {"notes": notes, "outside_range": delta,
+                                                      "cutting": {"teeth": t.cutting.teeth,
+                                                                  "tangential_coeff": t.cutting.tangential_coeff,
+                                                                  "radial_ratio": t.cutting.radial_ratio,
+                                                                  "radial_immersion": t.cutting.radial_immersion,
+                                                                  "milling": t.cutting.milling,
+                                                                  "source": t.cutting_source},
+                                                      "holder": t.holder, "diameter_mm": t.diameter_mm,
+                                                      "overhang_mm": t.overhang_mm, "material": t.material})
+                append(_ok_row(t, result["summary"], delta, notes))
+    finally:
+        bar.close()
+        if client is not None:
+            client.close()
+    counts["seconds"] = time.perf_counter() - t0
+    counts["path"] = str(path)
+    return counts
+
+
+def _execute(jobs, workers, client):
+    """Yield (job, result or exception) as tools finish (extrapolation is said once per tool in its row)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)
+        yield from execute(evaluate_tool, jobs, workers, client)

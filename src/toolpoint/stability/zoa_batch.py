@@ -1,0 +1,166 @@
+r"""Zero-order stability limits of many FRFs of one symmetric tool at once.
+
+The recommendation samples a few hundred joints per tool; calling
+:func:`~toolpoint.stability.zoa.zoa_lobes` per sample (lobes, chatter
+frequencies, refined minimum) costs ~0.1 s each. Here only the limit on a
+speed grid is computed, for all samples together.
+
+For a symmetric tool (Φ_yy = Φ_xx = Φ, no cross terms) the oriented FRF is
+H₀Φ, so its eigenvalues are μ_b(ω) = λ_b Φ(ω) with λ_b (b = 0, 1) the two
+eigenvalues of the average directional matrix H₀ (N/m²): no branch tracking
+over frequency is needed. As in :mod:`~toolpoint.stability.zoa`,
+
+    1/a_lim = −2 Re μ  (1/m),   ε = π + 2 arg(−μ),
+    tooth period T = (k + ε/2π) / f,  n = 60 / (N T)  (rpm),  k = 0, 1, …
+
+μ is interpolated linearly between FRF points, so 1/a_lim is linear there;
+where Re μ changes sign the piece runs to the crossing (1/a_lim = 0, ε = 0 or
+2π), so a lobe flank rises to its asymptote instead of being cut. Unlike
+``zoa_lobes``, which solves for the exact point of each grid speed on a piece
+(Newton), 1/a_lim is interpolated linearly in the tooth period between the
+piece's ends; the limit at a speed is 1 / max over (piece, lobe, branch) of
+the interpolated 1/a_lim. The difference to ``zoa_lobes`` is measured in
+``tests/test_library.py`` and ``docs/design/recommend.md``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .cutting import CuttingConditions
+from .milling import average_directional_matrix, check_rpm
+
+__all__ = ["zoa_limits"]
+
+# (sample, piece, lobe, speed) entries handled per block: bounds memory (~100 B each).
+_BLOCK_ENTRIES = 2_000_000
+
+
+def zoa_limits(freq_hz, receptance, cutting: CuttingConditions, rpm, *, cap_m: float = np.inf,
+               subdivide: int = 4) -> np.ndarray:
+    """Zero-order stability limits (axial depth, m) of a symmetric tool for many receptances.
+
+    Parameters
+    ----------
+    freq_hz : array_like, shape (F,)
+        Increasing frequencies, Hz (> 0).
+    receptance : array_like, shape (N, F) or (F,)
+        Tool-point receptances Φ_xx = Φ_yy, m/N (cross terms 0).
+    cutting : CuttingConditions
+        Teeth, K_t (N/m²), K_r, immersion, milling.
+    rpm : array_like, shape (G,)
+        Increasing spindle speeds, rpm.
+    cap_m : float, default inf
+        Depths above this (m) are not resolved: pieces of lobe entirely above
+        it are skipped and the result is clipped to it (faster; the limit is
+        then "≥ cap_m" where it equals cap_m).
+    subdivide : int, default 4
+        Each piece between FRF points is split in this many parts, each
+        interpolated linearly in the tooth period (error ∝ 1/subdivide²).
+
+    Returns
+    -------
+    ndarray, shape (N, G) or (G,)
+        Stability limit, m: the minimum over lobes and both eigenvalue
+        branches; inf (or ``cap_m``) where no lobe reaches the speed.
+
+    Examples
+    --------
+    One mode in x and y (922 Hz, ζ = 0.011, 0.03993 kg), slotting, two teeth:
+    the minimum of the limit is 2kζ(1+ζ)/(N K_t (1 + K_r²)^½ ... ) — here
+    compared with :func:`~toolpoint.stability.zoa_lobes` itself:
+
+    >>> import numpy as np
+    >>> from toolpoint.frf import FRF
+    >>> from toolpoint.stability import CuttingConditions, zoa_lobes
+    >>> f = np.arange(1.0, 3001.0)
+    >>> w, wn, zeta, m = 2 * np.pi * f, 2 * np.pi * 922.0, 0.011, 0.03993
+    >>> h = 1 / (m * (wn**2 - w**2 + 2j * zeta * wn * w))
+    >>> cut = CuttingConditions(teeth=2, tangential_coeff=6e8, radial_ratio=1/3, radial_immersion=1.0)
+    >>> rpm = np.linspace(5000, 25000, 300)
+    >>> fast = zoa_limits(f, h, cut, rpm)
+    >>> ref = zoa_lobes(FRF(f, h), None, cut, rpm=rpm).depth_m
+    >>> bool(np.max(np.abs(fast / ref - 1)) < 1e-3)
+    True
+    """
+    f = np.asarray(freq_hz, float)
+    H = np.asarray(receptance)
+    single = H.ndim == 1
+    H = np.atleast_2d(H)
+    grid = check_rpm(rpm)
+    phi_st, phi_ex = cutting.immersion_angles
+    h0 = average_directional_matrix(cutting.teeth, cutting.tangential_coeff, cutting.radial_ratio, phi_st, phi_ex)
+    tr, det = np.trace(h0), np.linalg.det(h0)
+    root = np.sqrt(complex(tr * tr / 4 - det))
+    lam = np.array([tr / 2 + root, tr / 2 - root])
+    period = 1.0 / grid[::-1]  # ascending, 1/rpm
+    G = grid.size
+    qmax = np.zeros((H.shape[0], G))  # 1/a_lim, 1/m; 0 = no lobe
+    q_cap = 0.0 if not np.isfinite(cap_m) else 1.0 / cap_m
+    rmin, rmax = grid[0], grid[-1]
+    chunk = max(1, int(_BLOCK_ENTRIES // max(1, 4 * G)))
+    for s0 in range(0, H.shape[0], chunk):
+        mu = lam[None, :, None] * H[s0:s0 + chunk, None, :]  # (n, 2, F)
+        _accumulate(qmax[s0:s0 + chunk], mu, f, 60.0 / cutting.teeth, period, rmin, rmax, q_cap, subdivide)
+    with np.errstate(divide="ignore"):
+        limit = np.where(qmax > 0, 1.0 / np.where(qmax > 0, qmax, 1.0), np.inf)[:, ::-1]
+    limit = np.minimum(limit, cap_m)
+    return limit[0] if single else limit
+
+
+def _accumulate(qmax, mu, f, teeth_c, period, rmin, rmax, q_cap, subdivide):
+    """qmax[s, g] = max(qmax, 1/a_lim of every lobe piece of sample s at reversed-grid speed g)."""
+    scale = np.abs(mu).max(axis=1, keepdims=True)
+    valid = np.isfinite(mu) & (mu.real < -1e-9 * scale) & (f > 0)
+    v0, v1 = valid[..., :-1], valid[..., 1:]
+    q = np.where(valid, -2.0 * mu.real, 0.0)
+    keep = (v0 | v1) & (np.maximum(q[..., :-1], q[..., 1:]) > q_cap)
+    s, b, i = np.nonzero(keep)
+    if s.size == 0:
+        return
+    m0, m1 = mu[s, b, i], mu[s, b, i + 1]
+    both = v0[s, b, i] & v1[s, b, i]
+    left = v0[s, b, i] & ~both
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tstar = np.clip(np.where(both, 0.5, m0.real / (m0.real - m1.real)), 0.0, 1.0)
+    ta = np.where(both | left, 0.0, tstar)
+    tb = np.where(both, 1.0, np.where(left, tstar, 1.0))
+    ok = tb > ta
+    s, i, m0, m1, ta, tb = s[ok], i[ok], m0[ok], m1[ok], ta[ok], tb[ok]
+    # each piece in `subdivide` parts: the speed n(t) is not linear in t where ε turns fast (sharp peaks)
+    j = np.tile(np.arange(subdivide), s.size)
+    s, i, m0, m1 = (np.repeat(v, subdivide) for v in (s, i, m0, m1))
+    ta, tb = np.repeat(ta, subdivide), np.repeat(tb, subdivide)
+    ta, tb = ta + (tb - ta) * j / subdivide, ta + (tb - ta) * (j + 1) / subdivide
+    ends = []
+    for t, is_crossing in ((ta, (ta > 0) & (j == 0)), (tb, (tb < 1) & (j == subdivide - 1))):
+        mt = m0 + t * (m1 - m0)
+        mt = np.where(is_crossing, 1j * mt.imag, mt)  # exactly Re μ = 0 at a crossing
+        ft = f[i] + t * (f[i + 1] - f[i])
+        frac = (np.pi + 2 * np.arctan2(-mt.imag, -mt.real)) / (2 * np.pi)
+        ends.append((np.maximum(-2.0 * mt.real, 0.0), teeth_c * ft, frac))
+    (qa, ca, fra), (qb, cb, frb) = ends
+    # lobes k with n = c/(k + frac) inside [rmin, rmax], over both ends
+    klo = np.maximum(np.minimum(np.ceil(ca / rmax - fra), np.ceil(cb / rmax - frb)), 0)
+    khi = np.maximum(np.floor(ca / rmin - fra), np.floor(cb / rmin - frb))
+    cnt = np.maximum(khi - klo + 1, 0).astype(np.int64)
+    p = np.repeat(np.arange(cnt.size), cnt)
+    k = klo[p] + (np.arange(p.size) - np.repeat(np.cumsum(cnt) - cnt, cnt))
+    pa = (k + fra[p]) / ca[p]  # tooth period × 60/N... in 1/rpm: n = c/(k+frac) → 1/n = (k+frac)/c
+    pb = (k + frb[p]) / cb[p]
+    lo = np.searchsorted(period, np.minimum(pa, pb), "left")
+    hi = np.searchsorted(period, np.maximum(pa, pb), "right")
+    n_g = np.maximum(hi - lo, 0)
+    e = np.repeat(np.arange(p.size), n_g)
+    g = lo[e] + (np.arange(e.size) - np.repeat(np.cumsum(n_g) - n_g, n_g))
+    if e.size == 0:
+        return
+    qa_e, qb_e, pa_e, pb_e = qa[p][e], qb[p][e], pa[e], pb[e]
+    span = pb_e - pa_e
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = np.where(span != 0, (period[g] - pa_e) / span, 0.0)
+    qg = np.where(span != 0, qa_e + np.clip(w, 0, 1) * (qb_e - qa_e), np.maximum(qa_e, qb_e))
+    G = period.size
+    flat = qmax.reshape(-1)
+    np.maximum.at(flat, s[p][e] * G + g, qg)
+    qmax[...] = flat.reshape(qmax.shape)

@@ -1,0 +1,170 @@
+"""Common-pole modal fit (toolpoint.dynamics.modal) against independent non-proportionally damped systems.
+
+Exact FRFs and poles come from M, C, K (tests/modal_systems.py): a direct solve per
+frequency and the state-space eigenvalues, not from the fitted model.
+"""
+
+import numpy as np
+import pytest
+
+from modal_systems import FIVE, FOUR, add_noise
+from toolpoint.dynamics.modal import fit_frfs, fit_modal
+from toolpoint.errors import InputError
+from toolpoint.frf import FRF
+
+F = np.arange(1.0, 3001.0)
+BAND = (100.0, 3000.0)
+
+
+def check_modes(fit, system, rel_f, rel_z):
+    fn, ze = system.poles()
+    assert fit.n_modes == fn.size  # no spurious mode, none lost
+    assert fit.fn_hz == pytest.approx(fn, rel=rel_f)
+    assert fit.zeta == pytest.approx(ze, rel=rel_z)
+    assert np.all((fit.fn_hz >= fit.band_hz[0]) & (fit.fn_hz <= fit.band_hz[1]))
+
+
+@pytest.mark.parametrize("system", [FOUR, FIVE], ids=["4-mode", "5-mode"])
+def test_noise_free_complex_modes_are_exact(system):
+    fit = fit_modal(F, system.frf(F, "accelerance"), quantity="accelerance", band=BAND)
+    check_modes(fit, system, 1e-7, 1e-5)
+    fb = F[F >= BAND[0]]
+    H = system.receptance(fb)
+    assert np.abs(fit(fb) - H).max() < 1e-7 * np.abs(H).max()
+    A, B, C = fit.state_space()  # the real state-space form reproduces the modes
+    s = 2j * np.pi * 777.0
+    h = (C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B))[:, 0]
+    assert h == pytest.approx(system.receptance([777.0])[0], rel=1e-6)
+
+
+@pytest.mark.parametrize("system", [FOUR, FIVE], ids=["4-mode", "5-mode"])
+def test_accelerance_noise_fitted_in_accelerance(system):
+    """0.5 % noise white in accelerance: frequencies to 0.05 %, damping to 5 %, receptance error ≪ noise."""
+    Y = add_noise(system.frf(F, "accelerance"), 0.005, seed=7)
+    fit = fit_modal(F, Y, quantity="accelerance", band=BAND)
+    check_modes(fit, system, 5e-4, 0.05)
+    fb = F[F >= BAND[0]]
+    H = system.receptance(fb)
+    err = np.linalg.norm(fit(fb) - H, axis=0) / np.linalg.norm(H, axis=0)
+    assert np.all(err < 0.01)
+
+
+def test_receptance_noise_fitted_in_receptance():
+    Y = add_noise(FOUR.frf(F, "receptance"), 0.005, seed=7)
+    fit = fit_modal(F, Y, band=BAND)
+    check_modes(fit, FOUR, 5e-4, 0.05)
+
+
+def test_close_pair_is_recovered():
+    """1482 / 1622 Hz, noise-free: a real-mode fit put 1482 Hz at 1467.6 Hz; complex modes are exact."""
+    fit = fit_modal(F, FIVE.frf(F, "receptance"), band=BAND)
+    fn, ze = FIVE.poles()
+    assert fn[1] == pytest.approx(1482.0, rel=1e-3) and fn[2] == pytest.approx(1622.0, rel=1e-3)
+    check_modes(fit, FIVE, 5e-4, 0.05)
+
+
+def test_same_data_same_fit():
+    Y = add_noise(FOUR.frf(F, "accelerance"), 0.005, seed=1)
+    a = fit_modal(F, Y, quantity="accelerance", band=BAND)
+    b = fit_modal(F, Y, quantity="accelerance", band=BAND)
+    assert np.array_equal(a.poles, b.poles) and np.array_equal(a.residues, b.residues)
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(band=(4000.0, 5000.0)), "band"),
+    (dict(band=(100.0, 105.0)), "at least"),
+    (dict(n_modes=0), "positive"),
+    (dict(quantity="velocity"), "quantity"),
+])
+def test_bad_input_is_one_line(kw, match):
+    with pytest.raises(InputError, match=match) as e:
+        fit_modal(F, FOUR.frf(F, "receptance"), **kw)
+    assert "\n" not in str(e.value)
+
+
+def test_zero_and_nan_frfs():
+    Y = FOUR.frf(F, "receptance")
+    Y[:, 1] = 0
+    with pytest.raises(InputError, match="zero"):
+        fit_modal(F, Y)
+    Y = FOUR.frf(F, "receptance")
+    Y[50, 0] = np.nan
+    with pytest.raises(InputError, match="finite"):
+        fit_modal(F, Y)
+
+
+@pytest.mark.parametrize("lo, hi", [(1500.0, 1700.0), (1000.0, 1300.0)], ids=["between modes", "around a mode"])
+def test_low_coherence_band_does_not_pull_the_fit(lo, hi):
+    """frf.meta["coherence"]: a band of γ² = 0.2 whose data carry the matching large errors.
+
+    The noise follows the H1 statistics the weights assume, σ = |y| √((1 − γ²)/γ²), so outside
+    the band (γ² = 0.9999) it is 1 % of |y| and inside it is twice |y|. Weighted by coherence,
+    the fit finds the four exact modes; unweighted (1 / peak per FRF), the corrupted band
+    pulls spurious modes into the fit and the receptance error grows by more than ten times.
+    """
+    Y0 = FOUR.frf(F, "accelerance")
+    gam = np.where((F >= lo) & (F <= hi), 0.2, 0.9999)
+    rng = np.random.default_rng(5)
+    sig = np.abs(Y0) * np.sqrt((1 - gam) / gam)[:, None]
+    Y = Y0 + sig * (rng.standard_normal(Y0.shape) + 1j * rng.standard_normal(Y0.shape)) / np.sqrt(2)
+    fb = F[F >= BAND[0]]
+    H = FOUR.receptance(fb)
+    err = {}
+    for use in (True, False):
+        frfs = [FRF(F, Y[:, k], "accelerance", f"y{k}", meta={"coherence": gam} if use else {}) for k in range(3)]
+        fit = fit_frfs(frfs, band=BAND)
+        err[use] = np.linalg.norm(fit(fb) - H, axis=0) / np.linalg.norm(H, axis=0)
+        if use:
+            check_modes(fit, FOUR, 5e-4, 0.05)
+        else:
+            assert fit.n_modes > 4  # the corrupted band did pull (the comparison is not vacuous)
+    assert err[True].max() < 0.002
+    assert err[True].max() < 0.1 * err[False].max()
+
+
+def test_bad_coherence_is_one_line():
+    Y = FOUR.frf(F, "receptance")
+    for g in (np.full(F.size, 1.5), np.full(7, 0.9)):
+        with pytest.raises(InputError, match="coherence") as e:
+            fit_modal(F, Y, coherence=g)
+        assert "\n" not in str(e.value)
+
+
+# A 3-DOF chain with a damping matrix not ∝ M or K (moved from the former polefit tests).
+M3 = np.diag([1.0, 0.6, 0.4])  # kg
+K3 = np.array([[3.0, -1.5, 0.0], [-1.5, 2.5, -1.0], [0.0, -1.0, 1.0]]) * 4e7  # N/m
+C3 = np.array([[60.0, -20.0, 0.0], [-20.0, 20.0, 0.0], [0.0, 0.0, 8.0]])  # N s/m
+F3 = np.arange(20.0, 3000.0, 2.0)
+
+
+def chain_frfs(f):
+    """H00, H01, H22 (m/N) by a direct solve of (K − ω²M + iωC) x = F at each frequency."""
+    w = 2 * np.pi * np.asarray(f)[:, None, None]
+    H = np.linalg.inv(K3[None] - w**2 * M3[None] + 1j * w * C3[None])
+    return np.stack([H[:, 0, 0], H[:, 0, 1], H[:, 2, 2]], -1)
+
+
+def test_chain_noise_free_interpolates_off_the_grid():
+    from modal_systems import System
+
+    fit = fit_modal(F3, chain_frfs(F3))
+    fn, ze = System(M3, C3, K3, (0,)).poles()
+    assert fit.fn_hz == pytest.approx(fn, rel=1e-7) and fit.zeta == pytest.approx(ze, rel=1e-5)
+    assert np.all(fit.fit_error < 1e-8)
+    f_new = np.linspace(25.0, 2990.0, 777)  # off the fitted grid
+    assert np.abs(fit(f_new) - chain_frfs(f_new)).max() < 1e-7 * np.abs(chain_frfs(f_new)).max()
+
+
+def test_chain_noise_removed_peaks_kept():
+    rng = np.random.default_rng(3)
+    Y = chain_frfs(F3)
+    sigma = 2e-3 * np.abs(Y).max(0)
+    noisy = Y + sigma * (rng.standard_normal(Y.shape) + 1j * rng.standard_normal(Y.shape)) / np.sqrt(2)
+    fit = fit_modal(F3, noisy)
+    err_fit = np.sqrt(np.mean(np.abs(fit(F3) - Y) ** 2, 0))
+    err_raw = np.sqrt(np.mean(np.abs(noisy - Y) ** 2, 0))
+    assert np.all(err_fit < 0.2 * err_raw)  # most of the noise is gone …
+    assert np.abs(fit(F3)).max(0) == pytest.approx(np.abs(Y).max(0), rel=5e-3)  # … and the peaks are not rounded
+    assert fit.n_modes == 3
+    with pytest.raises(InputError, match="increasing"):
+        fit_modal(F3[::-1], Y)
