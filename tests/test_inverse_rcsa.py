@@ -275,7 +275,8 @@ def test_bad_points_blank_and_frequencies(example, blank80):
 def test_subassembly_from_files_and_model(example, tmp_path):
     f = np.arange(10.0, 3001.0, 10.0)
     true = subassembly_from_assembly(example, f)
-    assert np.array_equal(true.R, Subassembly.from_assembly(example, f).R)
+    # the same computation by two routes: equal to round-off (older OpenBLAS builds may sum in another order)
+    np.testing.assert_allclose(true.R, Subassembly.from_assembly(example, f).R, rtol=1e-12, atol=0)
     paths = {}
     for name, (i, j) in zip("hlnp", ((0, 0), (0, 1), (1, 0), (1, 1))):
         paths[name] = tmp_path / f"{name}.csv"
