@@ -45,8 +45,8 @@ class Bounds:
     Examples
     --------
     >>> b = Bounds.from_dict({"kt": [1e6, 1e8]})
-    >>> b.as_dict()["kt"], b.log_hi[0]
-    ([1000000.0, 100000000.0], np.float64(8.0))
+    >>> b.as_dict()["kt"], float(b.log_hi[0])
+    ([1000000.0, 100000000.0], 8.0)
     >>> Bounds.from_dict({"kt": [1e8, 1e6]}, source="a.toml")
     Traceback (most recent call last):
     ...
