@@ -144,8 +144,8 @@ def test_noise_free_recovery_to_1e_6(example, blank80):
         assert np.linalg.norm(d) / np.linalg.norm(true.R[:, i, j]) < 1e-8  # measured ~2e-10
         assert np.max(np.abs(d) / np.abs(true.R[:, i, j])) < 1e-6  # measured ~1e-8
     assert np.array_equal(sub.R[:, 0, 1], sub.R[:, 1, 0])
-    # G21 (reciprocal) averaged in: same answer; other blank and point: same subassembly
-    assert np.allclose(subassembly_from_blank(blank80, 0.03, *G, G21=G[1]).R, sub.R, rtol=1e-12, atol=0)
+    # G21 (reciprocal) averaged in: same answer; other blank and point: same subassembly (to round-off)
+    assert np.allclose(subassembly_from_blank(blank80, 0.03, *G, G21=G[1]).R, sub.R, rtol=1e-9, atol=0)
     sub2 = subassembly_from_blank(blank_of(example, 0.05), 0.04, *measured(example, blank_of(example, 0.05), 0.04, f))
     assert np.max(norm_rel(sub2, true)) < 1e-8
 
@@ -275,8 +275,8 @@ def test_bad_points_blank_and_frequencies(example, blank80):
 def test_subassembly_from_files_and_model(example, tmp_path):
     f = np.arange(10.0, 3001.0, 10.0)
     true = subassembly_from_assembly(example, f)
-    # the same computation by two routes: equal to round-off (older OpenBLAS builds may sum in another order)
-    np.testing.assert_allclose(true.R, Subassembly.from_assembly(example, f).R, rtol=1e-12, atol=0)
+    # the same computation by two routes: equal to round-off (numpy 1.26 differed by 1e-11 relative here)
+    np.testing.assert_allclose(true.R, Subassembly.from_assembly(example, f).R, rtol=1e-9, atol=0)
     paths = {}
     for name, (i, j) in zip("hlnp", ((0, 0), (0, 1), (1, 0), (1, 1))):
         paths[name] = tmp_path / f"{name}.csv"
