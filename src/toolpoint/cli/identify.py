@@ -114,19 +114,24 @@ def run(args) -> int:
         res = _run_with_progress(model, meas, args.method, args.seed, bounds, algo)
     _report(res, args)
     doc = result_document(res, args.method, args.seed, assembly=args.assembly, measured=args.measured)
+    _write(doc, out, plot, args.method, meas, res.model_frf, res.history,
+           f"{Path(args.measured).name}: identified holder–tool joint")
+    return 0
+
+
+def _write(doc, out, plot, method, measured, fitted, history, title) -> None:
+    """The result JSON and (if asked) the measured-vs-identified figure, each written atomically."""
     fig = None
     if plot:
         use_agg()
         from ..identification.figures import fit_figure
 
-        fig = fit_figure(meas, {f"identified ({args.method})": res.model_frf}, {args.method: res.history},
-                         title=f"{Path(args.measured).name}: identified holder–tool joint")
+        fig = fit_figure(measured, {f"identified ({method})": fitted}, {method: history}, title=title)
     if out:
         with atomic_open(out) as fh:
             json.dump(doc, fh, indent=2)
     if fig is not None:
         save_figure(fig, plot)
-    return 0
 
 
 def _run_with_progress(model, meas, method, seed, bounds, algo):
@@ -319,16 +324,6 @@ def run_general(args) -> int:
         doc["joint"] = joint
     else:
         doc["params"] = list(names)
-    fig = None
-    if plot:
-        use_agg()
-        from ..identification.figures import fit_figure
-
-        fig = fit_figure(meas[0].frf, {f"identified ({args.method})": res.model_frfs[0]}, {args.method: res.history},
-                         title=f"{Path(meas[0].source).name}: identified {joint or ', '.join(names)}")
-    if out:
-        with atomic_open(out) as fh:
-            json.dump(doc, fh, indent=2)
-    if fig is not None:
-        save_figure(fig, plot)
+    _write(doc, out, plot, args.method, meas[0].frf, res.model_frfs[0], res.history,
+           f"{Path(meas[0].source).name}: identified {joint or ', '.join(names)}")
     return 0
