@@ -2,13 +2,16 @@
 
 1. Coverage: on a real synthetic campaign (``campaign synth`` + ``run`` + ``learn``), for the held-out tools
    of ``models/split.csv``, the share of (tool, speed) pairs where the limit of the truth-law joint
-   (camp/truth/) lies inside the predicted 5–95 % band.
+   (camp/truth/) lies inside the predicted 5–95 % band — for the ANFIS distribution and for the GP
+   baseline's own (``--model gp``).
 2. Speed: N tools (default 1000; zero-order lobes at 500 speeds, 200 samples each) with a local process
-   pool of --workers, and on a Dask LocalCluster with 1 and 2 workers (--dask).
+   pool of --workers (wall time, and the CPU time the tools took, summed from their JSON files), and
+   on a Dask LocalCluster with 1 and 2 worker processes of 1 thread each on the first --dask-tools tools.
 
 Usage::
 
-    python benchmarks/bench_library.py --campaign CAMP --results CAMP/results [--tools 1000] [--workers 2] [--dask]
+    python benchmarks/bench_library.py --campaign CAMP --results CAMP/results [--tools 1000] [--workers 2]
+        [--dask] [--dask-tools 100]
 
 (CAMP from ``toolpoint campaign synth --n 178 CAMP``, ``campaign run CAMP --out CAMP/results``,
 ``campaign learn CAMP/results --mfs 3,3``.) Results: docs/design/recommend.md.
@@ -18,6 +21,8 @@ from __future__ import annotations
 
 import argparse
 import csv
+import json
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -36,11 +41,11 @@ HEADER = ("id,diameter_mm,overhang_mm,teeth,holder,tangential_coeff_n_mm2,radial
           "milling,rpm_min,rpm_max")
 
 
-def coverage(camp: Path, results: Path, n_samples=200, cap_m=0.02) -> float:
+def coverage(camp: Path, results: Path, model="anfis", n_samples=200, cap_m=0.02) -> float:
     c = load_campaign(camp)
     sub = c.subassembly("ER40", None)
     f = sub.freq_hz
-    pred = JointPredictor(results / "models")
+    pred = JointPredictor(results / "models", model)
     with open(results / "models" / "split.csv", newline="") as fh:
         test = [r["id"] for r in csv.DictReader(fh) if r["set"] == "test"]
     with open(camp / "truth" / "truth.csv", newline="") as fh:
@@ -51,17 +56,18 @@ def coverage(camp: Path, results: Path, n_samples=200, cap_m=0.02) -> float:
     hits = []
     for tid in test:
         D, L = truth[tid]
-        model = ToolPointModel(c.family.tool(D, L), sub, f)
-        H = model.tool_point(pred.predict(D, L).sample(0, n_samples, rng))
-        h_true = model.tool_point(truth_joint(D, L))
+        tp = ToolPointModel(c.family.tool(D, L), sub, f)
+        H = tp.tool_point(pred.predict(D, L).sample(0, n_samples, rng))
+        h_true = tp.tool_point(truth_joint(D, L))
         for cut in cuts:
             lo, hi = np.quantile(zoa_limits(f, H, cut, grid, cap_m=cap_m), [0.05, 0.95], axis=0)
             true = zoa_limits(f, h_true, cut, grid, cap_m=cap_m)
             hits.append((true >= lo * (1 - 1e-9)) & (true <= hi * (1 + 1e-9)))
     cov = float(np.mean(hits))
     per_tool = np.mean(hits, axis=1)
-    print(f"coverage of the true limit by the 5–95 % band: {cov:.3f} over {len(test)} held-out tools × 2 cuts × "
-          f"{grid.size} speeds (per tool-cut: min {per_tool.min():.2f}, median {np.median(per_tool):.2f})")
+    print(f"{model}: coverage of the true limit by the 5–95 % band: {cov:.3f} over {len(test)} held-out tools × "
+          f"2 cuts × {grid.size} speeds (per tool-cut: min {per_tool.min():.2f}, median {np.median(per_tool):.2f}, "
+          f"share of tool-cuts ≥ 0.85: {np.mean(per_tool >= 0.85):.2f})")
     return cov
 
 
@@ -76,22 +82,46 @@ def library(path: Path, n: int, seed=0) -> Path:
     return path
 
 
-def speed(camp: Path, results: Path, n: int, workers: int, dask: bool) -> None:
+def cpu_seconds(out: Path) -> np.ndarray:
+    """CPU time each tool took in its worker (``cpu_seconds`` of the tools' JSON files)."""
+    return np.array([json.loads(p.read_text())["cpu_seconds"] for p in sorted((out / "tools").glob("*.json"))])
+
+
+def speed(camp: Path, results: Path, n: int, workers: int, dask: bool, dask_tools: int) -> None:
     tmp = Path(tempfile.mkdtemp(prefix="bench_library_"))
     lib = library(tmp / "lib.csv", n)
+    load = os.getloadavg()[0]
     t = time.perf_counter()
     r = run_library(lib, camp, results / "models", tmp / "pool", workers=workers, progress=False)
-    print(f"{n} tools, process pool of {workers}: {time.perf_counter() - t:.1f} s wall ({r['ok']} ok)")
+    dt = time.perf_counter() - t
+    cpu = cpu_seconds(tmp / "pool")
+    print(f"{n} tools, process pool of {workers}: {dt:.1f} s wall ({r['ok']} ok); CPU per tool mean "
+          f"{cpu.mean():.3f} s, max {cpu.max():.2f} s, sum {cpu.sum():.0f} s (sum/{workers} = "
+          f"{cpu.sum() / workers:.0f} s); load average 1 min before {load:.1f}, after {os.getloadavg()[0]:.1f}")
     if dask:
+        import dask
         from distributed import LocalCluster
 
+        # Dask starts its workers with MALLOC_TRIM_THRESHOLD_=65536, which turns off glibc's adaptive mmap
+        # threshold: every MB-sized NumPy temporary is then mapped and zeroed afresh, +50 % CPU per tool here
+        # (docs/design/recommend.md). Workers get only the single-thread BLAS settings; the statistical
+        # profiler (a thread sampling every 10 ms) is off as well.
+        environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ").items()
+                   if k != "MALLOC_TRIM_THRESHOLD_"}
+        dask.config.set({"distributed.worker.profile.enabled": False, "distributed.nanny.pre-spawn-environ": environ})
+        sub = library(tmp / "lib_dask.csv", dask_tools)  # the first dask_tools tools of the same library
+        base = None
         for w in (1, 2):
-            with LocalCluster(n_workers=w, threads_per_worker=1, processes=True) as cluster:
+            with LocalCluster(n_workers=w, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+                load = os.getloadavg()[0]
                 t = time.perf_counter()
-                r = run_library(lib, camp, results / "models", tmp / f"dask{w}", dask=cluster.scheduler_address,
+                r = run_library(sub, camp, results / "models", tmp / f"dask{w}", dask=cluster.scheduler_address,
                                 progress=False)
                 dt = time.perf_counter() - t
-                print(f"{n} tools, Dask LocalCluster {w} worker(s): {dt:.1f} s wall ({r['ok']} ok)")
+            base = base or dt
+            cpu = cpu_seconds(tmp / f"dask{w}")
+            print(f"{dask_tools} tools, Dask LocalCluster {w} worker(s) × 1 thread: {dt:.1f} s wall ({r['ok']} ok), "
+                  f"speed-up ×{base / dt:.2f}; CPU sum {cpu.sum():.0f} s; load average before {load:.1f}")
 
 
 if __name__ == "__main__":
@@ -101,8 +131,14 @@ if __name__ == "__main__":
     ap.add_argument("--tools", type=int, default=1000)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--dask", action="store_true")
+    ap.add_argument("--dask-tools", type=int, default=100)
     ap.add_argument("--no-coverage", action="store_true")
+    ap.add_argument("--no-speed", action="store_true")
     a = ap.parse_args()
+    print(f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores, "
+          f"OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS')}")
     if not a.no_coverage:
-        coverage(a.campaign, a.results)
-    speed(a.campaign, a.results, a.tools, a.workers, a.dask)
+        for m in ("anfis", "gp"):
+            coverage(a.campaign, a.results, m)
+    if not a.no_speed:
+        speed(a.campaign, a.results, a.tools, a.workers, a.dask, a.dask_tools)

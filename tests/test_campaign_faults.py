@@ -2,6 +2,7 @@
 and configuration errors that concern every tool."""
 
 import os
+import re
 import shutil
 import signal
 import socket
@@ -131,3 +132,61 @@ def test_progress_goes_to_a_log_when_stderr_is_not_a_terminal(small, tmp_path):
     assert proc.returncode == 0, proc.stderr
     lines = [s for s in proc.stderr.splitlines() if s.startswith("campaign: ")]
     assert lines and lines[-1].startswith("campaign: 6/6 tools (100 %)") and "\r" not in proc.stderr
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_a_dask_scheduler_lost_mid_run_is_one_error_and_no_traceback(capfd):
+    # a real scheduler (a process of its own) that dies while jobs are queued on it: the jobs' futures are
+    # cancelled, distributed logs reconnect tracebacks; execute must stop with one InputError naming --dask
+    pytest.importorskip("distributed")
+    port = _free_port()
+    sched = subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--port", str(port),
+                              "--no-dashboard", "--host", "127.0.0.1"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.time() + 30
+        while time.time() < deadline:  # wait until it listens
+            with socket.socket() as s:
+                if s.connect_ex(("127.0.0.1", port)) == 0:
+                    break
+            time.sleep(0.2)
+        client = run_mod.dask_client(f"tcp://127.0.0.1:{port}")
+        threading.Timer(1.0, sched.kill).start()  # no worker: the jobs wait until the scheduler dies
+        t0 = time.perf_counter()
+        with pytest.raises(InputError, match=r"--dask: the Dask scheduler .* was lost after 0 of 5 jobs"):
+            list(run_mod.execute(time.sleep, [0.1] * 5, client=client))
+        with run_mod.quiet_distributed():
+            client.close()
+        assert time.perf_counter() - t0 < 60
+    finally:
+        sched.kill()
+        sched.wait(10)
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "ERROR" not in err, err
+
+
+@pytest.mark.parametrize("column, value, msg", [
+    ("diameter_mm", "1e300", "'1e300' mm is not a tool size"),
+    ("overhang_mm", "-5", "'-5' mm is not a tool size"),
+    ("kt", "1e300", "'1e300' is beyond ±1e+100"),
+])
+def test_identified_csv_numbers_that_overflow_the_models_are_refused(tmp_path, column, value, msg):
+    from toolpoint.campaign.results import Appender, new_row, read_identified, resume
+
+    path = tmp_path / "identified.csv"
+    resume(path, set())
+    with Appender(path) as append:
+        for k in range(3):
+            cells = dict(diameter_mm="12.0", overhang_mm="40.0", kt="2e7", ct="15", kr="1e6", cr="3")
+            if k == 1:
+                cells[column] = value
+            d, L = cells.pop("diameter_mm"), cells.pop("overhang_mm")
+            append(new_row(f"T{k}", "ER40", d, L, status="ok", **cells))
+    rows = read_identified(path, required=["kt"]).ok()
+    with pytest.raises(InputError, match=rf"identified\.csv: {column}: line 3: {re.escape(msg)}"):
+        rows.column(column)

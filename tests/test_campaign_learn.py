@@ -133,6 +133,32 @@ def test_models_split_metrics_and_plots(campaign):
     assert all((folder / "plots" / n).read_bytes()[:4] == b"\x89PNG" for n in pngs)
 
 
+def test_gp_baseline_saved_and_rebuilt_exactly(campaign):
+    """learn saves each GP baseline; the rebuilt GP (kernel fixed, refitted on the saved data) predicts the
+    test rows as the GP fitted by learn did (its test metrics, recomputed), and its predictive σ grows
+    away from the training data."""
+    from toolpoint.campaign.predict import load_gp_models
+    from toolpoint.learning.metrics import paper_metrics
+
+    folder, result, _ = campaign
+    gps = load_gp_models(folder / "models")
+    assert set(gps) == set(result.targets) == {"kt", "ct", "kr"}
+    assert json.loads((folder / "models" / "manifest.json").read_text())["gp"] == {t: f"gp_{t}.json" for t in gps}
+    test = {i for i, s in read_split(folder)[1:] if s == "test"}
+    with open(folder / "identified.csv", newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["id"] in test]
+    X = np.array([[float(r["diameter_mm"]), float(r["overhang_mm"])] for r in rows])
+    for t in ("kt", "kr"):  # identified in every row: the metrics are over all test rows
+        y = np.array([float(r[t]) for r in rows])
+        mean, sd = gps[t].predict(X)
+        recomputed = paper_metrics(y, 10**mean)
+        for k, v in recomputed.items():
+            assert v == pytest.approx(result.metrics[t]["gpr"]["test"][k], rel=1e-6)
+        assert np.all(sd > 0)
+        inside = gps[t].predict([[20.0, 50.0]])[1][0]
+        assert gps[t].predict([[60.0, 200.0]])[1][0] > 3 * inside
+
+
 def test_paper_grid_3x7(tmp_path):
     """The defaults are the paper's: 3x7 Gaussian MFs, 21 rules, linear consequents, 200 epochs."""
     folder = write_identified(tmp_path, identified_rows())
@@ -285,7 +311,7 @@ def test_more_parameters_than_identified_rows_is_said(tmp_path):
 
 
 def test_learn_leaves_exactly_the_models_predict_will_use(tmp_path):
-    from toolpoint.campaign.predict import load_models
+    from toolpoint.campaign.predict import load_gp_models, load_models
 
     folder = write_identified(tmp_path, identified_rows(n=60, n_failed=0))
     quick = dict(test_size=12, mfs=(2, 2), epochs=3, baselines=False, plots=False)
@@ -293,6 +319,12 @@ def test_learn_leaves_exactly_the_models_predict_will_use(tmp_path):
     assert set(load_models(folder / "models")) == {"kt", "kr"}
     learn(folder, targets=["kt"], **quick)  # fewer targets: the older kr model must not be used stale
     assert set(load_models(folder / "models")) == {"kt"} and not (folder / "models" / "kr.json").exists()
+    learn(folder, targets=["kt", "kr"], **dict(quick, baselines=True))
+    assert set(load_gp_models(folder / "models")) == {"kt", "kr"}
+    learn(folder, targets=["kt"], **quick)  # no baselines: no GP left to be used stale
+    assert not list((folder / "models").glob("gp_*.json"))
+    with pytest.raises(InputError, match="no GP baseline for kt saved"):
+        load_gp_models(folder / "models")
     before = sorted(p.name for p in (folder / "models").iterdir())
     with pytest.raises(InputError, match="must include kt"):  # predict could not run on what it would write
         learn(folder, targets=["kr"], **quick)

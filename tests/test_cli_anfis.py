@@ -1,11 +1,13 @@
 """`toolpoint anfis train|predict` end to end (CSV in, model/plots/CSV out)."""
 
 import csv
+import re
 
 import numpy as np
 import pytest
 
 import toolpoint.cli.main as cli_main
+from toolpoint.errors import InputError
 from toolpoint.learning.anfis import ANFIS
 
 
@@ -96,7 +98,8 @@ def test_missing_column_exit_2_nothing_written(tmp_path, data, capsys):
     assert not model.exists() and not plots.exists()
 
 
-@pytest.mark.parametrize("bad,what", [("nan", "not a finite number"), ("", "not a number"), ("abc", "not a number")])
+@pytest.mark.parametrize("bad,what", [("nan", "not a finite number"), ("", "not a number"), ("abc", "not a number"),
+                                      ("1e300", "beyond ±1e+100")])
 def test_bad_cell_exit_2(tmp_path, capsys, bad, what):
     rows = stiffness_rows(20, 0)
     rows[4][2] = bad
@@ -136,3 +139,77 @@ def test_predict_errors_exit_2(tmp_path, data, capsys):
     code, _, err = run(["anfis", "predict", tmp_path / "none.json", data, "--out", pred], capsys)
     assert code == 2 and "not found" in err
     assert not pred.exists()
+
+
+# ---------------------------------------------------------------- issue 13: bad models, failed plots, wild values
+@pytest.fixture
+def model_doc(tmp_path, data, capsys):
+    import json
+
+    model = tmp_path / "good.json"
+    assert run(TRAIN[:2] + [data] + TRAIN[3:] + ["--epochs", 2, "--out", model], capsys)[0] == 0
+    return json.loads(model.read_text())
+
+
+@pytest.mark.parametrize("key, value, field", [
+    ("history", [1], "history"),
+    ("history", {"train_rmse": "abc"}, "history.train_rmse"),
+    ("best_epoch", -3, "best_epoch"),
+    ("premise", [[1, 2]], "premise"),
+    ("consequents", [[1e400]], "consequents"),
+    ("n_mfs", [3, 10**400], "n_mfs"),
+    ("params", [1], "params"),
+    ("target_name", {"a": 1}, "target_name"),
+])
+def test_a_malformed_model_is_one_line_naming_the_field(tmp_path, data, model_doc, capsys, key, value, field):
+    import json
+
+    model_doc[key] = value
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(model_doc).replace("Infinity", "1e400"))
+    with pytest.raises(InputError, match=rf"bad\.json: {re.escape(field)}: "):
+        ANFIS.load(bad)
+    pred = tmp_path / "p.csv"
+    code, _, err = run(["anfis", "predict", bad, data, "--out", pred], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and f"bad.json: {field}: " in err
+    assert not pred.exists()
+
+
+def test_failed_plots_leave_no_model_and_no_plots(tmp_path, data, capsys, monkeypatch):
+    # running as root, a read-only folder is still writable: the failure is made in the plot writer itself
+    import toolpoint.cli.anfis as cli_anfis
+
+    calls = []
+
+    def failing_save(fig, path, dpi=120):
+        calls.append(path)
+        if len(calls) == 3:
+            raise OSError(30, "Read-only file system")
+        real_save(fig, path, dpi)
+
+    real_save = cli_anfis.save_png
+    monkeypatch.setattr(cli_anfis, "save_png", failing_save)
+    model, plots = tmp_path / "m.json", tmp_path / "plots"
+    argv = TRAIN[:2] + [data] + TRAIN[3:] + ["--epochs", 2, "--test-fraction", 0.25, "--out", model, "--plots", plots]
+    code, _, err = run(argv, capsys)
+    assert code == 2 and "--plots" in err and "Read-only" in err and len(err.strip().splitlines()) == 1
+    assert len(calls) == 3 and not model.exists() and not plots.exists()
+
+
+def test_predict_far_outside_the_training_range_is_refused(tmp_path, data, capsys):
+    model, pred = tmp_path / "m.json", tmp_path / "p.csv"
+    assert run(TRAIN[:2] + [data] + TRAIN[3:] + ["--epochs", 2, "--out", model], capsys)[0] == 0
+    far = write_csv(tmp_path / "far.csv", ["diameter_mm", "overhang_mm"], [[10.0, 50.0], [1e300, 1e300]])
+    code, _, err = run(["anfis", "predict", model, far, "--out", pred], capsys)
+    assert code == 2 and "far.csv: diameter_mm: line 3: '1e+300' is beyond ±1e+100" in err
+    assert "Warning" not in err and not pred.exists()
+    edge = write_csv(tmp_path / "edge.csv", ["diameter_mm", "overhang_mm"], [[10.0, 50.0], [1e100, -1e100]])
+    code, out, err = run(["anfis", "predict", model, edge, "--out", pred], capsys)  # extrapolates, finitely
+    assert code == 0 and "outside the training input range" in out and "Warning" not in err
+    assert np.all(np.isfinite(np.loadtxt(pred, delimiter=",", skiprows=1)))
+
+
+def test_a_step_size_beyond_the_inputs_span_is_refused(tmp_path, data, capsys):
+    model = tmp_path / "m.json"
+    code, _, err = run(TRAIN[:2] + [data] + TRAIN[3:] + ["--step-size", "1e300", "--out", model], capsys)
+    assert code == 2 and "--step-size" in err and "span" in err and not model.exists()

@@ -105,3 +105,75 @@ def test_reproduce_quick(tmp_path):
     assert doc["success"] is True and doc["status"] == 0
     pso = json.loads((tmp_path / "result_pso.json").read_text())  # the paper's PSO runs its 280 iterations
     assert pso["success"] is False and pso["status"] == 1 and pso["iterations"] == 280
+
+
+# --------------------------------------------------------------------------- trusted band (issue 11 item 3)
+@pytest.fixture(scope="module")
+def noisy_csv(tmp_path_factory, example):
+    """The exact tool-point receptance plus complex white accelerance noise (σ 0.1 m/(N s²) per part) × 1/(−ω²):
+    below ≈ 120 Hz the noise exceeds the 2.6e-7 m/N static compliance."""
+    f = np.arange(1.0, 3001.0)
+    h = model_for(example, f).tool_point(example.holder_tool.as_array())
+    rng = np.random.default_rng(0)
+    noise = 0.1 * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)) / -((2 * np.pi * f) ** 2)
+    p = tmp_path_factory.mktemp("noisy") / "noisy.csv"
+    write_csv_frf(p, FRF(f, h + noise))
+    return p
+
+
+def test_identify_fits_the_trusted_band_only(tmp_path, example_path, noisy_csv, capsys):
+    """Found by itself: the low-frequency junk is left out (note on stderr, band in the JSON) and the joint
+    comes out at the paper's values; fitted over the whole band (given) the same data pin nothing down."""
+    out = tmp_path / "r.json"
+    assert main(["identify", str(example_path), str(noisy_csv), "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    lo = doc["band_hz"][0]
+    assert 120 < lo < 250 and doc["band_hz"][1] == 3000.0
+    err = capsys.readouterr().err
+    assert (f"note: {noisy_csv}: trusted band {lo:g}–3000 Hz (below {lo:g} Hz the receptance looks like "
+            "accelerance noise ×1/ω²)") in err
+    assert doc["kt"] == pytest.approx(2.1e7, rel=0.01) and doc["kr"] == pytest.approx(1.4e6, rel=0.05)
+    assert doc["ci95"]["kt"][1] / doc["ci95"]["kt"][0] < 1.1
+    # --band overrides: the whole band, junk included → kt no longer identifiable (CI spans > ×2)
+    assert main(["identify", str(example_path), str(noisy_csv), "--band", "1:3000", "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["band_hz"] == [1.0, 3000.0]
+    assert doc["ci95"]["kt"][1] / doc["ci95"]["kt"][0] > 2
+    assert f"note: {noisy_csv}: band 1–3000 Hz given by --band (no automatic trimming)" in capsys.readouterr().err
+
+
+def _with_identify(tmp_path, example_path, table):
+    text = example_path.read_text()
+    p = tmp_path / "a.toml"
+    p.write_text(text + "\n[identify]\n" + table + "\n")
+    return p
+
+
+def test_band_hz_config_key(tmp_path, example_path, noisy_csv, capsys):
+    a = _with_identify(tmp_path, example_path, "band_hz = [300.0, 2800.0]")
+    out = tmp_path / "r.json"
+    assert main(["identify", str(a), str(noisy_csv), "--out", str(out)]) == 0
+    assert json.loads(out.read_text())["band_hz"] == [300.0, 2800.0]
+    assert "band 300–2800 Hz given by identify.band_hz (no automatic trimming)" in capsys.readouterr().err
+    # the command line wins over the file
+    assert main(["identify", str(a), str(noisy_csv), "--band", "200:3000", "--out", str(out)]) == 0
+    assert json.loads(out.read_text())["band_hz"] == [200.0, 3000.0]
+
+
+@pytest.mark.parametrize("where, argv, match", [
+    ("cli", ["--band", "4000:5000"], "noisy.csv: --band: band 4000–5000 Hz holds 0 of the data's points"),
+    ("cli", ["--band", "100-200"], "command line: --band: expected LO:HI"),
+    ("cli", ["--band", "200:3000", "--fmin", "100"], "give --band or --fmin/--fmax, not both"),
+    ("file", "band_hz = [4000.0, 5000.0]", "noisy.csv: identify.band_hz: band 4000–5000 Hz holds 0"),
+    ("file", "band_hz = [300.0]", "a.toml: identify.band_hz: expected \\[LO, HI\\]"),
+    ("general", "band_hz = [4000.0, 5000.0]\njoint = \"holder_tool\"", "noisy.csv: identify.band_hz: band 4000"),
+])
+def test_band_outside_the_data_is_one_line_exit_2_no_output(tmp_path, example_path, noisy_csv, capsys, where,
+                                                            argv, match):
+    a = example_path if where == "cli" else _with_identify(tmp_path, example_path, argv)
+    extra = argv if where == "cli" else []
+    out = tmp_path / "r.json"
+    assert main(["identify", str(a), str(noisy_csv), *extra, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and __import__("re").search(match, err), err
+    assert not out.exists()

@@ -48,6 +48,7 @@ def test_joint_spindle_holder_writes_the_usual_keys(case, capsys):
     for k, v in TRUE.items():
         assert doc[k] == pytest.approx(v, rel=1e-6), k
     assert set(doc["ci95"]) == set(TRUE) and doc["joint"] == "spindle_holder"
+    assert doc["ci95_method"] == "profile"
 
 
 def test_general_params_with_at(case, tmp_path):

@@ -105,6 +105,7 @@ def test_assembly_toml_input(tmp_path, example_path, capsys):
         ["--immersion", "1.5"],
         ["--rpm", "20000:2000"],
         ["--rpm", "2000"],
+        ["--rpm", "5000:1e300"],  # beyond MAX_RPM: a typo, not a spindle speed
         ["--rpm-points", "1"],
         ["--method", "fem"],
     ],
@@ -310,3 +311,126 @@ def test_sdm_with_cross_frfs_matches_the_exact_model(tmp_path, capsys):
     assert main(["lobes", str(files["x"]), "--frf-y", str(files["y"]), *args, "--out", str(plain)]) == 0
     _, no_cross = read(plain)
     assert np.max(np.abs(no_cross[:, 1] / data[:, 1] - 1)) > 0.05
+
+
+# --------------------------------------------------------------------------- trusted band (issue 11 item 3)
+NOISY_CUT = ["--teeth", "3", "--tangential-coeff", "6e8", "--radial-ratio", "0.3", "--immersion", "0.5",
+             "--rpm", "2000:20000", "--rpm-points", "400"]
+
+
+@pytest.fixture
+def noisy_files(tmp_path):
+    """A tool-point receptance from an accelerance with white noise (tests/test_trust.py), and its clean twin."""
+    from test_trust import noisy_toolpoint
+
+    f, clean, noisy = noisy_toolpoint(0)
+    return write_csv(tmp_path / "noisy.csv", f, noisy), write_csv(tmp_path / "clean.csv", f, clean)
+
+
+def test_lobes_on_noisy_frf_use_the_trusted_band_only(tmp_path, noisy_files, capsys):
+    """Over the whole band (the old behaviour, now only with --band given) the limit rests on chatter in the
+    low-frequency junk; by default the band starts where the noise falls below the signal, every limiting
+    chatter frequency lies inside it and the limit is the noise-free FRF's."""
+    noisy, clean = noisy_files
+    out = tmp_path / "l.csv"
+    assert main(["lobes", str(noisy), *NOISY_CUT, "--band", "0:5000", "--out", str(out)]) == 0
+    _, whole = read(out)
+    assert np.mean(whole[:, 2] < 100) > 0.5  # most speeds limited by "chatter" below 100 Hz: noise
+    assert whole[:, 1].min() < 0.6  # mm (the noise-free FRF: 2.88 mm)
+    capsys.readouterr()
+
+    assert main(["lobes", str(noisy), *NOISY_CUT, "--out", str(out)]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"note: {noisy}: trusted band ")
+    lo = float(err[0].split("trusted band ")[1].split("–")[0])
+    assert 126 < lo < 230  # the noise crosses the clean receptance at 126 Hz (tests/test_trust.py)
+    assert "override with --band LO:HI" in err[0]
+    _, trusted = read(out)
+    assert np.all(trusted[:, 2] >= lo) and np.all(trusted[:, 2] > 600)  # near the modes, none in the junk
+
+    assert main(["lobes", str(clean), *NOISY_CUT, "--out", str(out)]) == 0
+    assert capsys.readouterr().err == ""  # the clean FRF keeps its band: no note
+    _, ref = read(out)
+    np.testing.assert_allclose(trusted[:, 1], ref[:, 1], rtol=0.01)  # the noise-free limit, within 1 %
+
+
+def _fitted_fn_hz(text):
+    """Natural frequencies of the modal-fit table printed by ``lobes --method sdm``."""
+    rows = [ln.split() for ln in text.splitlines()]
+    return [float(r[1]) for r in rows if len(r) == 3 and r[0].isdigit()]
+
+
+def test_sdm_on_noisy_frf_weighs_the_fit_as_accelerance_noise(tmp_path, noisy_files, capsys):
+    """The receptance's noise grows as 1/ω² (tests/test_trust.py): the trusted band says so and the SDM path's
+    modal fit is weighted in accelerance. Weighted in receptance it put three ultra-light modes (177–219 Hz,
+    ζ 0.07–0.17 %) on the noise just above the band edge; now it finds only the three modes (650, 1056,
+    2400 Hz) and the noise-free FRF's limit."""
+    noisy, clean = noisy_files
+    cut = [*NOISY_CUT[:-1], "60", "--method", "sdm"]
+    out = tmp_path / "l.csv"
+    assert main(["lobes", str(noisy), *cut, "--out", str(out)]) == 0
+    fn = _fitted_fn_hz(capsys.readouterr().out)
+    assert len(fn) == 3 and min(fn) > 300
+    assert fn == pytest.approx([650.0, 1056.0, 2400.0], rel=1e-3)
+    _, data = read(out)
+    assert main(["lobes", str(clean), *cut, "--out", str(out)]) == 0
+    _, ref = read(out)
+    assert np.nanmin(data[:, 1]) == pytest.approx(np.nanmin(ref[:, 1]), rel=0.05)
+
+
+def test_limit_at_the_band_edge_is_not_trusted(tmp_path, noisy_files, capsys):
+    """--band cuts into the 1056 Hz mode: the speeds limited at the band edge are named on stderr."""
+    _, clean = noisy_files
+    out = tmp_path / "l.csv"
+    assert main(["lobes", str(clean), *NOISY_CUT, "--band", "1065:5000", "--out", str(out)]) == 0
+    cap = capsys.readouterr()
+    warn = [w for w in cap.err.splitlines() if w.startswith("warning:")]
+    assert len(warn) == 1 and "the limiting chatter frequency lies at the edge of the band 1065–5000 Hz" in warn[0]
+    assert "not trusted" in warn[0] and "--band LO:HI" in warn[0]
+    assert "— not trusted: chatter at the band edge" in cap.out and "lowest trusted limit:" in cap.out
+    _, data = read(out)
+    n = int(warn[0].split("at ")[1].split(" of")[0])
+    assert n == int(np.sum(data[:, 2] <= 1067.0))
+
+
+@pytest.mark.parametrize("band", ["6000:7000", "4999.5:4999.9"])
+def test_lobes_band_outside_the_data(tmp_path, noisy_files, capsys, band):
+    noisy, _ = noisy_files
+    out = tmp_path / "l.csv"
+    err = _refused(["lobes", str(noisy), *NOISY_CUT, "--band", band, "--out", str(out)], capsys, out)
+    assert err.startswith(f"toolpoint lobes: error: {noisy}: --band: band ") and "the data cover 0–5000 Hz" in err
+
+
+def test_lobes_low_coherence_is_left_out(tmp_path, capsys):
+    """A coherence column below 0.8 above 2000 Hz: the band ends there and the note says why."""
+    f = np.linspace(0.0, 3000.0, 3001)
+    g = np.where(f > 2000, 0.3, 0.99)
+    x = tmp_path / "coh.csv"
+    with open(x, "w") as fh:
+        fh.write("freq_hz,real,imag,coherence\n")
+        v = MODE.frf(f).values
+        np.savetxt(fh, np.column_stack([f, v.real, v.imag, g]), delimiter=",", fmt="%.17g")
+    out = tmp_path / "l.csv"
+    assert main(["lobes", str(x), *BASE, "--rpm-points", "100", "--out", str(out)]) == 0
+    err = capsys.readouterr().err.strip()
+    assert err == (f"note: {x}: trusted band 0–2000 Hz (coherence γ² < 0.8 above 2000 Hz); override with "
+                   "--band LO:HI")
+    _, data = read(out)
+    assert np.nanmax(data[:, 2]) <= 2000
+
+
+def test_trusted_bands_of_x_and_y_on_other_grids_intersect(tmp_path, capsys):
+    """x on a 1 Hz grid, y on a 2 Hz grid, each with its own junk: one band for both, one note each."""
+    from test_trust import noisy_toolpoint
+
+    f, _, nx = noisy_toolpoint(0)
+    _, _, ny = noisy_toolpoint(1)
+    x = write_csv(tmp_path / "x.csv", f, nx)
+    y = write_csv(tmp_path / "y.csv", f[::2], ny[::2])
+    out = tmp_path / "l.csv"
+    assert main(["lobes", str(x), "--frf-y", str(y), *NOISY_CUT, "--out", str(out)]) == 0
+    notes = capsys.readouterr().err.strip().splitlines()
+    assert [n.split(":")[1].strip() for n in notes] == [str(x), str(y)]
+    edges = [float(n.split("trusted band ")[1].split("–")[0]) for n in notes]
+    _, data = read(out)
+    assert np.all(data[:, 2] >= max(edges)) and data[:, 1].min() == pytest.approx(2.88, abs=0.02)

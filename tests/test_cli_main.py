@@ -94,6 +94,9 @@ def test_outputs_get_the_users_umask(tmp_path):
     (["lobes", "examples/numerical_case.toml", "--teeth", "2", "--immersion", "1", "--rpm", "5000:6000",
       "--tangential-coeff", "-6e8", "--radial-ratio", "0.3", "--out", "{tmp}/l.csv"],
      "--tangential-coeff"),  # a negative number in e-notation is a value to judge, not an unknown option
+    (["lobes", "examples/numerical_case.toml", "--teeth", "2", "--immersion", "1", "--rpm", "5000:6000",
+      "--tangential-coeff", "1e300", "--radial-ratio", "0.3", "--out", "{tmp}/l.csv"],
+     "--tangential-coeff"),  # finite, but overflows the lobe arithmetic
 ])
 def test_bad_numbers_are_one_line_exit_2_and_write_nothing(argv, field, tmp_path, capsys, monkeypatch):
     from pathlib import Path

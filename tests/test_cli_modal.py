@@ -138,3 +138,36 @@ def test_bad_input_is_one_line_exit_2_no_output(case, tmp_path, capsys):
     assert err.count("\n") == 1 and err.startswith("toolpoint modal: error: ")
     assert __import__("re").search(match, err), err
     assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written, not even a temporary file
+
+
+# --------------------------------------------------------------------------- trusted band (issue 11 item 3)
+def test_trusted_band_of_real_measured_accelerances(tmp_path, capsys):
+    """The pyuff sample accelerances (tests/data/pyuff): converted to receptance, their lowest lines are noise
+    ×1/ω²; the fit leaves them out with one note per file and uses the intersection of the trusted bands."""
+    Y = np.stack([np.genfromtxt(DATA / f"meas_point_{k}.txt", dtype=complex) for k in (1, 2, 3)], -1)
+    f = np.arange(Y.shape[0], dtype=float)
+    paths = [write_csv(tmp_path / f"p{k}.csv", f[1:], Y[1:, k]) for k in range(3)]
+    out = tmp_path / "modes.csv"
+    assert main(["modal", *paths, "--quantity", "accelerance", "--out", str(out)]) == 0
+    cap = capsys.readouterr()
+    notes = [n for n in cap.err.splitlines() if n.startswith("note:")]
+    assert len(notes) == 3
+    edges = [float(n.split("trusted band ")[1].split("–")[0]) for n in notes]
+    assert all(2 <= e <= 10 for e in edges)  # a few hertz of junk; the first mode (52 Hz) is kept
+    assert all("the accelerance's noise ×1/ω² exceeds the signal" in n for n in notes)
+    assert f"{max(edges):g}–1000 Hz" in cap.out
+
+
+def test_given_band_is_noted_and_outside_names_the_file(tmp_path, capsys):
+    Y = FOUR.frf(F, "receptance")
+    paths = [write_csv(tmp_path / f"y{k}.csv", F, Y[:, k]) for k in range(2)]
+    out = tmp_path / "modes.csv"
+    assert main(["modal", *paths, "--band", "100:3000", "--out", str(out)]) == 0
+    assert capsys.readouterr().err == "note: band 100–3000 Hz given by --band (no automatic trimming)\n"
+    assert main(["modal", *paths, "--out", str(out)]) == 0
+    assert capsys.readouterr().err == ""  # exact FRFs: nothing to exclude, nothing said
+    out.unlink()
+    assert main(["modal", *paths, "--band", "4000:5000", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"toolpoint modal: error: {paths[0]}: --band: band 4000–5000 Hz holds 0 of the data's points "
+                   "(the data cover 1–3000 Hz)\n") and not out.exists()

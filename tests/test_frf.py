@@ -181,3 +181,13 @@ def test_check_freq_hz_options():
         check_freq_hz([0.0, 1.0], positive=True, where=lambda i: f"row {i + 1}")
     with pytest.raises(InputError, match="numbers"):
         check_freq_hz(["x"])
+
+
+def test_at_interpolates_per_frequency_meta_like_the_values():
+    f = np.array([10.0, 20.0, 30.0])
+    h = FRF(f, np.array([1.0, 2.0, 4.0]) + 0j, meta={"coherence": np.array([0.9, 0.7, 0.5]), "source": "x"})
+    g = h.at([15.0, 25.0])
+    np.testing.assert_allclose(g.meta["coherence"], [0.8, 0.6])  # linear, like the values (1.5, 3.0)
+    np.testing.assert_allclose(g.values, [1.5, 3.0])
+    assert g.meta["source"] == "x"
+    assert h.at(np.empty(0)).meta["coherence"].shape == (0,)

@@ -50,7 +50,8 @@ def n_datasets(path):
 def test_csv_round_trip_is_exact(tmp_path):
     f = np.array([0.0, 0.1, 1 / 3, 1e-300, 5e-324 + 1, 12345.678901234567])
     f.sort()
-    v = np.array([1e-9 + 2e-9j, -0.0 + 1j / 3, 5e-324 - 1e300j, np.pi, -np.e * 1j, 1 / 7 - 1j / 11])
+    # extreme parts within the accepted magnitudes (0 or 1e-100 ≤ |H| ≤ 1e100; refused beyond: see below)
+    v = np.array([1e-9 + 2e-9j, -0.0 + 1j / 3, 5e-324 - 1e100j, np.pi, -np.e * 1j, 1 / 7 - 1j / 11])
     p = tmp_path / "a.csv"
     write_csv_frf(p, FRF(f, v))
     assert p.read_text().splitlines()[0] == "freq_hz,real,imag"
@@ -63,7 +64,8 @@ def test_csv_round_trip_is_exact(tmp_path):
 @settings(max_examples=60, deadline=None)
 @given(
     freqs=st.lists(st.floats(0, 1e6, allow_nan=False), min_size=1, max_size=40, unique=True),
-    parts=st.lists(st.floats(allow_nan=False, allow_infinity=False), min_size=80, max_size=80),
+    # every magnitude the readers accept: 0, or 1e-100 ≤ |part| ≤ 1e99 (so 1e-100 ≤ |H| ≤ 1e100)
+    parts=st.lists(st.just(0.0) | st.floats(1e-100, 1e99) | st.floats(-1e99, -1e-100), min_size=80, max_size=80),
 )
 def test_csv_round_trip_property(freqs, parts):
     f = np.array(sorted(freqs))
@@ -306,6 +308,7 @@ CSV_ERRORS = [
     ("freq_hz,real,imag\n1,2,3\n5,2,3\n4,2,3\n", "freq_hz", "(5 Hz is followed by 4 Hz) at line 4"),
     ("freq_hz,real,imag\n-1,2,3\n5,2,3\n", "freq_hz", "must be ≥ 0 Hz, got -1 at line 2"),
     ("freq_hz,real,imag\n1,2,3\nnan,2,3\n", "freq_hz", "must be finite, got nan at line 3"),
+    ("freq_hz,real,imag\n1,2,3\n2,1_000,3\n", "real", "line 3: '1_000' is not a number"),  # Python-only syntax
 ]
 
 
@@ -347,3 +350,66 @@ def test_uff_keeps_dof_on_rewrite(tmp_path):
     write_uff58(q := tmp_path / "again.uff", read_frf(p))
     got = read_uff58(q)
     assert (got.meta["rsp_node"], got.meta["rsp_dir"], got.meta["ref_node"], got.meta["ref_dir"]) == (7, -2, 3, 3)
+
+
+# ---------------------------------------------------------------- implausible values and cut files (issue 13)
+@pytest.mark.parametrize("ext, sep", [(".csv", ","), (".txt", "\t"), (".frf", "\t")])
+@pytest.mark.parametrize("row, field, msg", [
+    ("300,1e300,0", "real", "|H| = 1e+300 at line {n} is not a plausible FRF value"),
+    ("300,1e-8,-1e101", "imag", "|H| = 1e+101 at line {n}"),
+    ("300,1e-320,0", "real", "|H| = 1e-320 at line {n}"),  # subnormal: 1/H overflows
+    ("2e9,1e-8,-1e-8", "freq", "frequency 2e+09 Hz at line {n} is above 1e+09 Hz"),
+])
+def test_values_that_overflow_downstream_are_refused(tmp_path, ext, sep, row, field, msg):
+    head = "freq_hz,real,imag\n" if ext == ".csv" else ""
+    body = "".join(f"{f}{sep}{1e-8 * f:.6e}{sep}{-1e-9:.6e}\n" for f in (100, 200))
+    p = tmp_path / f"big{ext}"
+    p.write_text(head + body + row.replace(",", sep) + "\n")
+    n = 4 if ext == ".csv" else 3
+    with pytest.raises(InputError) as info:
+        read_frf(p)
+    s = str(info.value)
+    assert "\n" not in s and str(p) in s and msg.format(n=n) in s
+    assert field in s.split(": ")[1].lower()
+
+
+def test_a_zero_value_is_accepted(tmp_path):
+    p = tmp_path / "z.csv"
+    p.write_text("freq_hz,real,imag\n0,0,0\n10,1e-8,-1e-9\n")
+    assert read_frf(p).values[0] == 0
+
+
+@pytest.mark.parametrize("last", ["300,3.1e-08,-1.2e-0", "300,3.1e-08,-1.2", "300,3.1e-08,-1", "300,3.1e-08,-1."])
+def test_a_file_cut_mid_number_is_refused_naming_the_line(tmp_path, last):
+    # the last number of a file that ends without a line break lost digits: -1.2e-09 read as -1.2 m/N
+    body = "freq_hz,real,imag\n100,1.0e-08,-1.5e-09\n200,2.0e-08,-2.5e-09\n"
+    p = tmp_path / "cut.csv"
+    p.write_text(body + last)
+    with pytest.raises(InputError, match=r"cut\.csv: imag: line 4: .* looks cut short .* end it with a line break"):
+        read_frf(p)
+    p.write_text(body + last + "\n")  # with a line break it is taken as written (and then judged as a value)
+    assert len(read_frf(p)) == 3
+
+
+def test_a_complete_file_without_final_line_break_is_accepted(tmp_path):
+    for name, text in (("a.csv", "freq_hz,real,imag\n100,1.5e-08,-1.5e-09\n200,2.5e-08,-2.5e-09\n300,3e-08,-3e-09"),
+                       ("b.frf", "100\t1.5e-08\t-1.5e-09\n200\t2.5e-08\t-2.5e-09\n300\t3.5e-08\t-3.5e-09")):
+        (tmp_path / name).write_text(text)
+        assert len(read_frf(tmp_path / name)) == 3
+
+
+def test_a_cut_impact_record_is_refused(tmp_path):
+    from toolpoint.io.impact import read_record
+
+    p = tmp_path / "rec.csv"
+    rows = "".join(f"{k * 1e-3:.6e},{k * 0.5:.6e},{-k * 0.25:.6e}\n" for k in range(5))
+    p.write_text("t,f,a\n" + rows + "5.000000e-03,2.500000e+00,-1.2")
+    with pytest.raises(InputError, match=r"rec\.csv: response: line 7: '-1\.2' looks cut short"):
+        read_record(p)
+
+
+def test_header_cell_that_is_empty_is_a_header_error_not_a_crash(tmp_path):
+    p = tmp_path / "h.txt"
+    p.write_text(",\tReal\tImag\n50\t1e-8\t-1e-9\n")
+    with pytest.raises(InputError, match="h.txt"):
+        read_frf(p)

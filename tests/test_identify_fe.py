@@ -89,3 +89,22 @@ def test_noisy_fe_data_truth_inside_the_reported_intervals(fe_case):
         if k not in flagged:
             lo, hi = r.ci95[k]
             assert lo <= exact[i] <= hi, (k, lo, exact[i], hi)
+
+
+def test_noisy_fe_data_truth_inside_every_profile_interval(fe_case):
+    """The same noisy data with profile-likelihood intervals: the truth is inside all four, cr's included
+    (cr is still flagged: its interval runs from the lower search bound up to ~6× the truth). Seeds 0–9:
+    40 of 40 profile intervals hold the truth, linearised 37 of 40 (cr misses 3; design notes)."""
+    model, exact, h_fe, *_ = fe_case
+    rng = np.random.default_rng(0)
+    sigma = 0.01 * np.abs(h_fe).max() / np.sqrt(2)
+    noisy = h_fe + sigma * (rng.standard_normal(F.size) + 1j * rng.standard_normal(F.size))
+    with pytest.warns(IdentifiabilityWarning) as rec:
+        r = identify(model, FRF(F, noisy), "hybrid", seed=0, intervals="profile")
+    assert [str(w.message) for w in rec] == list(r.warnings)
+    assert r.intervals == "profile"
+    assert any(w.startswith("cr is not identifiable") for w in r.warnings)
+    assert any(w.startswith("cr has a 95 % interval that runs into the lower search bound") for w in r.warnings)
+    for i, k in enumerate(PARAMS):
+        lo, hi = r.ci95[k]
+        assert lo <= exact[i] <= hi, (k, lo, exact[i], hi)

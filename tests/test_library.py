@@ -59,7 +59,7 @@ def small_campaign() -> Path:
             ci = [x for k in range(4) for x in (v[k] * np.exp(-1.96 * se[k]), v[k] * np.exp(1.96 * se[k]))]
             cells = [repr(float(x)) for x in (*v, *ci)]
             w.writerow([f"T{i:03d}", "ER40", D[i], L[i], *cells, "ok"])
-    learn(res, test_size=10, mfs=(2, 2), epochs=30, baselines=False, plots=False)
+    learn(res, test_size=10, mfs=(2, 2), epochs=30, baselines=True, plots=False)  # baselines: the saved GP
     return root
 
 
@@ -121,6 +121,22 @@ def test_batch_limits_cap_only_clips():
     full = zoa_limits(f, h, cut, grid)
     cap = 2 * full.min()
     assert np.allclose(zoa_limits(f, h, cut, grid, cap_m=cap), np.minimum(full, cap), rtol=1e-12)
+
+
+def test_batch_limits_uneven_speed_grid():
+    """An uneven speed grid (searched, not indexed arithmetically) against zoa_lobes on the same grid, and the
+    evenly spaced grid's limits at the speeds both grids share."""
+    c = load_campaign(small_campaign() / "camp")
+    f = np.arange(20.0, 4000.0, 2.0)
+    h = ToolPointModel(c.family.tool(12, 60), c.subassembly("ER40", f), f).tool_point(truth_joint(12, 60))
+    cut = CuttingConditions(teeth=2, tangential_coeff=6e8, radial_ratio=1 / 3, radial_immersion=1.0)
+    even = np.linspace(3000, 21000, 301)
+    uneven = np.unique(np.r_[even[::3], np.geomspace(3100, 20900, 97)])
+    lim = zoa_limits(f, h, cut, uneven)
+    ref = zoa_lobes(FRF(f, h), None, cut, rpm=uneven).depth_m
+    assert np.max(np.abs(lim / ref - 1)) < 0.01
+    shared = np.isin(uneven, even[::3])
+    assert np.allclose(lim[shared], zoa_limits(f, h, cut, even)[::3], rtol=1e-12)
 
 
 # ------------------------------------------------------------------ library file
@@ -207,6 +223,9 @@ def test_coverage_of_the_true_limit_on_held_out_tools():
 
     Held-out tools of the models' split; the campaign's identifications are simulated (small_campaign), so
     this checks the propagation, not the identification (benchmarks/bench_library.py does the real thing).
+    ANFIS σ (training residuals and identification intervals). The GP baseline's own σ gives 0.725 here
+    (6 tools; it is over-confident on 40 training rows: RMS z of the truth 1.3–1.4) and 0.872 in the
+    benchmark: docs/design/recommend.md.
     """
     from toolpoint.recommend.uncertainty import JointPredictor
 
@@ -236,6 +255,42 @@ def test_coverage_of_the_true_limit_on_held_out_tools():
     assert coverage >= 0.85
 
 
+def test_gp_model_samples_the_gp_predictive_distribution(tmp_path):
+    """--model gp: the joint's median and σ per tool are the saved GP's predictive mean and std of log10 p
+    (not the ANFIS ones); a models folder without saved GPs is refused with a clear error."""
+    import json
+
+    from toolpoint.campaign.predict import load_gp_models
+    from toolpoint.recommend.uncertainty import JointPredictor
+
+    root = small_campaign()
+    models = root / "results" / "models"
+    lib = _library(tmp_path / "lib.csv", GOOD[:1])
+    run_library(lib, root / "camp", models, tmp_path / "g", workers=1, n_samples=20, rpm_points=60, progress=False,
+                model="gp")
+    assert _rows(tmp_path / "g")["A16"]["status"] == "ok"
+    doc = json.loads((tmp_path / "g" / "tools" / "A16.json").read_text())
+    gps = load_gp_models(models)
+    anfis = JointPredictor(models).predict(16, 50)
+    assert doc["model"] == "gp" and set(gps) == {"kt", "ct", "kr"}
+    for k, p in enumerate(PARAMS):
+        if p in gps:
+            mean, sd = gps[p].predict([[16, 50]])
+            assert doc["joint"][p]["sigma_log10"] == pytest.approx(sd[0], rel=1e-9)
+            assert doc["joint"][p]["p50"] == pytest.approx(10 ** mean[0], rel=1e-9)
+            assert abs(doc["joint"][p]["sigma_log10"] / anfis.sigma_log10[0, k] - 1) > 0.1
+    bare = tmp_path / "bare" / "models"
+    shutil.copytree(models, bare)
+    shutil.copy(root / "results" / "identified.csv", bare.parent)
+    manifest = json.loads((bare / "manifest.json").read_text())
+    del manifest["gp"]
+    (bare / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(InputError, match="no GP baseline for kt saved"):
+        JointPredictor(bare, "gp")
+    with pytest.raises(InputError, match="must be one of anfis, gp"):
+        JointPredictor(models, "gpr")
+
+
 # ------------------------------------------------------------------ CLI
 def test_cli_bad_library_is_one_line_exit_2(tmp_path, capsys):
     root = small_campaign()
@@ -259,3 +314,24 @@ def test_cli_bad_rows_on_stderr_others_go_on(tmp_path, capsys):
     errs = [ln for ln in cap.err.splitlines() if ln.startswith("error: ")]
     assert [ln.split(":")[1].strip() for ln in errs] == ["C1", "D1"]
     assert math.isfinite(float(_rows(tmp_path / "o")["A16"]["depth_mm"]))
+
+
+def test_resume_keeps_only_tools_computed_with_the_same_joint_model(tmp_path):
+    import json
+
+    from toolpoint.recommend.run import COLUMNS, _resume
+
+    tools = tmp_path / "tools"
+    tools.mkdir()
+    table = tmp_path / "recommendations.csv"
+    with open(table, "w", newline="") as fh:
+        w = csv.DictWriter(fh, COLUMNS)
+        w.writeheader()
+        for tid, model in (("A", "anfis"), ("B", "gp"), ("C", None)):
+            w.writerow({c: "" for c in COLUMNS} | {"id": tid, "status": "ok"})
+            (tools / f"{tid}.npz").write_bytes(b"")
+            (tools / f"{tid}.json").write_text(json.dumps({} if model is None else {"model": model}))
+    assert _resume(table, tools, {"A", "B", "C"}, "gp") == {"B"}  # A and C (older runs: ANFIS) start again
+    assert _resume(table, tools, {"A", "B", "C"}, "gp") == {"B"}  # and the rewritten table says so
+    with open(table, newline="") as fh:
+        assert [r["id"] for r in csv.DictReader(fh)] == ["B"]

@@ -156,3 +156,56 @@ def test_old_keywords_still_work_with_a_deprecation_warning():
     with pytest.warns(DeprecationWarning, match="sdm_spectral_radius"):
         rho = sdm_spectral_radius(MODE, None, teeth=2, kt=6e8, kr=1 / 3, radial_immersion=0.05, rpm=rpm, depth=0.0)
     assert rho == pytest.approx(sdm_spectral_radius(MODE, None, cut(0.05), rpm=rpm, depth=0.0), rel=0, abs=0)
+
+
+def _plain_sdm_limit(rpm, ri, m, lo=1e-4, hi=2e-2):
+    """Independent reference: the first-order SDM of Insperger & Stépán (2004) for the one mode of MODE in x,
+    written out directly (the cutting stiffness a·h_i inside the exponential of every step, scipy's expm),
+    limit by bisection on ρ(Φ) = 1."""
+    from toolpoint.stability.milling import interval_directional_matrix
+
+    wn, ze, mass = MODE.omega_n[0], MODE.zeta[0], MODE.mass_kg[0]
+    c = cut(ri)
+    st, ex = c.immersion_angles
+    tau = 60.0 / (2 * rpm)
+    angle = min(ex - st, np.pi)
+    t_cut = angle / (2 * np.pi * rpm / 60.0)
+    dt = t_cut / m
+    h = interval_directional_matrix(st + angle * np.arange(m + 1) / m, 2, 6e8, 1 / 3, st, ex)[:, 0, 0]
+    A0 = np.array([[0.0, 1.0], [-wn**2, -2 * ze * wn]])
+
+    def rho(a):
+        D = 2 + m + 1
+        Y = np.zeros((2, D))
+        Y[:, :2] = np.eye(2)
+        Phi = np.zeros((D, D))
+        Phi[2, :2] = [1.0, 0.0]
+        for i in range(m):
+            Ai = A0 - np.array([[0.0, 0.0], [a * h[i] / mass, 0.0]])
+            X = np.zeros((4, 4))
+            X[:2, :2], X[:2, 2] = Ai * dt, np.array([0.0, a * h[i] / mass]) * dt
+            X[2, 3] = 1.0
+            E = expm(X)
+            G1 = E[:2, 3]
+            G0 = E[:2, 2] - G1
+            Y = E[:2, :2] @ Y
+            Y[:, 2 + i] += G0
+            Y[:, 3 + i] += G1
+            Phi[3 + i, :] = Y[0]
+        Phi[:2] = expm(A0 * (tau - t_cut)) @ Y
+        return np.abs(np.linalg.eigvals(Phi)).max()
+
+    for _ in range(40):
+        mid = np.sqrt(lo * hi)
+        lo, hi = (mid, hi) if rho(mid) < 1 else (lo, mid)
+    return hi
+
+
+@pytest.mark.parametrize("ri,rpm", [(1.0, 15909.0), (0.05, 10000.0)])
+def test_converges_to_the_independent_first_order_sdm(ri, rpm):
+    """The full discretisation (depth-independent exponentials) and the first-order SDM (written out above)
+    share the limit they converge to: Richardson extrapolations from m = 40 and 80 within 0.01 %."""
+    ref = [_plain_sdm_limit(rpm, ri, m, lo=0.1e-3, hi=10e-3) for m in (40, 80)]
+    got = [sdm_lobes(MODE, None, cut(ri), rpm=[rpm], m=m, rtol=1e-7).depth_m[0] for m in (40, 80)]
+    ext_ref, ext_got = ref[1] + (ref[1] - ref[0]) / 3, got[1] + (got[1] - got[0]) / 3
+    assert ext_got == pytest.approx(ext_ref, rel=1e-4)

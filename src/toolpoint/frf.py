@@ -193,10 +193,11 @@ class FRF:
         object.__setattr__(self, "freq_hz", f)
         object.__setattr__(self, "values", v)
 
-    def _new(self, freq_hz, values, quantity: str | None = None) -> "FRF":
+    def _new(self, freq_hz, values, quantity: str | None = None, meta: dict | None = None) -> "FRF":
         """An object of the same type and label on new data (checked like any other)."""
         out = object.__new__(type(self))
-        FRF.__init__(out, freq_hz, values, quantity or self.quantity, self.label, dict(self.meta))
+        FRF.__init__(out, freq_hz, values, quantity or self.quantity, self.label, dict(self.meta if meta is None
+                                                                                      else meta))
         return out
 
     # ------------------------------------------------------------------ basics
@@ -265,7 +266,7 @@ class FRF:
         if fq.size == self.freq_hz.size and np.array_equal(fq, self.freq_hz):
             return self
         if fq.size == 0:
-            return self._new(fq, self.values[:0])
+            return self._new(fq, self.values[:0], meta=self._meta_per_freq(lambda v: v[:0]))
         if len(self) == 0:
             raise InputError(f"FRF {self.label!r} is empty; asked for {fq.min():g}–{fq.max():g} Hz", field="freq_hz")
         lo, hi = self.freq_hz[0], self.freq_hz[-1]
@@ -273,16 +274,28 @@ class FRF:
         if fq.min() < lo - tol or fq.max() > hi + tol:
             raise InputError(f"{self.label or 'FRF'!r} covers {lo:g}–{hi:g} Hz; asked for {fq.min():g}–{fq.max():g} "
                              "Hz (no extrapolation outside the measured band)", field="freq_hz")
-        return self._new(fq, _interp(np.clip(fq, lo, hi), self.freq_hz, self.values))
+        fc = np.clip(fq, lo, hi)
+        return self._new(fq, _interp(fc, self.freq_hz, self.values),
+                         meta=self._meta_per_freq(lambda v: _interp(fc, self.freq_hz, v)))
+
+    def _meta_per_freq(self, f) -> dict:
+        """``meta`` with ``f`` applied to every per-frequency array (first axis one entry per frequency)."""
+        n = len(self)
+        return {k: (f(v) if isinstance(v, np.ndarray) and v.ndim >= 1 and v.shape[0] == n else v)
+                for k, v in self.meta.items()}
 
     def band(self, fmin: float | None = None, fmax: float | None = None) -> "FRF":
-        """The points with fmin ≤ f ≤ fmax (Hz), no interpolation; same type and shape per point."""
+        """The points with fmin ≤ f ≤ fmax (Hz), no interpolation; same type and shape per point.
+
+        Per-frequency arrays in ``meta`` (NumPy arrays whose first axis has one
+        entry per frequency, e.g. ``meta["coherence"]``) are cut to the same points.
+        """
         m = np.ones(len(self), bool)
         if fmin is not None:
             m &= self.freq_hz >= fmin
         if fmax is not None:
             m &= self.freq_hz <= fmax
-        return self._new(self.freq_hz[m], self.values[m])
+        return self._new(self.freq_hz[m], self.values[m], meta=self._meta_per_freq(lambda v: v[m]))
 
     def peak(self) -> tuple[float, float]:
         """Dominant peak of a SISO FRF: (frequency Hz, magnitude in :attr:`unit`) of max |values|.

@@ -3,7 +3,8 @@
 ``campaign.toml`` (lengths in mm at the boundary, all else SI)::
 
     [campaign]
-    band_hz = [20.0, 4000.0]        # frequency band to fit (Hz)
+    band_hz = [20.0, 4000.0]        # frequency band to fit (Hz); each measured FRF is further cut to its
+                                    # trusted band (toolpoint.trust), noted in its row's warnings
     [materials.carbide]             # optional, as in an assembly file
     E = 580e9
     rho = 14500.0
@@ -16,7 +17,8 @@
     model = "spindle_holder.toml"   #   a model (spindle + holder + spindle–holder joint), or
     # joint = "sh_identified.json"  #   with the joint of `toolpoint identify --joint spindle_holder`, or
     # blank = { segments = [{ length_mm = 50, od_mm = 20 }], x2_mm = 40,
-    #           G11 = "sh/G11.csv", G12 = "sh/G12.csv", G22 = "sh/G22.csv", smooth = "modal" }
+    #           G11 = "sh/G11.csv", G12 = "sh/G12.csv", G22 = "sh/G22.csv", smooth = "modal",
+    #           band_hz = "auto" }      # or [lo, hi]: the blank FRFs' band (default all; "auto": trusted band)
     # files = { h = "h.csv", l = "l.csv", n = "n.csv", p = "p.csv" }
     # smooth = "modal": common-pole modal fit of the measured FRFs (noise out, peaks
     # kept; recommended); smooth_hz = 25: Savitzky–Golay window (rounds sharp peaks)
@@ -30,7 +32,6 @@ relative to the folder) and optionally ``holder`` (default: the only holder).
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -48,6 +49,7 @@ from ..dynamics.assembly import (
     load_assembly,
 )
 from ..errors import InputError
+from ..io.table import read_rows
 from ..io.toml import TomlReader, load_toml
 from ..io.frf_files import read_frf
 from ..dynamics.inverse_rcsa import subassembly_from_blank, subassembly_from_files
@@ -141,8 +143,13 @@ class Campaign:
         else:
             r = TomlReader(str(self.toml))
             blank = Component("blank", parse_segments(r, src.spec, f"holders.{name}.blank", self.materials))
-            sub = subassembly_from_blank(blank, float(src.spec["x2_mm"]) * MM, *(read_frf(p) for p in keys),
-                                         smooth=smooth)
+            try:
+                sub = subassembly_from_blank(blank, float(src.spec["x2_mm"]) * MM, *(read_frf(p) for p in keys),
+                                             smooth=smooth, band=src.spec.get("band_hz"))
+            except InputError as e:
+                if e.field != "band":
+                    raise
+                raise InputError(e.message, file=self.toml, field=f"holders.{name}.blank.band_hz") from None
         _MEMO.clear()  # one holder set at a time is enough
         _MEMO[memo] = sub
         return sub
@@ -190,6 +197,16 @@ def _smooth(r: TomlReader, spec: dict, path: str):
             raise r.err(f"{path}.smooth_hz", f"must be a window > 0 Hz, got {v!r}")
         return float(v)
     return None
+
+
+def _blank_band(r: TomlReader, b: dict, path: str):
+    """A blank's ``band_hz``: absent (None: all of the measured FRFs), ``[lo, hi]`` in Hz or ``"auto"``."""
+    from ..trust import check_band
+
+    v = b.get("band_hz")
+    if v is None or v == "auto":
+        return v
+    return check_band(v, file=r.file, field=f"{path}.band_hz")
 
 
 def _band(r: TomlReader, doc: dict) -> tuple[float, float]:
@@ -271,19 +288,15 @@ def _holders(r: TomlReader, doc: dict, folder: Path) -> dict[str, HolderSource]:
                 _file_key(r, b, k, f"{path}.blank", folder)
             sm = _smooth(r, b, f"{path}.blank")
             out[name] = HolderSource(name, kind, {**{k: v for k, v in b.items() if k not in ("smooth", "smooth_hz")},
-                                                  "smooth": sm})
+                                                  "smooth": sm, "band_hz": _blank_band(r, b, f"{path}.blank")})
     return out
 
 
 def _measurements(path: Path, holders: dict) -> tuple[Measurement, ...]:
-    try:
-        with open(path, newline="") as fh:
-            rows = list(csv.reader(fh))
-    except FileNotFoundError:
-        raise InputError("file not found", file=path) from None
+    rows = read_rows(path, what="the measurements table")
     if not rows:
         raise InputError("empty file", file=path, field="header")
-    head = [h.strip() for h in rows[0]]
+    head = [h.strip() for h in rows[0][1]]
     need = ["id", "diameter_mm", "overhang_mm", "frf"]
     for col in need:
         if col not in head:
@@ -292,9 +305,7 @@ def _measurements(path: Path, holders: dict) -> tuple[Measurement, ...]:
     default_holder = next(iter(holders)) if len(holders) == 1 else None
     seen: dict[str, int] = {}
     out = []
-    for n, row in enumerate(rows[1:], start=2):
-        if not any(c.strip() for c in row):
-            continue
+    for n, row in rows[1:]:
         if len(row) != len(head):
             raise InputError(f"line {n}: {len(row)} cells, header has {len(head)}", file=path, field="row")
         get = lambda c: row[idx[c]].strip()  # noqa: E731

@@ -21,7 +21,10 @@ baselines on the same split: a Gaussian process and gradient boosting.
   fit log10 whenever the target is positive.
 
 The pipeline: read rows → split → per target fit ANFIS and baselines → metrics
-→ write models, ``split.csv``, ``metrics.json``/``.csv`` and plots. It returns a
+→ write models, ``split.csv``, ``metrics.json``/``.csv`` and plots. The GP baseline of a
+log10 target is saved too (``gp_<target>.json``: training data, per-row noise and fitted kernel
+hyper-parameters, from which :func:`~toolpoint.campaign.predict.load_gp_models` rebuilds it exactly),
+for its predictive standard deviation (``toolpoint library --model gp``). It returns a
 :class:`LearnResult`; ``toolpoint campaign learn`` prints it. Why these choices
 (weighting, log targets, over-fitting of the 3×7 grid) and what they measured:
 ``docs/design/campaign.md``.
@@ -50,7 +53,7 @@ from .results import FILE_NAME, IdentifiedRows, read_identified
 
 __all__ = [
     "learn", "LearnResult", "overfit_ratio", "PAPER", "PAPER_N_TEST", "INPUTS", "IDENTIFIABLE_SHARE",
-    "OVERFIT_RATIO", "MIN_TRAIN", "MIN_RELIABLE", "SIGMA_FLOOR",
+    "OVERFIT_RATIO", "MIN_TRAIN", "MIN_RELIABLE", "SIGMA_FLOOR", "GP_FORMAT", "gp_kernel",
 ]
 
 #: Model inputs: columns of identified.csv, mm.
@@ -59,6 +62,8 @@ INPUTS = ("diameter_mm", "overhang_mm")
 REQUIRED_FOR_PREDICT = "kt"
 #: The file in the models folder naming the models one ``learn`` wrote.
 MANIFEST = "manifest.json"
+#: ``format`` of a saved GP baseline (``gp_<target>.json``; read by :func:`toolpoint.campaign.predict.load_gp_models`).
+GP_FORMAT = "toolpoint.gp"
 #: Damping parameters: learned by default only where the file has their intervals.
 DAMPING = ("ct", "cr")
 #: Below this share of ok rows with an identified value, a note says how little of the data pins a target down.
@@ -125,8 +130,8 @@ class LearnResult:
     paper : dict
         Target → the paper's test metrics (:data:`PAPER`) and ``n``.
     files : dict
-        What was written: ``split``, ``<target>`` (model JSON), ``<target>_plots``,
-        ``metrics_json``, ``metrics_csv``.
+        What was written: ``split``, ``<target>`` (model JSON), ``gp_<target>`` (the GP
+        baseline, log10 targets only), ``<target>_plots``, ``metrics_json``, ``metrics_csv``.
     notes : list of str
         Lines for the user about the data as a whole.
     target_notes : dict
@@ -190,6 +195,7 @@ class _Fit:
     baseline_settings: dict | None = None
     y_test: np.ndarray | None = None
     p_test: np.ndarray | None = None
+    gp: dict | None = None  # the fitted GP baseline as saved (gp_<target>.json), log10 targets only
 
 
 # --------------------------------------------------------------- settings
@@ -258,20 +264,36 @@ def _exp10(v):
     return np.power(10.0, v)
 
 
+def gp_kernel():
+    """The GP baseline's kernel before fitting: C · RBF(ARD over the standardised inputs) + white noise.
+
+    Returns
+    -------
+    sklearn.gaussian_process.kernels.Kernel
+        A fitted kernel is this one with its hyper-parameters ``theta`` (what ``gp_<target>.json`` stores).
+
+    Examples
+    --------
+    >>> gp_kernel().n_dims  # log constant, two length scales, log noise level
+    4
+    """
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+
+    rbf = RBF(length_scale=[1.0] * len(INPUTS), length_scale_bounds=(1e-2, 1e2))
+    return ConstantKernel(1.0, (1e-3, 1e3)) * rbf + WhiteKernel(1e-3, (1e-10, 1.0))
+
+
 def _baselines(seed: int, log: bool) -> dict:
     """Unfitted baseline regressors {key: estimator} (target in log10 if ``log``)."""
     from sklearn.compose import TransformedTargetRegressor
     from sklearn.ensemble import GradientBoostingRegressor
     from sklearn.gaussian_process import GaussianProcessRegressor
-    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
     from sklearn.pipeline import make_pipeline
     from sklearn.preprocessing import StandardScaler
 
-    rbf = RBF(length_scale=[1.0] * len(INPUTS), length_scale_bounds=(1e-2, 1e2))
-    kernel = ConstantKernel(1.0, (1e-3, 1e3)) * rbf + WhiteKernel(1e-3, (1e-10, 1.0))
     gpr = make_pipeline(
         StandardScaler(),
-        GaussianProcessRegressor(kernel=kernel, normalize_y=True, n_restarts_optimizer=3, random_state=seed),
+        GaussianProcessRegressor(kernel=gp_kernel(), normalize_y=True, n_restarts_optimizer=3, random_state=seed),
     )
     gbr = GradientBoostingRegressor(random_state=seed)
 
@@ -302,6 +324,16 @@ def _fit_weighted(key, est, X, y, sigma, log: bool) -> None:
     name = "regressor__gaussianprocessregressor__alpha" if log else "gaussianprocessregressor__alpha"
     est.set_params(**{name: alpha})
     est.fit(X, y)
+
+
+def _gp_document(t: str, est, X, y) -> dict:
+    """What reproduces a fitted log10-target GP baseline exactly (refit with the kernel fixed):
+    training inputs (mm), log10 targets, per-row noise ``alpha`` and the kernel's ``theta``."""
+    gpr = est.regressor_.steps[-1][1]
+    return {"format": GP_FORMAT, "version": 1, "target": t, "unit": UNITS[t], "inputs": list(INPUTS),
+            "log10_target": True, "X_mm": np.asarray(X, float).tolist(), "log10_y": np.log10(y).tolist(),
+            "alpha": np.broadcast_to(gpr.alpha, (len(y),)).tolist(), "normalize_y": True,
+            "theta": gpr.kernel_.theta.tolist(), "kernel": str(gpr.kernel_)}
 
 
 def _describe_baseline(key, est) -> str:
@@ -396,7 +428,7 @@ def _fit_target(t: str, data: _Data, train_idx, test_idx, anfis: dict, *, baseli
     ratio = overfit_ratio(scores["anfis"]["test"]["nrmse"], scores["anfis"]["train"]["nrmse"])
     scores["anfis"]["overfit"] = bool(ratio > OVERFIT_RATIO)
 
-    settings = None
+    settings, gp = None, None
     if baselines:
         log = bool(np.all(y > 0))
         settings = {}
@@ -407,7 +439,12 @@ def _fit_target(t: str, data: _Data, train_idx, test_idx, anfis: dict, *, baseli
                 b_tr, b_te = est.predict(Xtr), est.predict(Xte)
             scores[key] = {"train": _metrics(ytr, b_tr), "test": _metrics(yte, b_te)}
             settings[key] = {"log10_target": log, "fitted": _describe_baseline(key, est)}
-    return _Fit(notes, model=model, metrics=scores, baseline_settings=settings, y_test=yte, p_test=p_te)
+            if key == "gpr" and log:
+                gp = _gp_document(t, est, Xfit, yfit)
+        if not log:
+            notes.append(f"{t}: not all values > 0, so its GP baseline fits {t} itself and is not saved "
+                         "(the library's GP option needs a log-normal joint)")
+    return _Fit(notes, model=model, metrics=scores, baseline_settings=settings, y_test=yte, p_test=p_te, gp=gp)
 
 
 # ------------------------------------------------------------------ output
@@ -426,15 +463,18 @@ def _check_folders(models_dir: Path, plots_dir: Path | None) -> None:
             raise InputError("exists and is not a folder", file=d)
 
 
-def _write_manifest(models_dir: Path, learned: list[str]) -> None:
-    """``manifest.json``: the models this run wrote (what ``predict`` uses); model files of other
-    parameters, left by an earlier run on other data or targets, are removed so none is used stale."""
+def _write_manifest(models_dir: Path, learned: list[str], gps: list[str]) -> None:
+    """``manifest.json``: the models this run wrote (what ``predict`` uses: ANFIS under ``models``, the
+    saved GP baselines under ``gp``); model files of other parameters, left by an earlier run on other
+    data or targets, are removed so none is used stale."""
     with atomic_open(models_dir / MANIFEST, "w", encoding="utf-8") as fh:
-        json.dump({"format": "toolpoint.models", "version": 1, "models": {t: f"{t}.json" for t in learned}}, fh,
-                  indent=1)
+        json.dump({"format": "toolpoint.models", "version": 1, "models": {t: f"{t}.json" for t in learned},
+                   "gp": {t: f"gp_{t}.json" for t in gps}}, fh, indent=1)
     for t in PARAMS:
         if t not in learned:
             (models_dir / f"{t}.json").unlink(missing_ok=True)
+        if t not in gps:
+            (models_dir / f"gp_{t}.json").unlink(missing_ok=True)
 
 
 def _write_split(path: Path, ids: list, test_idx) -> None:
@@ -613,6 +653,8 @@ def learn(
             continue
         fits[t] = fit
         files[t] = str(models_dir / f"{t}.json")
+        if fit.gp is not None:
+            files[f"gp_{t}"] = str(models_dir / f"gp_{t}.json")
         if fit.baseline_settings is not None:
             baseline_settings[t] = fit.baseline_settings
         metrics[t] = fit.metrics
@@ -667,8 +709,14 @@ def learn(
     _write_split(models_dir / "split.csv", data.ids, test_idx)
     for t, fit in fits.items():
         _save_model(fit.model, models_dir / f"{t}.json")
+        if fit.gp is not None:
+            try:
+                with atomic_open(models_dir / f"gp_{t}.json", "w", encoding="utf-8") as fh:
+                    json.dump(fit.gp, fh, allow_nan=False)
+            except OSError as err:
+                raise _writing(models_dir / f"gp_{t}.json")(err) from None
         if plots:
             _write_plots(t, fit, plots_dir)
     _write_metrics(result, models_dir / "metrics.json", models_dir / "metrics.csv")
-    _write_manifest(models_dir, learned)
+    _write_manifest(models_dir, learned, [t for t, fit in fits.items() if fit.gp is not None])
     return result

@@ -39,10 +39,15 @@ import numpy as np
 from ..errors import InputError
 from ..identification.params import PARAMS, interval_ratio, is_identified, sigma_ln_from_interval
 from ..io.atomic import atomic_open
+from ..io.table import read_table
 
 __all__ = ["COLUMNS", "FILE_NAME", "new_row", "resume", "Appender", "read_identified", "IdentifiedRows"]
 
 FILE_NAME = "identified.csv"
+#: Largest tool diameter or overhang accepted, mm (a 10 m tool: beyond it the number is not a tool size).
+MAX_LENGTH_MM = 1e4
+#: Largest magnitude of any other required number (squares and sums of squares stay finite).
+MAX_ABS_VALUE = 1e100
 COLUMNS = (
     ["id", "holder", "diameter_mm", "overhang_mm", *PARAMS]
     + [f"{p}_{s}" for p in PARAMS for s in ("lo", "hi")]
@@ -78,15 +83,7 @@ def _is_ok(row: dict) -> bool:
 
 def _read_rows(path: Path) -> tuple[list[str], list[tuple[int, dict]]]:
     """Header and (line number, row) of every data row; InputError if unreadable."""
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            reader = csv.DictReader(fh)
-            header = [h.strip() for h in (reader.fieldnames or [])]
-            reader.fieldnames = header
-            rows = [(reader.line_num, row) for row in reader]
-    except (OSError, UnicodeDecodeError, csv.Error) as err:
-        raise InputError(f"cannot read CSV: {err}", file=path) from None
-    return header, rows
+    return read_table(path, what="identified.csv")
 
 
 def resume(path: str | os.PathLike, ids: set[str]) -> set[str]:
@@ -240,8 +237,9 @@ class IdentifiedRows:
         name : str
             Column name.
         required : bool, default True
-            True: every row must hold a finite number (InputError naming the
-            line and the cell otherwise); False: NaN where it does not.
+            True: every row must hold a finite number, within ±:data:`MAX_ABS_VALUE`
+            (diameter and overhang: in (0, :data:`MAX_LENGTH_MM`] mm) — an InputError
+            naming the line and the cell otherwise; False: NaN where it is not a finite number.
 
         Returns
         -------
@@ -270,6 +268,12 @@ class IdentifiedRows:
                 raise InputError(f"line {line}: {cell!r} is not a finite number (status ok)", file=self.path,
                                  field=name)
             return math.nan
+        if required and name in ("diameter_mm", "overhang_mm") and not 0 < v <= MAX_LENGTH_MM:
+            raise InputError(f"line {line}: {cell!r} mm is not a tool size (0 to {MAX_LENGTH_MM:g} mm)",
+                             file=self.path, field=name)
+        if required and abs(v) > MAX_ABS_VALUE:
+            raise InputError(f"line {line}: {cell!r} is beyond ±{MAX_ABS_VALUE:g} (models square it)",
+                             file=self.path, field=name)
         return v
 
     def has_interval(self, param: str) -> bool:

@@ -35,7 +35,7 @@ from .config import Campaign, load_campaign
 from .results import COLUMNS, FILE_NAME, Appender, new_row, resume
 
 __all__ = ["COLUMNS", "MIN_POINTS", "Item", "identify_item", "item_seed", "prepare", "run_campaign", "dask_client",
-           "execute", "worker_init", "holder_subassemblies"]
+           "execute", "worker_init", "holder_subassemblies", "trusted_part"]
 
 #: Fewest frequency points of a measurement inside the campaign's band.
 MIN_POINTS = 10
@@ -63,6 +63,10 @@ class Item:
         The item's own seed (:func:`item_seed`).
     bounds_lo, bounds_hi : ndarray, shape (4,)
         Search bounds of kt, ct, kr, cr (SI).
+    note : str
+        Why the fitted band is narrower than ``campaign.band_hz`` (the measured
+        FRF's trusted band, :func:`toolpoint.trust.trusted_band`), or ``""``;
+        written into the row's ``warnings`` cell.
     """
 
     id: str
@@ -77,6 +81,7 @@ class Item:
     seed: int
     bounds_lo: np.ndarray
     bounds_hi: np.ndarray
+    note: str = ""
 
 
 # warnings.catch_warnings changes process-wide state: with several identifications on threads
@@ -132,7 +137,8 @@ def identify_item(item: Item) -> dict:
                        Bounds(item.bounds_lo, item.bounds_hi))
     row = new_row(item.id, item.holder, item.diameter_mm, item.overhang_mm, status="ok",
                   objective=f"{res.fun:.6g}", evaluations=int(res.nfev),
-                  seconds=f"{time.perf_counter() - t0:.3f}", warnings="; ".join(res.warnings))
+                  seconds=f"{time.perf_counter() - t0:.3f}",
+                  warnings="; ".join(([item.note] if item.note else []) + list(res.warnings)))
     for p in PARAMS:
         row[p] = repr(res.params[p])
         row[f"{p}_lo"], row[f"{p}_hi"] = (repr(v) for v in res.ci95[p])
@@ -200,7 +206,7 @@ def prepare(c: Campaign, todo, method: str, seed: int, native: dict | None = Non
     lo, hi = c.band_hz
     for m in todo:
         try:
-            meas = read_frf(m.frf, min_points=MIN_POINTS).band(lo, hi)
+            meas, note = trusted_part(read_frf(m.frf, min_points=MIN_POINTS), m.frf, (lo, hi))
             if len(meas) < MIN_POINTS:
                 raise InputError(f"only {len(meas)} points inside the band {lo:g}–{hi:g} Hz", file=m.frf,
                                  field="freq_hz")
@@ -214,10 +220,30 @@ def prepare(c: Campaign, todo, method: str, seed: int, native: dict | None = Non
                     raise InputError(f"{e}", file=m.frf, field="freq_hz") from None
             items.append(Item(m.id, m.holder, m.diameter_mm, m.overhang_mm, meas.freq_hz, meas.values,
                               c.family.tool(m.diameter_mm, m.overhang_mm), sub.R, method, item_seed(seed, m.id),
-                              c.bounds.lo, c.bounds.hi))
+                              c.bounds.lo, c.bounds.hi, note))
         except InputError as e:
             failed.append(new_row(m.id, m.holder, m.diameter_mm, m.overhang_mm, status="failed", error=str(e)))
     return items, failed
+
+
+def trusted_part(frf: FRF, path, band_hz: tuple[float, float]) -> tuple[FRF, str]:
+    """A measured FRF cut to ``campaign.band_hz`` and to its own trusted band (:func:`toolpoint.trust.trusted_band`).
+
+    Returns the cut FRF and a note (``""`` unless the trusted band cuts into
+    ``band_hz``). A trusted band that misses ``band_hz`` is an InputError (the item fails).
+    """
+    from ..trust import trusted_band
+
+    lo, hi = band_hz
+    tb = trusted_band(frf, file=path)
+    lo2, hi2 = max(lo, tb.lo_hz), min(hi, tb.hi_hz)
+    if lo2 >= hi2:
+        raise InputError(f"its trusted band {tb.lo_hz:g}–{tb.hi_hz:g} Hz ({tb.reason}) misses campaign.band_hz "
+                         f"{lo:g}–{hi:g} Hz", file=path, field="freq_hz")
+    note = ""
+    if tb.reason and (lo2 > lo or hi2 < hi):
+        note = f"note: fitted {lo2:g}–{hi2:g} Hz of campaign.band_hz {lo:g}–{hi:g} Hz ({tb.reason})"
+    return frf.band(lo2, hi2), note
 
 
 def run_campaign(folder, out_dir, *, method: str | None = None, workers: int | None = None,
@@ -272,7 +298,8 @@ def run_campaign(folder, out_dir, *, method: str | None = None, workers: int | N
             return _run_locked(c, out, method, seed, workers, client, progress, t0, native)
     finally:
         if client is not None:
-            client.close()
+            with quiet_distributed():
+                client.close()
 
 
 def _run_locked(c, out: Path, method, seed, workers, client, progress, t0, native) -> dict:
@@ -391,12 +418,22 @@ def execute(fn, jobs, workers: int | None = None, client=None):
     if client is not None:
         from distributed import as_completed as dask_completed
 
-        futs = {client.submit(fn, j, pure=False): j for j in jobs}
-        for fut in dask_completed(futs):
-            try:
-                yield futs[fut], fut.result()
-            except Exception as e:  # noqa: BLE001 — a failed job is reported to the caller, the rest goes on
-                yield futs[fut], e
+        with quiet_distributed():
+            futs = {client.submit(fn, j, pure=False): j for j in jobs}
+            done = 0
+            for fut in dask_completed(futs):
+                if fut.status == "cancelled" or client.status not in ("running", "connecting"):
+                    break  # the scheduler went away: its futures are cancelled, the rest never come
+                try:
+                    result = fut.result()
+                except Exception as e:  # noqa: BLE001 — a failed job is reported to the caller, the rest goes on
+                    result = e
+                done += 1
+                yield futs[fut], result
+            if done < len(futs):
+                raise InputError(f"the Dask scheduler at {client.scheduler.address!r} was lost after {done} of "
+                                 f"{len(futs)} jobs (their results are kept; run again to do the rest)",
+                                 file="command line", field="--dask")
         return
     n = workers or os.cpu_count() or 1
     if n == 1:
@@ -413,6 +450,28 @@ def execute(fn, jobs, workers: int | None = None, client=None):
                 yield futs[fut], fut.result()
             except Exception as e:  # noqa: BLE001
                 yield futs[fut], e
+
+
+#: Loggers through which distributed (and the asyncio/tornado loop under it) report a lost scheduler
+#: with tracebacks; a lost scheduler is reported as one line (:func:`execute`) instead.
+_DASK_LOGGERS = ("distributed", "distributed.client", "distributed.core", "distributed.comm", "distributed.utils",
+                 "distributed.batched", "distributed.worker", "asyncio", "tornado", "tornado.application")
+
+
+@contextmanager
+def quiet_distributed():
+    """Silence distributed's own error logging while a Dask client runs jobs or closes (levels restored)."""
+    import logging
+
+    loggers = [logging.getLogger(n) for n in _DASK_LOGGERS]
+    old = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, old):
+            lg.setLevel(level)
 
 
 def _failed_row(it: Item, err: Exception) -> dict:

@@ -36,6 +36,9 @@ from ..learning.anfis import ANFIS, MF_PARAMS, predict_quietly
 from ..learning.figures import membership_figure, per_sample_figure, regression_figure, save_png
 from ..learning.metrics import PAPER_METRICS, paper_metrics
 
+#: Largest magnitude accepted in a data column: squares and sums of squares in training stay finite.
+MAX_ABS_VALUE = 1e100
+
 #: ANFIS parameter → the option that sets it (to name the option in an InputError).
 _OPTIONS = {"n_mfs": "--mfs", "mf": "--mf", "order": "--order", "epochs": "--epochs", "step_size": "--step-size"}
 
@@ -82,17 +85,13 @@ def read_columns(path, names) -> dict[str, np.ndarray]:
     """Read the named numeric columns of a CSV with a header row.
 
     Raises :class:`InputError` (file and column named) for a missing file or
-    column, an empty table, and an empty, non-numeric or non-finite cell.
+    column, an empty table, and an empty, non-numeric or non-finite cell, or one
+    beyond ±:data:`MAX_ABS_VALUE`.
     """
+    from ..io.table import read_rows
+
     path = Path(path)
-    if not path.is_file():
-        raise InputError("file not found", file=path)
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            reader = csv.reader(fh)
-            rows = [(reader.line_num, row) for row in reader if any(c.strip() for c in row)]
-    except (OSError, UnicodeDecodeError, csv.Error) as err:
-        raise InputError(f"cannot read CSV: {err}", file=path) from None
+    rows = read_rows(path)
     if not rows:
         raise InputError("empty file (no header row)", file=path)
     header = [h.strip() for h in rows[0][1]]
@@ -114,6 +113,9 @@ def read_columns(path, names) -> dict[str, np.ndarray]:
                 raise InputError(f"line {line}: {cell!r} is not a number", file=path, field=name) from None
             if not np.isfinite(v):
                 raise InputError(f"line {line}: {cell!r} is not a finite number", file=path, field=name)
+            if abs(v) > MAX_ABS_VALUE:
+                raise InputError(f"line {line}: {cell!r} is beyond ±{MAX_ABS_VALUE:g} (training squares it)",
+                                 file=path, field=name)
             values[k] = v
         out[name] = values
     return out
@@ -135,6 +137,11 @@ def _names(text: str, option: str) -> list[str]:
     if len(set(names)) != len(names):
         raise InputError(f"a column is named twice in {text!r}", field=option)
     return names
+
+
+def _ranges(model, names) -> str:
+    """The model's training range per input, e.g. ``a 0–1, b 2–5``."""
+    return ", ".join(f"{n} {lo:.6g}–{hi:.6g}" for n, (lo, hi) in zip(names, model.input_range_))
 
 
 def _write_csv(path, header, columns) -> None:
@@ -197,6 +204,10 @@ def train(args) -> int:
         if np.ptp(X[:, i]) == 0:
             raise InputError("constant in the training data; a grid partition needs a range", file=args.data,
                              field=name)
+    span = float(np.max(np.ptp(X, axis=0)))
+    if args.step_size > span:  # κ moves premise parameters, in input units: beyond the span it leaves the data
+        raise InputError(f"{args.step_size:g} is larger than the span of the training inputs ({span:g}); "
+                         "the step moves membership functions in input units", field="--step-size")
     if args.log_target and np.any(y <= 0):
         raise InputError("--log-target needs positive target values", file=args.data, field=target)
 
@@ -211,19 +222,32 @@ def train(args) -> int:
         pred, outside = predict_quietly(model, Xs)
         results.append((name, ys, pred, paper_metrics(ys, pred), outside))
 
+    # plots first, the model last; a failure removes what this run wrote, so no model is left without its plots
+    plots = Path(args.plots) if args.plots else None
+    made = plots is not None and not plots.exists()
+    figures = [] if plots is None else [
+        (f"{kind}_{name}.png", lambda f=figure, ys=ys, pred=pred, name=name: f(ys, pred, target, f"{name} data"))
+        for name, ys, pred, _, _ in results
+        for kind, figure in (("predicted_vs_target", per_sample_figure), ("regression", regression_figure))
+    ] + [("membership_functions.png", lambda: membership_figure(model))]
+    written = []
     try:
-        model.save(args.out)
-    except OSError as err:
-        raise InputError(f"cannot write: {err.strerror or err}", file=args.out, field="--out") from None
-    if args.plots:
-        plots = Path(args.plots)
+        for file_name, draw in figures:
+            written.append(plots / file_name)
+            try:
+                save_png(draw(), written[-1])
+            except OSError as err:
+                raise InputError(f"cannot write plots: {err.strerror or err}", file=plots, field="--plots") from None
         try:
-            for name, ys, pred, _, _ in results:
-                save_png(per_sample_figure(ys, pred, target, f"{name} data"), plots / f"predicted_vs_target_{name}.png")
-                save_png(regression_figure(ys, pred, target, f"{name} data"), plots / f"regression_{name}.png")
-            save_png(membership_figure(model), plots / "membership_functions.png")
+            model.save(args.out)
         except OSError as err:
-            raise InputError(f"cannot write plots: {err.strerror or err}", file=plots, field="--plots") from None
+            raise InputError(f"cannot write: {err.strerror or err}", file=args.out, field="--out") from None
+    except BaseException:
+        for f in written:
+            f.unlink(missing_ok=True)
+        if made and plots.is_dir() and not any(plots.iterdir()):
+            plots.rmdir()
+        raise
 
     rules = int(np.prod(model.n_mfs_))
     print(
@@ -247,7 +271,9 @@ def predict(args) -> int:
     out_path(args.out, "--out", inputs=[args.data, args.model])
     try:
         model = ANFIS.load(args.model)
-    except (ValueError, OSError, UnicodeDecodeError) as err:
+    except InputError:
+        raise
+    except (ValueError, OSError) as err:
         raise InputError(f"not a valid ANFIS model: {err}", file=args.model) from None
     if args.inputs is not None:
         inputs = _names(args.inputs, "--inputs")
@@ -259,7 +285,13 @@ def predict(args) -> int:
         raise InputError(f"the model has {model.n_features_in_} inputs, {len(inputs)} names given", field="--inputs")
     cols = read_columns(args.data, inputs)
     X = np.column_stack([cols[c] for c in inputs])
-    pred, outside = predict_quietly(model, X)
+    with np.errstate(all="ignore"):  # far outside the training range the arithmetic overflows: checked below
+        pred, outside = predict_quietly(model, X)
+    bad = np.flatnonzero(~np.isfinite(pred))
+    if bad.size:
+        row = ", ".join(f"{c} = {X[bad[0], i]:.6g}" for i, c in enumerate(inputs))
+        raise InputError(f"data row {bad[0] + 1} ({row}) is so far outside the training range "
+                         f"({_ranges(model, inputs)}) that the prediction is not a finite number", file=args.data)
     out_name = model.target_name_ or "prediction"
     if out_name in inputs:
         out_name += "_predicted"

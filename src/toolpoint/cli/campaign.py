@@ -203,6 +203,11 @@ def _synth(args) -> int:
     check_number(args.noise, "--noise", minimum=0)
     check_number(args.blank_noise, "--blank-noise", minimum=0)
     out = Path(args.out_dir)
+    parent = out
+    while not parent.exists():  # the first existing ancestor must be a folder, checked before any work
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InputError(f"is a file or under one ({parent}), expected a folder", file=out, field="OUT_DIR")
     if out.exists() and any(out.iterdir()):
         raise InputError("folder exists and is not empty", file=out, field="OUT_DIR")
     s = synthesise(out, n=args.n, seed=args.seed, noise=args.noise, blank_noise=args.blank_noise, fmt=args.format)

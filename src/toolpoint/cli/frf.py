@@ -33,10 +33,10 @@ def run(args) -> int:
     Bad input raises :class:`~toolpoint.errors.InputError` before anything is written
     (the CLI turns it into one line and exit code 2).
     """
-    out = out_path(args.out, "--out")
+    out = out_path(args.out, "--out", inputs=[args.assembly])
     if out.suffix.lower() not in (".csv", ".uff", ".unv", ".uf", ".frf"):
         raise InputError("use .csv, .uff/.unv or .frf (the format follows the extension)", file=out, field="--out")
-    plot = out_path(args.plot, "--plot") if args.plot else None
+    plot = out_path(args.plot, "--plot", inputs=[args.assembly]) if args.plot else None
     with warnings_to_stderr():
         assembly = load_assembly(args.assembly, require_holder_tool=(args.point == "tool"))
         model = AssemblyModel(assembly)

@@ -24,7 +24,7 @@ from ..io.frf_files import read_frf
 from ..identification.identify import identify, make_algorithm, model_for
 from ..identification.params import PARAMS, UNITS, Bounds
 from ..identification.optim import METHODS, check_method
-from .common import out_path, save_figure, use_agg, warnings_to_stderr
+from .common import check_number, out_path, parse_band, save_figure, trusted, use_agg, warnings_to_stderr
 
 MIN_POINTS = 10
 
@@ -49,8 +49,12 @@ def register(sub) -> None:
     p.add_argument("--plot", help="figure: measured vs identified FRF and convergence (PNG/PDF/SVG)")
     p.add_argument("--bounds", nargs="+", metavar="NAME=LO:HI", default=[],
                    help="override search bounds, e.g. kt=1e6:1e9 cr=0.1:300 (SI units)")
-    p.add_argument("--fmin", type=float, help="fit only from this frequency (Hz)")
-    p.add_argument("--fmax", type=float, help="fit only up to this frequency (Hz)")
+    p.add_argument("--band", metavar="LO:HI",
+                   help="fit only from LO to HI Hz (default: [identify] band_hz = [LO, HI] of the assembly file, "
+                   "else the trusted band found in each measured file — low-frequency noise ×1/ω² and low "
+                   "coherence left out, with a note on stderr)")
+    p.add_argument("--fmin", type=float, help="fit only from this frequency (Hz); older spelling of --band")
+    p.add_argument("--fmax", type=float, help="fit only up to this frequency (Hz); older spelling of --band")
     p.add_argument("--quantity", choices=("receptance", "mobility", "accelerance"),
                    help="what the measured file holds (default: as the file says; CSV means receptance)")
     p.set_defaults(func=run)
@@ -86,6 +90,7 @@ def load_problem_inputs(args):
 def run(args) -> int:
     """Run ``toolpoint identify``; returns the exit code (0)."""
     check_method(args.method)
+    check_number(args.seed, "--seed", minimum=0)  # NumPy's generator refuses a negative seed with a ValueError
     if general_requested(args):
         return run_general(args)
     if len(args.measured) != 1:
@@ -95,25 +100,29 @@ def run(args) -> int:
         raise InputError("--at, --weight and --no-tool need --params or --joint", file="command line",
                          field="--at")
     args.measured = args.measured[0]
-    out = out_path(args.out, "--out") if args.out else None
-    plot = out_path(args.plot, "--plot") if args.plot else None
+    inputs = [args.assembly, args.measured]
+    out = out_path(args.out, "--out", inputs=inputs) if args.out else None
+    plot = out_path(args.plot, "--plot", inputs=inputs) if args.plot else None
     with warnings_to_stderr():
         assembly, bounds = load_problem_inputs(args)
         meas = read_frf(args.measured, quantity=args.quantity, min_points=MIN_POINTS)
         if meas.freq_hz[0] == 0:
             warnings.warn(f"{args.measured}: the 0 Hz point is not used (free–free components are singular there)")
             meas = meas.band(fmin=np.nextafter(0.0, 1.0))
-        meas = meas.band(args.fmin, args.fmax)
+        meas, note = fit_band(meas, args.measured, band_spec(args))
         if len(meas) < MIN_POINTS:
             raise InputError(f"only {len(meas)} points in the fitted band, need at least {MIN_POINTS}",
                              file=args.measured, field="freq_hz")
         if assembly.holder_tool is not None:
             print(f"note: [joints.holder_tool] in {args.assembly} is ignored — it is what we identify", file=sys.stderr)
         model = model_for(assembly, meas.freq_hz)
+        if note:
+            print(note, file=sys.stderr)
         algo = make_algorithm(args.method)
         res = _run_with_progress(model, meas, args.method, args.seed, bounds, algo)
     _report(res, args)
-    doc = result_document(res, args.method, args.seed, assembly=args.assembly, measured=args.measured)
+    doc = result_document(res, args.method, args.seed, assembly=args.assembly, measured=args.measured,
+                          band_hz=[float(meas.freq_hz[0]), float(meas.freq_hz[-1])])
     _write(doc, out, plot, args.method, meas, res.model_frf, res.history,
            f"{Path(args.measured).name}: identified holder–tool joint")
     return 0
@@ -188,6 +197,39 @@ def _report(res, args, names=PARAMS, units=UNITS) -> None:
         print(f"warning: {w}", file=sys.stderr)
 
 
+def band_spec(args) -> tuple:
+    """Where the fitted band comes from: ``("given", (lo, hi), field)``, ``("fminmax", fmin, fmax)`` or ``("auto",)``.
+
+    ``--band`` first, then the old ``--fmin``/``--fmax`` (not both spellings at once), then
+    ``band_hz = [LO, HI]`` in the assembly file's ``[identify]`` table; otherwise the trusted
+    band of each measured file (:func:`toolpoint.trust.trusted_band`).
+    """
+    from ..trust import check_band
+
+    band = parse_band(getattr(args, "band", None))
+    fmin, fmax = getattr(args, "fmin", None), getattr(args, "fmax", None)
+    if band is not None and (fmin is not None or fmax is not None):
+        raise InputError("give --band or --fmin/--fmax, not both", file="command line", field="--band")
+    if band is not None:
+        return ("given", band, "--band")
+    if fmin is not None or fmax is not None:
+        return ("fminmax", fmin, fmax)
+    t = _file_identify(args.assembly)
+    if "band_hz" in t:
+        return ("given", check_band(t["band_hz"], file=args.assembly, field="identify.band_hz"), "identify.band_hz")
+    return ("auto",)
+
+
+def fit_band(frf, path, spec):
+    """``frf`` (read from ``path``) cut to the band of ``spec`` (:func:`band_spec`), and the note for stderr."""
+    if spec[0] == "fminmax":
+        return frf.band(spec[1], spec[2]), ""
+    band, field = (spec[1], spec[2]) if spec[0] == "given" else (None, "--band")
+    hint = "--band LO:HI or [identify] band_hz"
+    cut, _, note = trusted(frf, path, band, field=field, hint=hint)
+    return cut, note
+
+
 # --------------------------------------------------------------------------- general form
 _GENERAL_KEYS = {"joint", "params", "at", "weights", "start"}
 
@@ -217,7 +259,7 @@ def _general_setup(args):
 
     src = args.assembly
     t = _file_identify(src)
-    r_unknown = set(t) - (_GENERAL_KEYS | {"bounds", "method"})
+    r_unknown = set(t) - (_GENERAL_KEYS | {"bounds", "method", "band_hz"})
     if r_unknown:
         raise InputError(f"unknown key {sorted(r_unknown)[0]!r}", file=src, field="identify")
     assembly = _load(src, require_tool=False, require_spindle_holder=False)
@@ -251,9 +293,12 @@ def _general_setup(args):
         raise InputError(f"{len(at)} points for {len(args.measured)} measured files: give one --at per file",
                          file=at_where[0], field=at_where[1])
     weights = args.weight or t.get("weights") or [1.0] * len(args.measured)
-    if len(weights) != len(args.measured) or not all(isinstance(w, (int, float)) and w >= 0 for w in weights):
-        raise InputError(f"need one weight ≥ 0 per measured file, got {weights!r}", file="command line",
-                         field="--weight")
+    # > 0 and finite: the model of a measurement is divided by √w (a weight 0 or inf made it NaN)
+    if len(weights) != len(args.measured) or not all(
+            isinstance(w, (int, float)) and not isinstance(w, bool) and np.isfinite(w) and w > 0 for w in weights):
+        raise InputError(f"need one finite weight > 0 per measured file, got {weights!r}",
+                         file="command line" if args.weight else src,
+                         field="--weight" if args.weight else "identify.weights")
     pts = [parse_at(a, file=at_where[0], field=at_where[1]) for a in at]
     with_tool = False if (args.no_tool or joint == "spindle_holder" or assembly.tool is None) else None
     on_tool = [p.text for pair in pts for p in pair if p.component == "tool"]
@@ -271,13 +316,16 @@ def _general_setup(args):
     start = t.get("start", {})
     if not isinstance(start, dict):
         raise InputError("must be a table like {\"spindle_holder.kt\" = 5e8}", file=src, field="identify.start")
-    meas = []
+    meas, spec = [], band_spec(args)
+    args.band_notes = []
     for path, (resp, force), w in zip(args.measured, pts, weights):
         frf = read_frf(path, quantity=args.quantity, min_points=MIN_POINTS)
         if frf.freq_hz[0] == 0:
             warnings.warn(f"{path}: the 0 Hz point is not used (free–free components are singular there)")
             frf = frf.band(fmin=np.nextafter(0.0, 1.0))
-        frf = frf.band(args.fmin, args.fmax)
+        frf, note = fit_band(frf, path, spec)
+        if note:
+            args.band_notes.append(note)
         if len(frf) < MIN_POINTS:
             raise InputError(f"only {len(frf)} points in the fitted band, need at least {MIN_POINTS}", file=path,
                              field="freq_hz")
@@ -289,8 +337,9 @@ def run_general(args) -> int:
     """``toolpoint identify`` in its general form (``--joint``/``--params``); returns the exit code (0)."""
     from ..identification.problem import FRFProblem, identify_frfs
 
-    out = out_path(args.out, "--out") if args.out else None
-    plot = out_path(args.plot, "--plot") if args.plot else None
+    inputs = [args.assembly, *args.measured]
+    out = out_path(args.out, "--out", inputs=inputs) if args.out else None
+    plot = out_path(args.plot, "--plot", inputs=inputs) if args.plot else None
     with warnings_to_stderr():
         assembly, names, meas, bounds, start, with_tool, joint, at = _general_setup(args)
         try:
@@ -300,6 +349,8 @@ def run_general(args) -> int:
                 raise InputError(e.message, file="command line" if args.at else assembly.source,
                                  field="--at" if args.at else "identify.at") from None
             raise
+        for note in args.band_notes:
+            print(note, file=sys.stderr)
         algo = make_algorithm(args.method)
         from tqdm import tqdm
 
@@ -317,8 +368,10 @@ def run_general(args) -> int:
     doc = result_document(
         res, args.method, args.seed, names=names, units=problem.units, key=key,
         assembly=args.assembly,
-        measured=[{"file": m.source, "at": a, "weight": m.weight} for m, a in zip(meas, at)],
+        measured=[{"file": m.source, "at": a, "weight": m.weight,
+                   "band_hz": [float(m.frf.freq_hz[0]), float(m.frf.freq_hz[-1])]} for m, a in zip(meas, at)],
         correlation={"names": [key(n) for n in names], "matrix": np.nan_to_num(res.correlation).tolist()},
+        ci95_method=res.intervals,
     )
     if joint is not None:
         doc["joint"] = joint

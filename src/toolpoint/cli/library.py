@@ -1,4 +1,4 @@
-"""``toolpoint library LIB --campaign CAMP --models MODELS --out DIR [--dask ADDRESS] [--workers N] [--report]``.
+"""``toolpoint library LIB --campaign CAMP --models MODELS --out DIR [--dask ADDRESS] [--model gp] [--report]``.
 
 For every tool of a tool library (CSV, :mod:`toolpoint.recommend.library`):
 the predicted joint with its uncertainty, the tool-point FRF band, the
@@ -12,8 +12,13 @@ other tools go on. An unreadable or empty library is one line, exit 2.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from ..errors import InputError
+
+#: run_library() keyword → CLI option, to name the option in an InputError.
+_OPTIONS = {"n_samples": "--samples", "rpm_points": "--rpm-points", "margin": "--margin",
+            "rpm_tolerance": "--rpm-tolerance", "outside": "--outside"}
 
 
 def register(sub) -> None:
@@ -35,6 +40,9 @@ def register(sub) -> None:
                    help="relative spindle-speed tolerance of the robust limit (default 0.01)")
     p.add_argument("--outside", choices=("widen", "refuse"), default="widen",
                    help="a tool outside the learned (D, L) range: widen its uncertainty (default) or refuse it")
+    p.add_argument("--model", choices=("anfis", "gp"), default="anfis",
+                   help="joint distribution from the ANFIS models (σ from training residuals and identification "
+                   "intervals; default) or from the GP baselines 'campaign learn' saved (their own predictive σ)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--report", action="store_true", help="also write DIR/report.html")
     p.set_defaults(func=run)
@@ -43,13 +51,32 @@ def register(sub) -> None:
 def run(args) -> int:
     """Run ``toolpoint library``."""
     from ..recommend.run import run_library
+    from .common import check_number
+
+    check_number(args.seed, "--seed", minimum=0)  # NumPy's generator refuses a negative seed with a ValueError
+    if args.workers is not None:
+        check_number(args.workers, "--workers", minimum=1)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InputError("exists and is not a folder", file=out, field="--out")
+    parent = out
+    while not parent.exists():  # the first existing ancestor must be a folder, checked before any work
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InputError(f"cannot write under {parent}: it is a file, not a folder", file=out, field="--out")
 
     def say(line):
         print(line, file=sys.stderr)
 
-    counts = run_library(args.library, args.campaign, args.models, args.out, workers=args.workers, dask=args.dask,
-                         n_samples=args.samples, rpm_points=args.rpm_points, seed=args.seed, margin=args.margin,
-                         rpm_tolerance=args.rpm_tolerance, outside=args.outside, on_bad=say)
+    try:
+        counts = run_library(args.library, args.campaign, args.models, args.out, workers=args.workers,
+                             dask=args.dask, n_samples=args.samples, rpm_points=args.rpm_points, seed=args.seed,
+                             margin=args.margin, rpm_tolerance=args.rpm_tolerance, outside=args.outside,
+                             model=args.model, on_bad=say)
+    except InputError as err:  # a setting: name its option
+        if err.file is None and err.field in _OPTIONS:
+            raise InputError(err.message, file="command line", field=_OPTIONS[err.field]) from None
+        raise
     print(f"{counts['ok']} tools ok, {counts['failed']} failed, {counts['skipped']} already done, "
           f"{counts['seconds']:.1f} s → {counts['path']}")
     if args.report:

@@ -3,11 +3,18 @@
 
 Stability lobes of a milling cut from tool-point receptances: zero-order
 approximation (default) or semi-discretisation of modal-fitted FRFs
-(``--method sdm``: real modes per direction, or with ``--frf-xy``/``--frf-yx``
+(``--method sdm``: complex modes per direction, or with ``--frf-xy``/``--frf-yx``
 a common-pole fit per force direction realised as a 2×2 state-space model;
 ``--accuracy`` scales its resolution; progress on stderr). An FRF with no
 resonance in its band (noise, all zero, the mode outside the band) is refused
 for the SDM.
+
+Every FRF is first cut to its trusted band (:func:`toolpoint.trust.trusted_band`:
+low-frequency noise ×1/ω² of a receptance derived from accelerance — the SDM's
+modal fit is then weighted in accelerance —, ends of low coherence; the
+intersection over the FRFs given), with a one-line note on stderr;
+``--band LO:HI`` sets the band instead. Speeds whose limiting chatter frequency
+lies on a cutting edge of the band are named on stderr as not trusted.
 
 ``--tangential-coeff`` is the cutting coefficient K_t in N/m² and
 ``--radial-ratio`` the force ratio K_r = K_n/K_t (not the joint stiffnesses
@@ -40,8 +47,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.atomic import atomic_open, atomic_path
-from ..stability.milling import MAX_RPM_POINTS
-from .common import out_path, use_agg, warnings_to_stderr
+from ..stability.milling import MAX_RPM, MAX_RPM_POINTS
+from .common import out_path, parse_band, trusted, use_agg, warnings_to_stderr
 
 # Deprecated flag → (new flag, what it is), for one release.
 _RENAMED = {"--kt": ("--tangential-coeff", "cutting coefficient, N/m²"),
@@ -78,7 +85,10 @@ def register(sub) -> None:
     p.add_argument("--modes", help="sdm: modes to fit per direction (default: chosen by the fit)")
     p.add_argument("--accuracy", default="1",
                    help="sdm: resolution factor 0.25–16 (default 1: within ≈ 1 %% of the converged limit); "
-                   "time grows with it: 0.5 → ≈ 0.5×, 2 → ≈ 2.5× the CPU time of 1 (4 modes per direction)")
+                   "time grows with it: 0.5 → ≈ 0.7×, 2 → ≈ 2.3×, 4 → ≈ 8× the CPU time of 1 (4 modes per direction)")
+    p.add_argument("--band", metavar="LO:HI",
+                   help="use the FRFs from LO to HI Hz only (default: the trusted band found in the data — "
+                   "low-frequency noise ×1/ω² and low coherence left out, with a note on stderr)")
     p.add_argument("--out", required=True, help="CSV of the limit: rpm,depth_mm,chatter_hz,lobe")
     p.add_argument("--lobes-out", help="CSV of every lobe: lobe,rpm,depth_mm,chatter_hz,branch")
     p.add_argument("--plot", help="chart file (.png, .pdf, .svg, …)")
@@ -107,6 +117,8 @@ def _rpm_range(text: str) -> tuple[float, float]:
         raise InputError(f"speeds must be > 0 rpm, got {text!r}", field="--rpm")
     if hi <= lo:
         raise InputError(f"range reversed or empty: {text!r} (LO must be below HI)", field="--rpm")
+    if hi > MAX_RPM:
+        raise InputError(f"speeds above {MAX_RPM:g} rpm are not spindle speeds, got {text!r}", field="--rpm")
     return lo, hi
 
 
@@ -156,7 +168,14 @@ def _cutting(args):
                                 radial_immersion=immersion, milling=args.milling)
     except InputError as err:
         raise InputError(err.message, field=flags.get(err.field, err.field)) from None
+    if cut.tangential_coeff > KT_MAX:  # finite but overflowing the lobe arithmetic (1e300 × depth × …)
+        raise InputError(f"{cut.tangential_coeff:g} N/m² is beyond any material (typical 1e8–3e9 N/m², "
+                         f"refused above {KT_MAX:g})", field=values["--kt"][1])
     return cut, used
+
+
+#: Largest specific cutting force accepted, N/m² (1e6 N/mm²: 300 × the hardest alloys' ~3e9 N/m²).
+KT_MAX = 1e12
 
 
 def run(args) -> int:
@@ -178,12 +197,15 @@ def run(args) -> int:
     if not 0.25 <= accuracy <= 16:
         raise InputError(f"must be from 0.25 to 16, got {args.accuracy}", field="--accuracy")
 
+    band = parse_band(args.band)
     outs = _outputs(args)
     frf_x = _load(args.frf, "FRF")
     frfs = {}
     for flag in ("--frf-y", "--frf-xy", "--frf-yx"):
         path = getattr(args, flag[2:].replace("-", "_"))
         frfs[flag] = None if path is None else _load(path, flag, freq_hz=frf_x.freq_hz)
+    data_hz = frf_x.freq_hz
+    frf_x, frfs, band, notes, noise = _trusted_band(frf_x, frfs, args, band)
     for old in deprecated:  # only once the input is known good: bad input gives one line
         new, what = _RENAMED[old]
         print(f"warning: {old} is deprecated, use {new} ({what})", file=sys.stderr)
@@ -210,11 +232,68 @@ def run(args) -> int:
                 raise InputError(err.message, file=path[f], field=f) from None
         else:
             paths = {"FRF": args.frf, "--frf-y": args.frf_y, "--frf-xy": args.frf_xy, "--frf-yx": args.frf_yx}
-            res = _sdm(dict(frfs, FRF=frf_x), paths, n_modes, cut, rpm, accuracy)
+            res = _sdm(dict(frfs, FRF=frf_x), paths, n_modes, cut, rpm, accuracy, noise)
     fig = _figure(res) if outs["plot"] else None
     _write(outs, res, fig)
-    _summary(res, outs)
+    for note in notes:
+        print(note, file=sys.stderr)
+    edge, min_at_edge = _edge_warning(res, band, data_hz)
+    _summary(res, outs, edge, min_at_edge)
     return 0
+
+
+def _trusted_band(frf_x, frfs, args, band):
+    """Every FRF cut to one band: the ``--band`` given, or the intersection of the files' trusted bands.
+
+    Returns the cut x FRF, the other FRFs, the band (Hz), the notes to print
+    once the lobes are written, and per flag the quantity each FRF's noise looks white in
+    (``TrustedBand.noise_quantity``, None when not found; the SDM's modal fit is weighted in it).
+    A given band outside an FRF's data is an InputError naming that file and ``--band``.
+    """
+    paths = {"FRF": args.frf, "--frf-y": args.frf_y, "--frf-xy": args.frf_xy, "--frf-yx": args.frf_yx}
+    given = {"FRF": frf_x, **{k: v for k, v in frfs.items() if v is not None}}
+    found = {k: trusted(g, paths[k], band) for k, g in given.items()}
+    lo = max(tb.lo_hz for _, tb, _ in found.values())
+    hi = min(tb.hi_hz for _, tb, _ in found.values())
+    notes = [note for _, _, note in found.values() if note]
+    noise = {k: tb.noise_quantity or None for k, (_, tb, _) in found.items()}
+    if band is not None:
+        notes = [found["FRF"][2].replace(f"{args.frf}: ", "")]
+    if lo >= hi:
+        each = ", ".join(f"{k} {tb.lo_hz:g}–{tb.hi_hz:g} Hz" for k, (_, tb, _) in found.items())
+        raise InputError(f"the trusted bands of the FRFs do not overlap ({each}): give --band LO:HI",
+                         file=args.frf, field="--band")
+    f = frf_x.freq_hz
+    if (lo, hi) == (f[0], f[-1]):
+        return frf_x, frfs, (lo, hi), notes, noise
+    cut = {k: (None if g is None else _covering(g, lo, hi)) for k, g in frfs.items()}
+    return frf_x.band(lo, hi), cut, (lo, hi), notes, noise
+
+
+def _covering(frf, lo, hi):
+    """``frf`` cut to the smallest run of its own points that covers [lo, hi] Hz (another grid: no extrapolation)."""
+    f = frf.freq_hz
+    a = f[f <= lo][-1] if np.any(f <= lo) else f[0]
+    b = f[f >= hi][0] if np.any(f >= hi) else f[-1]
+    return frf.band(a, b)
+
+
+def _edge_warning(res, band, data_hz):
+    """Say on stderr which limits rest on a chatter frequency at a cutting edge of the band.
+
+    Returns their mask over the speeds, and whether the absolute minimum's chatter frequency is at an edge.
+    """
+    from ..trust import edge_hits
+
+    edge = edge_hits(res.chatter_hz, band, data_hz) & np.isfinite(res.depth_m)
+    min_at_edge = bool(edge_hits([res.min_chatter_hz], band, data_hz)[0])
+    if edge.any():
+        r = res.rpm[edge]
+        print(f"warning: at {edge.sum()} of {res.rpm.size} speeds ({r.min():.0f}–{r.max():.0f} rpm) the limiting "
+              f"chatter frequency lies at the edge of the band {band[0]:g}–{band[1]:g} Hz: those limits are not "
+              "trusted (the resonance behind them may lie outside the band); check the FRF there and set "
+              "--band LO:HI", file=sys.stderr)
+    return edge, min_at_edge
 
 
 def _outputs(args) -> dict:
@@ -238,37 +317,36 @@ def _outputs(args) -> dict:
     return outs
 
 
-# A one-mode fit that leaves this relative RMS error explains < 10 % of the FRF's energy: no resonance.
+# A modal fit that leaves this relative RMS error explains < 10 % of the FRF's energy: no resonance.
 _NO_RESONANCE = 0.95
 # A final fit worse than this explains < 75 % of the FRF: lobes from it would describe another structure.
 _BAD_FIT = 0.5
 
 
-def _fit_one(frf, flag, path, n_modes):
-    """Real modes of one direct receptance (``stability.fit_modes``), refused when there is nothing to fit.
+def _fit_one(frf, flag, path, n_modes, noise=None):
+    """Complex modes of one direct receptance (``dynamics.modal.fit_frfs``), refused when there is nothing to fit.
 
-    A one-mode probe first: noise has no resonance, and the automatic search
-    for more modes would spend seconds fitting noise before failing.
+    ``noise``: the quantity the FRF's noise is white in (``"accelerance"`` for a receptance whose
+    noise grows as 1/ω², found by the trusted band), passed to the fit's weighting.
+
+    Refused (one line naming the file and flag): a fit that leaves ≥ 95 % of the FRF
+    unexplained (no resonance: noise only), a fit with no mode inside the band (the
+    resonance lies outside it), or one that leaves > 50 % unexplained.
     """
-    from ..stability import fit_modes
+    from ..dynamics.modal import fit_frfs
 
     try:
-        if n_modes is None:
-            probe = fit_modes(frf, 1)
-            if probe.fit_error >= _NO_RESONANCE:
-                raise InputError(f"no resonance found for --method sdm: the best one-mode fit leaves "
-                                 f"{100 * probe.fit_error:.0f} % (relative RMS) unexplained (noise only?)")
-        fit = fit_modes(frf, n_modes)
+        fit = fit_frfs([frf], n_modes=n_modes, noise=noise)
     except InputError as err:
-        msg = err.message
-        if "no mode with a non-zero residue" in msg:
-            msg = "no resonance found for --method sdm (modal fit: no mode with a non-zero residue; noise only?)"
-        raise InputError(msg, file=path, field=flag) from None
-    lo, hi = frf.freq_hz[frf.freq_hz > 0][[0, -1]]
-    inside = (fit.fn_hz > lo * (1 + 1e-6)) & (fit.fn_hz < hi * (1 - 1e-6))
-    if not inside.any():
-        raise InputError(f"no mode inside the FRF's band {lo:g}–{hi:g} Hz for --method sdm (the fitted mode "
-                         "sits on the band edge: the resonance lies outside the measured band)", file=path, field=flag)
+        raise InputError(err.message, file=path, field=flag) from None
+    if np.max(fit.fit_error) >= _NO_RESONANCE:
+        raise InputError(f"no resonance found for --method sdm: the modal fit ({fit.n_modes} modes) leaves "
+                         f"{100 * np.max(fit.fit_error):.0f} % (relative RMS) of the FRF unexplained (noise only?)",
+                         file=path, field=flag)
+    if fit.n_modes == 0:
+        lo, hi = fit.band_hz
+        raise InputError(f"no mode inside the FRF's band {lo:g}–{hi:g} Hz for --method sdm (the resonance lies "
+                         "outside the measured band)", file=path, field=flag)
     _check_fit(fit.fit_error, flag, path)
     return fit
 
@@ -306,12 +384,13 @@ def _cross_model(frfs, paths, n_modes):
     return from_modal_fit(fits[0], fits[1])
 
 
-def _sdm(frfs, paths, n_modes, cut, rpm, accuracy):
+def _sdm(frfs, paths, n_modes, cut, rpm, accuracy, noise=None):
     """Fit modes to the FRFs (printing them) and run the semi-discretisation, reporting progress on stderr.
 
-    Without cross FRFs: real modes per direction (``stability.fit_modes``);
-    with ``--frf-xy``/``--frf-yx``: a common-pole fit per force direction and
-    its state-space realisation (``stability.statespace.from_modal_fit``).
+    Without cross FRFs: complex modes per direction (``dynamics.modal.fit_frfs``);
+    with ``--frf-xy``/``--frf-yx``: a common-pole fit per force direction; either way
+    the fits' state-space realisation (``stability.statespace.from_modal_fit``). ``noise``: per flag the
+    quantity the FRF's noise is white in (None: its own), for the weighting of the direct fits.
     """
     from ..progress import Progress
     from ..stability import sdm_lobes
@@ -319,15 +398,19 @@ def _sdm(frfs, paths, n_modes, cut, rpm, accuracy):
     if frfs["--frf-xy"] is not None or frfs["--frf-yx"] is not None:
         model, my = _cross_model(frfs, paths, n_modes), None
     else:
+        from ..stability.statespace import from_modal_fit
+
         frf_x, frf_y = frfs["FRF"], frfs["--frf-y"]
-        model = _fit_one(frf_x, "FRF", paths["FRF"], n_modes)
-        print(f"modal fit, x ({frf_x.label or 'FRF'}):\n{model.table()}")
+        noise = noise or {}
+        fx = _fit_one(frf_x, "FRF", paths["FRF"], n_modes, noise.get("FRF"))
+        print(f"modal fit, x ({frf_x.label or 'FRF'}):\n{fx.table()}")
+        fy = None
         if frf_y is None:
-            my = model
             print("y: same modes as x (symmetric tool)")
         else:
-            my = _fit_one(frf_y, "--frf-y", paths["--frf-y"], n_modes)
-            print(f"modal fit, y ({frf_y.label or 'FRF_Y'}):\n{my.table()}")
+            fy = _fit_one(frf_y, "--frf-y", paths["--frf-y"], n_modes, noise.get("--frf-y"))
+            print(f"modal fit, y ({frf_y.label or 'FRF_Y'}):\n{fy.table()}")
+        model, my = from_modal_fit(fx, fy), None
     with Progress(rpm.size, "semi-discretisation", "speed") as bar:
         res = sdm_lobes(model, my, cut, rpm=rpm, accuracy=accuracy,
                         progress=lambda done, total: bar.update(done - bar.n))
@@ -374,11 +457,20 @@ def _write(outs, res, fig) -> None:
             fig.savefig(tmp, format=outs["plot"].suffix.lstrip(".").lower(), dpi=130)
 
 
-def _summary(res, outs) -> None:
-    """Print the minimum, the best pocket and what was written."""
+def _summary(res, outs, edge=None, at_edge=False) -> None:
+    """Print the minimum, the best pocket and what was written.
+
+    ``edge``: speeds whose limit is not trusted; ``at_edge``: the absolute minimum is not.
+    """
     if np.isfinite(res.min_depth_m):
         print(f"absolute minimum depth: {1e3 * res.min_depth_m:.4g} mm at {res.min_rpm:.0f} rpm "
-              f"(chatter {res.min_chatter_hz:.1f} Hz)")
+              f"(chatter {res.min_chatter_hz:.1f} Hz)" + (" — not trusted: chatter at the band edge" if at_edge
+                                                          else ""))
+        if at_edge and edge is not None and not edge.all():
+            k = int(np.argmin(np.where(edge, np.inf, res.depth_m)))
+            if np.isfinite(res.depth_m[k]):
+                print(f"lowest trusted limit: {res.depth_mm[k]:.4g} mm at {res.rpm[k]:.0f} rpm "
+                      f"(chatter {res.chatter_hz[k]:.1f} Hz)")
     else:
         print("no chatter found in the speed range (no lobe reaches it)")
     pr, pd = res.pocket()

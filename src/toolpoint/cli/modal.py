@@ -19,6 +19,7 @@ accelerance are iω H and −ω² H.)
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +29,7 @@ from ..errors import InputError
 from ..frf import FRF
 from ..io.atomic import atomic_open
 from ..io.frf_files import read_frf
-from .common import out_path, save_figure, use_agg, warnings_to_stderr
+from .common import out_path, parse_band, save_figure, trusted, use_agg, warnings_to_stderr
 
 QUANTITIES = ("receptance", "mobility", "accelerance")
 
@@ -42,7 +43,9 @@ def register(sub) -> None:
     p.add_argument("--quantity", choices=QUANTITIES,
                    help="what the files hold (default: as each file says; CSV means receptance); the fit is "
                    "weighted in it (noise white in the measured quantity)")
-    p.add_argument("--band", metavar="LO:HI", help="fit only from LO to HI Hz (default: all points above 0 Hz)")
+    p.add_argument("--band", metavar="LO:HI",
+                   help="fit only from LO to HI Hz (default: the trusted band found in the data — low-frequency "
+                   "noise ×1/ω² and low coherence left out, with a note — above 0 Hz)")
     p.add_argument("--modes", default="auto", metavar="N|auto",
                    help="number of modes, or auto (default: chosen by the Bayesian information criterion)")
     p.add_argument("--out", required=True,
@@ -50,21 +53,6 @@ def register(sub) -> None:
                    "constants of the receptance, m/N × rad/s = m/(N s)")
     p.add_argument("--plot", help="figure: measured vs fitted magnitude and phase per FRF (PNG/PDF/SVG)")
     p.set_defaults(func=run)
-
-
-def parse_band(text: str | None) -> tuple[float, float] | None:
-    """``"LO:HI"`` → (LO, HI) Hz with 0 ≤ LO < HI finite; None → None; otherwise an InputError."""
-    if text is None:
-        return None
-    lo, sep, hi = text.partition(":")
-    try:
-        band = (float(lo), float(hi))
-    except ValueError:
-        band = None
-    if not sep or band is None or not (np.all(np.isfinite(band)) and 0 <= band[0] < band[1]):
-        raise InputError(f"expected LO:HI in Hz with 0 ≤ LO < HI, got {text!r}", file="command line",
-                         field="--band")
-    return band
 
 
 def parse_modes(text: str) -> int | None:
@@ -92,13 +80,15 @@ def run(args) -> int:
     n_modes = parse_modes(args.modes)
     with warnings_to_stderr():
         frfs = [read_frf(path, quantity=args.quantity) for path in args.frf]
+        band, notes = _trusted(frfs, args.frf, band)
         _check(frfs, args.frf, band)
         try:
             fit = fit_frfs(frfs, band=band, n_modes=n_modes)
         except InputError as e:
-            if e.field != "band":
+            flag = {"band": "--band", "n_modes": "--modes"}.get(e.field)
+            if flag is None:
                 raise
-            raise InputError(e.message, file="command line", field="--band") from None
+            raise InputError(e.message, file="command line", field=flag) from None
     if plot:  # render first: a plotting failure must not leave a CSV without its figure
         fig = _figure(frfs, fit, args.frf)
     _write_modes(out, fit)
@@ -106,7 +96,27 @@ def run(args) -> int:
         save_figure(fig, plot)
     print(fit.table())
     print(f"{fit.n_modes} modes, {fit.band_hz[0]:g}–{fit.band_hz[1]:g} Hz, {len(frfs)} FRFs → {out}")
+    for note in notes:
+        print(note, file=sys.stderr)
     return 0
+
+
+def _trusted(frfs, paths, band):
+    """The band to fit: given (checked against every file), or the trusted band of every file (intersection).
+
+    Returns the band (None: all of it) and the notes to print once the fit has succeeded.
+    """
+    tbs = [trusted(g, path, band)[1:] for g, path in zip(frfs, paths)]
+    if band is not None:
+        return band, [tbs[0][1].replace(f"{paths[0]}: ", "")]
+    notes = [note for _, note in tbs if note]
+    if not notes:
+        return None, []
+    lo, hi = max(tb.lo_hz for tb, _ in tbs), min(tb.hi_hz for tb, _ in tbs)
+    if lo >= hi:
+        return None, notes + ["note: the trusted bands of the files do not overlap: all of the band fitted"]
+    f = frfs[0].freq_hz
+    return (None if (lo, hi) == (f[0], f[-1]) else (lo, hi)), notes
 
 
 def _check(frfs, paths, band) -> None:

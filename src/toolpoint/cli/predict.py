@@ -28,11 +28,15 @@ def run(args) -> int:
     """Predict the joint of a tool (D, L in mm) from the learned models and write its tool-point FRF."""
     from ..campaign.predict import predict_frf
 
+    from ..campaign.results import MAX_LENGTH_MM
+
     for name in ("diameter", "overhang"):
-        if not (math.isfinite(getattr(args, name)) and getattr(args, name) > 0):
-            raise InputError("must be a finite number > 0 (mm)", file="command line", field=f"--{name}")
-    out = out_path(args.out, "--out")
-    plot = out_path(args.plot, "--plot") if args.plot else None
+        if not (math.isfinite(getattr(args, name)) and 0 < getattr(args, name) <= MAX_LENGTH_MM):
+            raise InputError(f"must be a number > 0 and ≤ {MAX_LENGTH_MM:g} mm, got {getattr(args, name):g}",
+                             file="command line", field=f"--{name}")
+    inputs = _inputs(args)
+    out = out_path(args.out, "--out", inputs=inputs)
+    plot = out_path(args.plot, "--plot", inputs=inputs) if args.plot else None
     with warnings_to_stderr():
         frf, joint, notes = predict_frf(args.source, args.diameter, args.overhang, args.models, holder=args.holder)
     for n in notes:
@@ -52,3 +56,13 @@ def run(args) -> int:
     print("predicted joint: " + ", ".join(f"{p} = {v:.4g} {UNITS[p]}" for p, v in zip(PARAMS, joint)))
     print(f"dominant peak {f_pk:g} Hz, |h| = {h_pk:.4g} m/N → {out}")
     return 0
+
+
+def _inputs(args) -> list:
+    """Every file ``predict`` reads: the source (or, for a campaign folder, its files) and the models."""
+    from pathlib import Path
+
+    files = []
+    for root in (Path(args.source), Path(args.models)):
+        files += [q for q in root.rglob("*") if q.is_file()] if root.is_dir() else [root]
+    return files

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 
 def register(sub) -> None:
     """Add the ``report`` sub-command."""
@@ -19,6 +21,8 @@ def run(args) -> int:
     from ..recommend.report import write_report
 
     use_agg()
-    out = out_path(args.out, "--out") if args.out else None
+    d = Path(args.dir)
+    inputs = [d / "recommendations.csv", *sorted((d / "tools").glob("*"))]  # what the report reads
+    out = out_path(args.out, "--out", inputs=inputs) if args.out else None
     print(f"report → {write_report(args.dir, out)}")
     return 0

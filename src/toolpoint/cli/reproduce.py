@@ -54,6 +54,11 @@ def run(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise InputError("exists and is not a folder", file=out, field="--out")
+    parent = out
+    while not parent.exists():  # the first existing ancestor must be a folder, checked before any work
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InputError(f"cannot write under {parent}: it is a file, not a folder", file=out, field="--out")
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     if not methods:
         raise InputError("names no method (give e.g. ga,sa,pso,hybrid)", file="command line", field="--methods")

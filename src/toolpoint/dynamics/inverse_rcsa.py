@@ -221,7 +221,7 @@ def _common_grid(frfs: dict[str, FRF], ref: str) -> np.ndarray:
 
 def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G22: FRF, *,
                            G21: FRF | None = None, smooth: float | None = None,
-                           polyorder: int = 3) -> Subassembly:
+                           polyorder: int = 3, band=None) -> Subassembly:
     """Inverse RCSA: the holder-tip receptance SH = [[h, l], [n, p]] from three measured FRFs.
 
     Parameters
@@ -237,8 +237,13 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
         G11 was measured in: ``meta["file_quantity"]``, else its ``quantity``), which removes
         the noise and keeps the peaks (recommended); or a Savitzky–Golay window in Hz
         applied to the result (:func:`smooth_subassembly`, ``polyorder``).
+    band : None, (lo, hi) in Hz, or ``"auto"`` — use the measured FRFs in this band only
+        (None: all of it); ``"auto"``: the intersection of their trusted bands
+        (:func:`toolpoint.trust.trusted_band`: low-frequency noise ×1/ω², low
+        coherence), named in the label when it cuts anything. A band with fewer
+        than two points of the data is an InputError (field ``band``).
 
-    Returns a :class:`Subassembly` on the FRFs' grid: h m/N, l 1/N, n rad/N,
+    Returns a :class:`Subassembly` on the FRFs' grid (inside ``band``): h m/N, l 1/N, n rad/N,
     p rad/(N m), with l = n. See the module docstring for the equations.
     Raises :class:`InputError` naming the FRF whose grid differs, or for a
     point outside the blank.
@@ -247,7 +252,9 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
     given = {"G11": G11, "G12": G12, "G22": G22}
     if G21 is not None:
         given["G21"] = G21
-    f = check_freq_hz(_common_grid(given, "G11"), field="G11", positive=True)  # free–free blank: no 0 Hz
+    _common_grid(given, "G11")
+    given, cut = _blank_band(given, band)
+    f = check_freq_hz(given["G11"].freq_hz, field="G11", positive=True)  # free–free blank: no 0 Hz
     g = {k: v.to_receptance().values for k, v in given.items()}
     g12 = 0.5 * (g["G12"] + g["G21"]) if G21 is not None else g["G12"]
     Gm = np.stack([g["G11"], g12, g["G22"]], -1)
@@ -263,8 +270,31 @@ def subassembly_from_blank(blank: Component, x2_m: float, G11: FRF, G12: FRF, G2
     SH = inv2(X) - R[:, ROOT, ROOT]
     SH[:, 1, 0] = SH[:, 0, 1] = 0.5 * (SH[:, 0, 1] + SH[:, 1, 0])  # equal up to round-off
     sub = Subassembly(f, SH, f"spindle–holder (inverse RCSA, blank {blank.length * 1e3:g} mm, "
-                             f"x2 {float(x2_m) * 1e3:g} mm{label})")
+                             f"x2 {float(x2_m) * 1e3:g} mm{label}{cut})")
     return sub if smooth is None or _is_modal(smooth) else smooth_subassembly(sub, float(smooth), polyorder)
+
+
+def _blank_band(given: dict, band) -> tuple[dict, str]:
+    """The measured FRFs cut to ``band`` (None, (lo, hi) Hz or "auto"), and a label part naming the cut."""
+    from ..trust import trusted_band
+
+    if band is None:
+        return given, ""
+    if isinstance(band, str):
+        if band != "auto":
+            raise InputError(f'band must be (lo, hi) in Hz or "auto", got {band!r}', field="band")
+        tbs = {k: trusted_band(v, file=v.meta.get("source")) for k, v in given.items()}
+        lo, hi = max(t.lo_hz for t in tbs.values()), min(t.hi_hz for t in tbs.values())
+        why = "; ".join(f"{k}: {t.reason}" for k, t in tbs.items() if t.reason)
+        if lo >= hi:
+            raise InputError(f"the trusted bands of the measured FRFs do not overlap ({why})", field="band")
+    else:
+        tb = trusted_band(given["G11"], band=band, field="band")
+        lo, hi, why = tb.lo_hz, tb.hi_hz, "given"
+    f = given["G11"].freq_hz
+    if (lo, hi) == (f[0], f[-1]):
+        return given, ""
+    return {k: v.band(lo, hi) for k, v in given.items()}, f", band {lo:g}–{hi:g} Hz: {why}"
 
 
 def _modal_fit(f, Y, noise: str = "receptance"):

@@ -164,7 +164,7 @@ class ReceptanceModel:
 
     def __init__(self, assembly: Assembly, freq_hz, points, variable, *, with_tool: bool | None = None,
                  max_beta_l: float | None = None, rot: dict | None = None):
-        f = check_freq_hz(np.sort(np.asarray(freq_hz, float)), positive=True)
+        f = check_freq_hz(np.unique(np.asarray(freq_hz, float)), positive=True)  # grids may repeat
         self.freq_hz = np.asarray(freq_hz, float)
         self.omega = w = 2 * np.pi * self.freq_hz
         self.assembly = a = assembly
@@ -247,6 +247,8 @@ class ReceptanceModel:
         self.G0 = G
         self._D = self._incidence(self.elements, k)
         self.P = np.einsum("km,fkl,ln->fmn", self._D, G, self._D)
+        self._symmetric = bool(np.allclose(self.P, np.swapaxes(self.P, -1, -2), rtol=1e-10, atol=0.0))
+        self._uv_cache: dict = {}
 
     # ------------------------------------------------------------------ internals
     @staticmethod
@@ -311,18 +313,23 @@ class ReceptanceModel:
         """
         v = self._check(values)
         di, dj = self._point_dof[i], self._point_dof[j]
-        G, D = self.G0[sl], self._D
+        G = self.G0[sl]
         w = self.omega[sl]
         kinv = self._kinv_sl(v, sl)  # (N, F, m)
-        m = D.shape[1]
+        m = self._D.shape[1]
         M = self.P[sl][None] + kinv[..., None] * np.eye(m)
-        Vj = np.einsum("km,fk->fm", D, G[:, :, dj])
-        Ui = np.einsum("fk,km->fm", G[:, di, :], D)
-        b = np.linalg.solve(M, np.broadcast_to(Vj[None, ..., None], M.shape[:-1] + (1,)))[..., 0]  # (N, F, m)
+        Ui, Vj = self._uv(di, dj, sl)
+        if jac and self._symmetric:  # reciprocity: Mᵀ = M, one solve for both right-hand sides
+            ab = np.linalg.solve(M, np.broadcast_to(np.stack([Vj, Ui], -1)[None], M.shape[:-1] + (2,)))
+            b, a = ab[..., 0], ab[..., 1]
+        else:
+            b = np.linalg.solve(M, np.broadcast_to(Vj[None, ..., None], M.shape[:-1] + (1,)))[..., 0]  # (N, F, m)
         h = G[None, :, di, dj] - np.einsum("fm,nfm->nf", Ui, b)
         if not jac:
             return h, None
-        a = np.linalg.solve(np.swapaxes(M, -1, -2), np.broadcast_to(Ui[None, ..., None], M.shape[:-1] + (1,)))[..., 0]
+        if not self._symmetric:
+            a = np.linalg.solve(np.swapaxes(M, -1, -2),
+                                np.broadcast_to(Ui[None, ..., None], M.shape[:-1] + (1,)))[..., 0]
         ab = a * b  # (N, F, m): ∂h/∂(K⁻¹_e) = a_e b_e
         out = np.zeros((v.shape[0], len(self.elements), 4, w.size), complex)
         col = 0
@@ -334,6 +341,63 @@ class ReceptanceModel:
                 out[:, e_i, 2 * slot + 1] = dk * 1j * w
                 col += 1
         return h, out
+
+    def minors(self, i: Point, j: Point, sl: slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
+        r"""The receptance between ``i`` and ``j`` as a ratio of polynomials in the element stiffnesses.
+
+        With k̃_d = k_d + iω c_d the complex stiffness of variable DOF d (the columns of the incidence D,
+        element by element, translation before rotation) and K = diag(k̃), expanding the determinants of
+        M = K⁻¹ + P and of the bordered matrix Q = [[P, V_j], [U_iᵀ, G₀,ij]] in the diagonal terms gives
+
+            h_ij = Σ_T num_T Π_{d∈T} k̃_d / Σ_T den_T Π_{d∈T} k̃_d,
+            den_T = det P[T, T],  num_T = det Q[T ∪ {m}, T ∪ {m}],
+
+        summed over the 2^m subsets T of the m variable DOFs (den_∅ = 1, num_∅ = G₀,ij).
+
+        Returns
+        -------
+        num, den : (F, 2^m) complex ndarray
+            Coefficients, column ``mask`` for the subset T = {d : bit d of mask set}; m/N · (N/m)^|T| units.
+
+        Examples
+        --------
+        >>> from toolpoint.dynamics.assembly import load_assembly
+        >>> a = load_assembly("examples/numerical_case.toml")
+        >>> f = np.array([500.0, 1500.0])
+        >>> tip = parse_point("holder_tip")
+        >>> m = ReceptanceModel(a, f, [tip], ["spindle_holder"], with_tool=False)
+        >>> num, den = m.minors(tip, tip)
+        >>> kt, ct, kr, cr = a.spindle_holder.as_array()
+        >>> k = np.stack([kt + 1j * m.omega * ct, kr + 1j * m.omega * cr], -1)
+        >>> mono = np.stack([np.ones(2), k[:, 0], k[:, 1], k[:, 0] * k[:, 1]], -1)
+        >>> h = (num * mono).sum(1) / (den * mono).sum(1)
+        >>> bool(np.allclose(h, m.frf(a.spindle_holder.as_array()[None, None], tip, tip)[0], rtol=1e-9))
+        True
+        """
+        G, D = self.G0[sl], self._D
+        di, dj = self._point_dof[i], self._point_dof[j]
+        m = D.shape[1]
+        Q = np.empty((G.shape[0], m + 1, m + 1), complex)
+        Q[:, :m, :m] = self.P[sl]
+        Q[:, :m, m] = np.einsum("km,fk->fm", D, G[:, :, dj])
+        Q[:, m, :m] = np.einsum("fk,km->fm", G[:, di, :], D)
+        Q[:, m, m] = G[:, di, dj]
+        num = np.empty((G.shape[0], 2**m), complex)
+        den = np.empty_like(num)
+        for mask in range(2**m):
+            idx = [d for d in range(m) if mask >> d & 1]
+            den[:, mask] = np.linalg.det(Q[:, idx][:, :, idx]) if idx else 1.0
+            idx.append(m)
+            num[:, mask] = np.linalg.det(Q[:, idx][:, :, idx])
+        return num, den
+
+    def _uv(self, di: int, dj: int, sl: slice):
+        """U_i = (G₀ D)_i and V_j = (Dᵀ G₀)_j on ``sl`` (F, m), cached per (i, j, slice)."""
+        key = (di, dj, sl.start, sl.stop, sl.step)
+        if key not in self._uv_cache:
+            G, D = self.G0[sl], self._D
+            self._uv_cache[key] = (np.einsum("fk,km->fm", G[:, di, :], D), np.einsum("km,fk->fm", D, G[:, :, dj]))
+        return self._uv_cache[key]
 
     def _kinv_sl(self, v, sl):
         w_all = self.omega

@@ -22,12 +22,12 @@ from scipy.optimize import OptimizeResult
 from ..dynamics.assembly import Assembly
 from ..dynamics.model import ToolPointModel
 from ..dynamics.subassembly import Subassembly
-from ..errors import IdentifiabilityWarning
+from ..errors import IdentifiabilityWarning, InputError
 from ..frf import FRF
 from .objective import JointProblem
 from .optim import METHODS, Termination, check_method
-from .params import PARAMS, Bounds
-from .uncertainty import identifiability_warnings, intervals_and_correlation
+from .params import PARAMS, UNITS, Bounds
+from .uncertainty import identifiability_warnings, intervals_and_correlation, open_end_warnings, profile_intervals
 
 __all__ = ["IdentificationResult", "make_algorithm", "model_for", "identify", "relative_errors"]
 
@@ -110,6 +110,9 @@ class IdentificationResult:
         Correlation of the log10 estimates (:func:`~toolpoint.identification.uncertainty.intervals_and_correlation`).
     model_frfs : tuple of FRF
         The model at every measured point (``model_frf`` is the first).
+    intervals : str
+        How ``ci95`` was made: ``"linear"`` (linearised at the optimum, :func:`identify`) or ``"profile"``
+        (profile likelihood, the default of :func:`~toolpoint.identification.problem.identify_frfs`).
     """
 
     params: dict
@@ -126,6 +129,7 @@ class IdentificationResult:
     names: tuple = PARAMS
     correlation: np.ndarray | None = None
     model_frfs: tuple = ()
+    intervals: str = "linear"
 
     @property
     def fun(self) -> float:
@@ -177,6 +181,7 @@ def identify(
     options: dict | None = None,
     termination: Termination | None = None,
     callback=None,
+    intervals: str = "linear",
 ) -> IdentificationResult:
     """Identify the holder–tool joint p = [kt, ct, kr, cr] from a measured tool-point FRF.
 
@@ -201,6 +206,10 @@ def identify(
         Deprecated: use ``options`` (``maxiter``, ``maxfev``, ``stall_iter``, ``tol``, ``f_target``).
     callback : callable, optional
         ``callback(nit, best_f, nfev)`` after every iteration.
+    intervals : {"linear", "profile"}, default "linear"
+        95 % intervals linearised at the optimum, or from the profile likelihood
+        (:func:`~toolpoint.identification.uncertainty.profile_intervals`; an end that reaches a search bound
+        is then also a warning).
 
     Returns
     -------
@@ -222,6 +231,8 @@ def identify(
     >>> r.success, round(r.params["kt"] / 2.1e7, 6), r.warnings
     (True, 1.0, ())
     """
+    if intervals not in ("profile", "linear"):
+        raise InputError(f"unknown interval method {intervals!r} (profile or linear)", field="intervals")
     if not np.array_equal(measured.freq_hz, model.freq_hz):
         raise ValueError("measured FRF and model frequencies differ: build the model on measured.freq_hz")
     algo = make_algorithm(method, options)
@@ -235,8 +246,13 @@ def identify(
     opt = algo.minimize(problem, rng, callback=callback)
     x_log = np.asarray(opt.x, float)
     ci, se, corr = intervals_and_correlation(problem, x_log)
+    extra = ()
+    if intervals == "profile":
+        prof = profile_intervals(problem, x_log, se)
+        ci = prof.ci
+        extra = tuple(open_end_warnings(prof, PARAMS, UNITS))
     seconds = time.perf_counter() - t0  # includes the uncertainty step
-    found = tuple(identifiability_warnings(x_log, ci, problem.bounds, corr=corr))
+    found = tuple(identifiability_warnings(x_log, ci, problem.bounds, corr=corr)) + extra
     for w in found:
         warnings.warn(w, IdentifiabilityWarning, stacklevel=2)
     x = 10.0**x_log
@@ -254,6 +270,7 @@ def identify(
         optimizer=opt,
         correlation=corr,
         model_frfs=(),
+        intervals=intervals,
     )
 
 

@@ -32,13 +32,30 @@ from ..frf import FRF
 from .identify import IdentificationResult, make_algorithm
 from .objective import JointProblem
 from .params import DEFAULT_BOUNDS, ELEMENT_PARAMS, ELEMENT_UNITS, Bounds
-from .uncertainty import identifiability_warnings, intervals_and_correlation
+from .uncertainty import identifiability_warnings, intervals_and_correlation, open_end_warnings, profile_intervals
 
 __all__ = ["Measured", "parse_params", "param_bounds", "FRFProblem", "identify_frfs"]
 
 _NAME = re.compile(r"^(spindle_holder|holder_tool|bearings\[(\d+)\])\.(\w+)$")
 BLOCK = 4
 """Population members per block of the general (Woodbury) path: (BLOCK, F, m, m) temporaries."""
+POLY_MAX_DOF = 6
+"""Variable spring DOFs up to which the general path evaluates populations in the polynomial form
+(2^m + m 2^(m−1) coefficient rows: 48 for m = 4, 256 for m = 6); above, the Woodbury solves."""
+POLY_BLOCK = 16
+"""Population members per block of the polynomial form."""
+
+
+@dataclass(frozen=True)
+class _Poly:
+    """Polynomial form of the general path (FRFProblem._polynomial)."""
+
+    dofs: list  # (element index, 0 translation / 1 rotation) per variable spring DOF
+    cols: list  # (subset mask, number of damping factors) per coefficient row
+    E: np.ndarray  # (n_cols, 2ΣF) real view of √w (num − h̄ den)
+    D: np.ndarray  # (n_cols, 2ΣF) real view of den
+    N: np.ndarray  # (n_cols, ΣF) complex √w num
+    Dc: np.ndarray  # (n_cols, ΣF) complex den
 
 
 @dataclass(frozen=True)
@@ -220,6 +237,9 @@ class FRFProblem:
         self.residual_scale = float(np.sqrt(np.mean(np.abs(self._meas) ** 2))) or 1.0
         self.fast = len(variable) == 1
         self._nfev = 0
+        self._poly = None
+        if not self.fast and self.model._D.shape[1] <= POLY_MAX_DOF:
+            self._poly = self._polynomial()
         if self.fast:
             parts = [self.model.coupler(m.response, m.force, sl) for m, sl in zip(self.measurements, self._slices)]
             c = ToolPointCoupler.from_parts(
@@ -234,6 +254,68 @@ class FRFProblem:
             self._inner = JointProblem(c, self._meas, Bounds(full_lo, full_hi))
             with np.errstate(divide="ignore"):
                 self._base_log = np.log10(np.nan_to_num(self._base[0], nan=1.0))
+
+    def _polynomial(self):
+        """Real matrices of the polynomial form of every measurement (see :meth:`_evaluate_poly`)."""
+        dofs = [(e_i, s) for e_i, e in enumerate(self.model.elements) for s in ((0, 1) if e.rot else (0,))]
+        m = len(dofs)
+        cols = []  # (mask, q): coefficient of (iω)^q times the sum of the products with q damping factors
+        for mask in range(2**m):
+            cols += [(mask, q) for q in range(bin(mask).count("1") + 1)]
+        E = np.empty((len(cols), self._meas.size), complex)
+        Dn = np.empty_like(E)
+        for meas, sl in zip(self.measurements, self._slices):
+            num, den = self.model.minors(meas.response, meas.force, sl)
+            iw = 1j * self.model.omega[sl]
+            for r, (mask, q) in enumerate(cols):
+                Dn[r, sl] = den[:, mask] * iw**q
+                E[r, sl] = num[:, mask] * iw**q
+        Nw = E * self._sw  # weighted numerator: √w h = Nw·μ / Dn·μ
+        E = Nw - self._meas * Dn  # e = √w (num − h̄ den), f² = Σ |e|² / |den|²
+        return _Poly(dofs, cols, np.ascontiguousarray(E.view(float)), np.ascontiguousarray(Dn.view(float)), Nw, Dn)
+
+    def _monomials(self, v) -> np.ndarray:
+        """(N, n_cols) products Σ Π k or c over each subset's DOFs, grouped by the number of c's."""
+        dofs = self._poly.dofs
+        N = v.shape[0]
+        polys = {0: np.ones((N, 1))}
+        for mask in range(1, 2 ** len(dofs)):
+            d = mask.bit_length() - 1
+            prev = polys[mask ^ (1 << d)]
+            e_i, s = dofs[d]
+            k, c = v[:, e_i, 2 * s, None], v[:, e_i, 2 * s + 1, None]
+            new = np.zeros((N, prev.shape[1] + 1))
+            new[:, :-1] += prev * k
+            new[:, 1:] += prev * c
+            polys[mask] = new
+        return np.concatenate([polys[mask] for mask in range(2 ** len(dofs))], axis=1)
+
+    def _evaluate_poly(self, X) -> np.ndarray:
+        r"""f for X (N, n_var) from the polynomial form (:meth:`~toolpoint.dynamics.points.ReceptanceModel.minors`).
+
+        h = num(k̃)/den(k̃) with num, den polynomials in the DOFs' k̃ = k + iωc; expanded, both are real
+        linear combinations μ(p) of products of the parameters with complex, frequency-dependent
+        coefficients, so a block of members costs two real matrix products, as in the holder–tool joint's
+        :class:`~toolpoint.identification.objective.JointProblem`.
+        """
+        E, Dn = self._poly.E, self._poly.D
+        v = self.values(X)
+        out = np.empty(v.shape[0])
+        for s in range(0, v.shape[0], POLY_BLOCK):
+            mu = self._monomials(v[s : s + POLY_BLOCK])
+            e = mu @ E
+            d = mu @ Dn
+            e *= e
+            d *= d
+            num = e[:, ::2] + e[:, 1::2]  # |e|²
+            out[s : s + POLY_BLOCK] = np.sqrt(np.einsum("ij,ij->i", num, 1.0 / (d[:, ::2] + d[:, 1::2])))
+        return out
+
+    def _poly_model(self, x) -> np.ndarray:
+        """Weighted model √w h (ΣF,) at one x from the polynomial form (residuals; the Jacobian is taken
+        from the Woodbury form, whose derivative does not suffer the ~1e-7 cancellation of ∂(N/D))."""
+        mu = self._monomials(self.values(x))
+        return (mu @ self._poly.N)[0] / (mu @ self._poly.Dc)[0]
 
     # ------------------------------------------------------------------ set-up checks
     def _check_unknowns(self, variable):
@@ -315,6 +397,9 @@ class FRFProblem:
         single = X.ndim == 1
         if self.fast:
             out = self._inner.evaluate(self._full_log(X))
+        elif self._poly is not None:
+            out = self._evaluate_poly(X)
+            self._nfev += out.size
         else:
             h, _ = self._model_stacked(X)
             out = np.linalg.norm(h - self._meas, axis=1)
@@ -327,9 +412,9 @@ class FRFProblem:
         """Stacked real and imaginary weighted residuals (2 ΣF,) at one x, in units of ``residual_scale``."""
         if self.fast:
             return self._inner.residuals(self._full_log(x)[0])
-        h, _ = self._model_stacked(x)
+        h = self._poly_model(x) if self._poly is not None else self._model_stacked(x)[0][0]
         self._nfev += 1
-        r = (h[0] - self._meas) / self.residual_scale
+        r = (h - self._meas) / self.residual_scale
         return np.concatenate([r.real, r.imag])
 
     def jacobian(self, x) -> np.ndarray:
@@ -338,16 +423,17 @@ class FRFProblem:
             J = self._inner.jacobian(self._full_log(x)[0])
             self._inner.nfev += self.n_var - 4
             return J[:, self._slot]
-        _, J = self._model_stacked(x, jac=True)
+        # the Woodbury form: the polynomial form's derivative loses ~1e-7 (relative) to cancellation
+        J = self._model_stacked(x, jac=True)[1][0]
         self._nfev += self.n_var
-        J = J[0] / self.residual_scale
+        J = J / self.residual_scale
         return np.concatenate([J.real, J.imag], axis=1).T
 
     def model_frfs(self, x) -> list[FRF]:
         """The model's receptance at every measurement (unweighted, m/N) at one x; not counted."""
         if self.fast:
             h = self._inner.model(self._full_log(x)[0]) / self._sw
-        else:
+        else:  # the Woodbury solves (also where the polynomial form is used for the search)
             n = self._nfev
             h = self._model_stacked(x)[0][0] / self._sw
             self._nfev = n
@@ -356,7 +442,7 @@ class FRFProblem:
 
 
 def identify_frfs(problem: FRFProblem, method: str = "hybrid", seed: int | None = 0, options: dict | None = None,
-                  callback=None) -> IdentificationResult:
+                  callback=None, intervals: str = "profile") -> IdentificationResult:
     """Identify ``problem``'s parameters: search, 95 % intervals, identifiability and trade-off warnings.
 
     Parameters
@@ -369,28 +455,41 @@ def identify_frfs(problem: FRFProblem, method: str = "hybrid", seed: int | None 
         Options of the optimiser.
     callback : callable, optional
         ``callback(nit, best_f, nfev)``.
+    intervals : {"profile", "linear"}, default "profile"
+        95 % intervals from the profile likelihood (:func:`~.uncertainty.profile_intervals`: follows the
+        curved valleys along which parameters trade off, stops at the search bounds) or linearised at the
+        optimum (:func:`~.uncertainty.intervals_and_correlation`: cheaper, too narrow where the fit is
+        not close to linear — see ``docs/design/identification.md``).
 
     Returns
     -------
     IdentificationResult
-        ``params``, ``ci95``, ``se_log10`` keyed by the full names (``result.names``); ``correlation``;
-        ``model_frfs`` (one per measurement); ``warnings`` include one per pair of parameters whose log10
-        estimates correlate with |ρ| > 0.95.
+        ``params``, ``ci95``, ``se_log10`` (linearised) keyed by the full names (``result.names``);
+        ``correlation`` (linearised); ``model_frfs`` (one per measurement); ``warnings`` include one per
+        pair of parameters whose log10 estimates correlate with |ρ| > 0.95, and one per interval that
+        runs into a search bound.
 
     Warns
     -----
     IdentifiabilityWarning
         Once per entry of ``result.warnings``.
     """
+    if intervals not in ("profile", "linear"):
+        raise InputError(f"unknown interval method {intervals!r} (profile or linear)", field="intervals")
     algo = make_algorithm(method, options)
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
     opt = algo.minimize(problem, rng, callback=callback)
     x_log = np.asarray(opt.x, float)
     ci, se, corr = intervals_and_correlation(problem, x_log)
+    extra = []
+    if intervals == "profile":
+        prof = profile_intervals(problem, x_log, se)
+        ci = prof.ci
+        extra = open_end_warnings(prof, problem.names, problem.units)
     seconds = time.perf_counter() - t0
     found = tuple(identifiability_warnings(x_log, ci, problem.bounds, names=problem.names, units=problem.units,
-                                           corr=corr, pairs=True))
+                                           corr=corr, pairs=True)) + tuple(extra)
     for w in found:
         warnings.warn(w, IdentifiabilityWarning, stacklevel=2)
     x = 10.0**x_log
@@ -410,6 +509,7 @@ def identify_frfs(problem: FRFProblem, method: str = "hybrid", seed: int | None 
         names=problem.names,
         correlation=corr,
         model_frfs=frfs,
+        intervals=intervals,
     )
 
 

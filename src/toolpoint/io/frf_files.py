@@ -30,7 +30,19 @@ UFF writers write it back.
 Every reader returns a receptance :class:`~toolpoint.frf.FRF` in m/N (a
 mobility or accelerance file is converted with :meth:`FRF.to_receptance`) and
 raises :class:`~toolpoint.errors.InputError` naming the file and field for bad
-input. Every writer writes receptance, through :mod:`toolpoint.io.atomic`, so a
+input. Besides finite numbers and a strictly increasing frequency grid, the
+readers refuse values no structure's FRF has, so that nothing overflows
+downstream (squares in the fits, ω⁴ in conversions, 1/H in inverse RCSA):
+
+* an FRF magnitude ``|H|`` above :data:`MAX_ABS_VALUE` (1e100, in the file's
+  unit) or, unless it is exactly 0, below :data:`MIN_ABS_VALUE` (1e-100);
+* a frequency above :data:`MAX_FREQ_HZ` (1e9 Hz);
+* in a text file that does not end with a line break (a copy or export cut
+  short), a last number with a missing or shorter exponent than every other
+  number of its column (``1.2345e-08`` cut to ``1.2345e-0`` or ``1.23`` reads
+  as 1.2345 or 1.23 m/N), or, in a column without exponents, with fewer digits
+  than each of them: the message names the line and says to end the file with
+  a line break if it is complete. Every writer writes receptance, through :mod:`toolpoint.io.atomic`, so a
 failure never leaves a half-written file.
 """
 
@@ -56,6 +68,9 @@ G0 = 9.80665  # standard gravity, m/s² per g
 CSV_HEADER = ("freq_hz", "real", "imag")
 COHERENCE_TOL = 1e-6  # round-off allowed outside [0, 1] before a coherence is refused
 CUTPRO_COLUMNS = ("Freq", "Real", "Imag")
+MAX_ABS_VALUE = 1e100  # largest |H| accepted from a file (file's unit); its square, summed, stays finite
+MIN_ABS_VALUE = 1e-100  # smallest non-zero |H| accepted; 1/H stays finite
+MAX_FREQ_HZ = 1e9  # largest frequency accepted from a file, Hz; (2πf)⁴ stays finite
 
 
 # ---------------------------------------------------------------- dispatch
@@ -156,7 +171,8 @@ def _pick(path, table):
 def read_csv_frf(path, *, quantity: str | None = None, min_points: int = 1, label: str | None = None) -> FRF:
     """Read a toolpoint CSV file: header ``freq_hz,real,imag``, then Hz, real, imaginary (m/N)."""
     q = _quantity(path, quantity)
-    lines = [(n, s) for n, s in enumerate(_read_lines(path), 1) if s.strip()]
+    text, open_end = _read_text(path)
+    lines = [(n, s) for n, s in enumerate(text, 1) if s.strip()]
     if not lines:
         raise InputError("empty file", file=path, field="header")
     head = lines[0][1]
@@ -165,7 +181,7 @@ def read_csv_frf(path, *, quantity: str | None = None, min_points: int = 1, labe
         raise InputError(f"expected {','.join(CSV_HEADER)!r} (optionally ',coherence'), found {head.strip()!r}",
                          file=path, field="header")
     rows = [(n, s.split(",")) for n, s in lines[1:]]
-    return _table_frf(path, rows, names, q, min_points, label, "csv")
+    return _table_frf(path, rows, names, q, min_points, label, "csv", open_end)
 
 
 def write_csv_frf(path, frf: FRF, *, as_measured: bool = False) -> None:
@@ -188,9 +204,10 @@ def read_cutpro(path, *, quantity: str | None = None, min_points: int = 1, label
     """
     q = _quantity(path, quantity)
     rows, head, units = [], None, None
-    for n, line in enumerate(_read_lines(path), 1):
+    text, open_end = _read_text(path)
+    for n, line in enumerate(text, 1):
         cells = _split(line)
-        if not cells or cells[0][0] in "%#":
+        if not cells or cells[0].startswith(("%", "#")):
             continue
         if not rows and not _is_number(cells[0]):
             if head is None:
@@ -212,7 +229,8 @@ def read_cutpro(path, *, quantity: str | None = None, min_points: int = 1, label
                                  field="columns")
             picked.append((n, [cells[c] for c in cols]))
         rows = picked
-    frf = _table_frf(path, rows, names, q, min_points, label, Path(path).suffix.lower().lstrip(".") or "text")
+    frf = _table_frf(path, rows, names, q, min_points, label, Path(path).suffix.lower().lstrip(".") or "text",
+                     open_end)
     if scale != 1.0:
         frf = FRF(frf.freq_hz, frf.values * scale, frf.quantity, frf.label, frf.meta)
     return frf
@@ -590,24 +608,67 @@ def _check_readable(path) -> None:
 
 
 def _read_lines(path) -> list[str]:
+    return _read_text(path)[0]
+
+
+def _read_text(path) -> tuple[list[str], bool]:
+    """(lines of a UTF-8 text file, whether it ends without a line break: its last line may be cut)."""
     _check_readable(path)
     try:
-        return Path(path).read_text(encoding="utf-8-sig").splitlines()
+        text = Path(path).read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise InputError("not a UTF-8 text file", file=path) from None
     except OSError as exc:
         raise InputError(f"cannot read file ({exc.strerror or exc})", file=path) from None
+    return text.splitlines(), bool(text) and text[-1] not in "\r\n"
+
+
+def _digits(cell: str) -> tuple[int, int | None]:
+    """(digits of the mantissa, digits of the exponent or None) of a number as written."""
+    s = cell.strip().lower().lstrip("+-")
+    mant, _, exp = s.partition("e")
+    return sum(ch.isdigit() for ch in mant), (sum(ch.isdigit() for ch in exp) if _ else None)
+
+
+def _check_not_cut(path, rows, names, open_end: bool) -> None:
+    """Refuse a last number that looks cut short, in a text file that ends without a line break.
+
+    ``rows`` are ``[(line number, cells), ...]`` of numbers. A cut removes the end of the file, so only
+    the last cell of the last row can lose digits (a cut elsewhere leaves too few columns). Compared
+    with the other numbers of its column (at least 2 of them) it is refused when
+
+    * they all have an exponent and it has none (and is not 0), or a shorter one;
+    * none of them has an exponent and it has fewer digits than each of them.
+    """
+    if not open_end or len(rows) < 3:
+        return
+    n, cells = rows[-1]
+    j = len(cells) - 1
+    others = [_digits(c[j]) for _, c in rows[:-1] if len(c) > j]
+    if not others:
+        return
+    m, e = _digits(cells[j])
+    exps = [x for _, x in others if x is not None]
+    if len(exps) == len(others):
+        cut = (e is None and float(cells[j]) != 0) or (e is not None and e < min(exps))
+    else:
+        cut = not exps and e is None and m < min(d for d, _ in others)
+    if cut:
+        raise InputError(f"line {n}: {cells[j].strip()!r} looks cut short (the file ends without a line break, "
+                         "mid-number?); if the file is complete, end it with a line break", file=path,
+                         field=names[min(j, len(names) - 1)])
 
 
 def _is_number(s: str) -> bool:
+    """Whether ``s`` is a number as data files write them (Python's ``1_000`` is not)."""
     try:
         float(s)
-        return True
+        return "_" not in s
     except ValueError:
         return False
 
 
-def _table_frf(path, rows, names, quantity, min_points, label, fmt) -> FRF:
+def _table_frf(path, rows, names, quantity, min_points, label, fmt, open_end=False) -> FRF:
     """FRF from text rows ``[(line number, [freq, real, imag(, coherence)]), ...]``; ``names`` name the columns."""
     k = len(names)
     a = np.empty((len(rows), k))
@@ -616,9 +677,12 @@ def _table_frf(path, rows, names, quantity, min_points, label, fmt) -> FRF:
             raise InputError(f"line {n}: expected {k} columns, found {len(cells)}", file=path, field="columns")
         for j, cell in enumerate(cells):
             try:
+                if "_" in cell:  # Python's float() reads "1_000" as 1000; no data file writes that
+                    raise ValueError(cell)
                 a[i, j] = float(cell)
             except ValueError:
                 raise InputError(f"line {n}: {cell.strip()!r} is not a number", file=path, field=names[j]) from None
+    _check_not_cut(path, rows, names, open_end)
     where = lambda i: f"line {rows[i][0]}"  # noqa: E731
     _validate(path, a[:, 0], a[:, 1], a[:, 2], where, names)
     v = np.empty(len(rows), dtype=complex)
@@ -637,12 +701,27 @@ def _check_coherence(path, c, where, name="coherence") -> np.ndarray:
 
 
 def _validate(path, f, re, im, where, names) -> None:
-    """Finite values (with their location in the file) and a valid frequency grid (:func:`check_freq_hz`)."""
+    """Finite values of a plausible magnitude and a valid frequency grid (:func:`check_freq_hz`), located in the file.
+
+    ``|H|`` must be 0 or within [:data:`MIN_ABS_VALUE`, :data:`MAX_ABS_VALUE`] and frequencies at most
+    :data:`MAX_FREQ_HZ`: a value such as 1e300 is finite but overflows downstream.
+    """
     for name, col in zip(names[1:], (re, im)):
         bad = np.flatnonzero(~np.isfinite(col))
         if bad.size:
             raise InputError(f"non-finite value {col[bad[0]]} at {where(bad[0])}", file=path, field=name)
+    mag = np.hypot(re, im)
+    bad = np.flatnonzero((mag > MAX_ABS_VALUE) | ((mag < MIN_ABS_VALUE) & (mag != 0)))
+    if bad.size:
+        i = bad[0]
+        name = names[1] if abs(re[i]) >= abs(im[i]) else names[2]
+        raise InputError(f"|H| = {mag[i]:.3g} at {where(i)} is not a plausible FRF value (accepted: 0 or "
+                         f"{MIN_ABS_VALUE:g} to {MAX_ABS_VALUE:g} in the file's unit)", file=path, field=name)
     check_freq_hz(f, file=path, field=names[0], min_points=0, where=where)
+    bad = np.flatnonzero(f > MAX_FREQ_HZ)
+    if bad.size:
+        raise InputError(f"frequency {f[bad[0]]:.3g} Hz at {where(bad[0])} is above {MAX_FREQ_HZ:g} Hz",
+                         file=path, field=names[0])
 
 
 def _finish(path, f, v, quantity, min_points, label, fmt, meta) -> FRF:

@@ -286,10 +286,11 @@ def read_record(path, *, response: str = "acceleration") -> Record:
     """
     if Path(path).suffix.lower() in (".uff", ".unv", ".uf"):
         return _read_uff_record(path)
-    from .frf_files import _is_number, _read_lines
+    from .frf_files import _check_not_cut, _is_number, _read_text
 
     rows = []
-    for n, line in enumerate(_read_lines(path), 1):
+    text, open_end = _read_text(path)
+    for n, line in enumerate(text, 1):
         s = line.strip()
         if not s or s[0] in "#%":
             continue
@@ -303,6 +304,8 @@ def read_record(path, *, response: str = "acceleration") -> Record:
     if not rows:
         raise InputError("no data rows", file=path, field="data")
     try:
+        if any("_" in c for _, cells in rows for c in cells):  # float() reads "1_000"; no data file writes it
+            raise ValueError("_")
         a = np.array([c for _, c in rows], dtype=float)
     except ValueError:
         for n, cells in rows:
@@ -310,6 +313,7 @@ def read_record(path, *, response: str = "acceleration") -> Record:
                 if not _is_number(c):
                     raise InputError(f"line {n}: {c!r} is not a number", file=path, field=name) from None
         raise
+    _check_not_cut(path, rows, ("time_s", "force_n", "response"), open_end)
     bad = np.argwhere(~np.isfinite(a))
     if bad.size:
         i, j = bad[0]

@@ -82,6 +82,7 @@ IEEE Trans. SMC 23(3), 665–685, 1993.
 from __future__ import annotations
 
 import json
+import math
 import numbers
 import os
 import warnings
@@ -688,46 +689,105 @@ class ANFIS(RegressorMixin, BaseEstimator):
 
     @classmethod
     def from_dict(cls, doc: dict) -> "ANFIS":
-        """Inverse of :meth:`to_dict`; raises ValueError on a malformed description."""
+        """Inverse of :meth:`to_dict`.
+
+        Raises
+        ------
+        InputError
+            A malformed description (a ``ValueError``), naming the field: ``format``, ``version``,
+            ``params`` (or the parameter, e.g. ``n_mfs``), ``premise``, ``consequents``,
+            ``input_range``, ``input_names``, ``target_name``, ``best_epoch``, ``history``.
+        """
+        def bad(field, msg):
+            return InputError(msg, field=field)
+
+        def array(key, shape):
+            try:
+                a = np.array(doc[key], dtype=float)
+            except KeyError:
+                raise bad(key, "missing") from None
+            except (TypeError, ValueError, OverflowError):
+                raise bad(key, "must be an array of numbers") from None
+            if a.shape != shape:
+                raise bad(key, f"shape {a.shape} does not match the rule base (expected {shape})")
+            if not np.all(np.isfinite(a)):
+                raise bad(key, "non-finite model parameters")
+            return a
+
+        if not isinstance(doc, dict):
+            raise bad(None, "not an ANFIS model (top level is not an object)")
+        if doc.get("format") != _FORMAT:
+            raise bad("format", f"not a {_FORMAT} model (format = {doc.get('format')!r})")
+        if doc.get("version") != _FORMAT_VERSION:
+            raise bad("version", f"unsupported model version {doc.get('version')!r}")
+        params = doc.get("params")
+        if not isinstance(params, dict):
+            raise bad("params", "must be an object of ANFIS settings")
+        params = dict(params)
+        if isinstance(params.get("n_mfs"), list):  # JSON has no tuples
+            params["n_mfs"] = tuple(params["n_mfs"])
         try:
-            if doc.get("format") != _FORMAT:
-                raise ValueError(f"not a {_FORMAT} model (format = {doc.get('format')!r})")
-            if doc.get("version") != _FORMAT_VERSION:
-                raise ValueError(f"unsupported model version {doc.get('version')!r}")
-            params = dict(doc["params"])
-            if isinstance(params.get("n_mfs"), list):  # JSON has no tuples
-                params["n_mfs"] = tuple(params["n_mfs"])
             model = cls(**params)
+        except TypeError as err:
+            raise bad("params", f"unknown setting ({err})") from None
+        try:
             n_mfs = tuple(int(v) for v in doc["n_mfs"])
-            d = len(n_mfs)
+        except KeyError:
+            raise bad("n_mfs", "missing") from None
+        except (TypeError, ValueError, OverflowError):
+            raise bad("n_mfs", f"must be a list of integers, got {doc['n_mfs']!r}"[:200]) from None
+        d = len(n_mfs)
+        try:
             model.check_params(d)
-            p = len(MF_PARAMS[model.mf])
-            premise = [np.array(P, dtype=float) for P in doc["premise"]]
-            if len(premise) != d or any(P.shape != (m, p) for P, m in zip(premise, n_mfs)):
-                raise ValueError("premise parameters do not match n_mfs and mf")
-            C = np.array(doc["consequents"], dtype=float)
-            if C.shape != (int(np.prod(n_mfs)), d + 1 if model.order == 1 else 1):
-                raise ValueError("consequent parameters do not match the rule base")
-            rng = np.array(doc["input_range"], dtype=float)
-            if rng.shape != (d, 2):
-                raise ValueError("input_range does not match the number of inputs")
-            names = doc.get("input_names")
-            if names is not None and len(names) != d:
-                raise ValueError("input_names does not match the number of inputs")
-            if not all(np.all(np.isfinite(a)) for a in [C, rng, *premise]):
-                raise ValueError("non-finite model parameters")
-        except (KeyError, TypeError, AttributeError) as err:
-            raise ValueError(f"malformed ANFIS model description ({type(err).__name__}: {err})") from None
+        except InputError as err:
+            raise bad(f"params.{err.field}" if err.field else "params", err.message) from None
+        except (TypeError, ValueError, OverflowError) as err:
+            raise bad("params", f"bad setting ({err})") from None
+        if any(m < 2 for m in n_mfs) or math.prod(n_mfs) > 10**6:
+            raise bad("n_mfs", f"must be integers ≥ 2 (at most 1e6 rules), got {list(n_mfs)}"[:200])
+        p = len(MF_PARAMS[model.mf])
+        prem = doc.get("premise")
+        if not isinstance(prem, list) or len(prem) != d:
+            raise bad("premise", f"must be a list of {d} arrays (one per input)")
+        premise = []
+        for i, m in enumerate(n_mfs):
+            try:
+                P = np.array(prem[i], dtype=float)
+            except (TypeError, ValueError, OverflowError):
+                raise bad(f"premise[{i}]", "must be an array of numbers") from None
+            if P.shape != (m, p):
+                raise bad(f"premise[{i}]", f"shape {P.shape} does not match n_mfs and mf (expected {(m, p)})")
+            if not np.all(np.isfinite(P)):
+                raise bad(f"premise[{i}]", "non-finite model parameters")
+            premise.append(P)
+        C = array("consequents", (int(np.prod(n_mfs)), d + 1 if model.order == 1 else 1))
+        rng = array("input_range", (d, 2))
+        names = doc.get("input_names")
+        if names is not None and (not isinstance(names, list) or len(names) != d):
+            raise bad("input_names", f"must be a list of {d} names (one per input)")
+        tn = doc.get("target_name")
+        if tn is not None and not isinstance(tn, str):
+            raise bad("target_name", f"must be a string, got {tn!r}"[:200])
+        best = doc.get("best_epoch", 0)
+        if not isinstance(best, int) or isinstance(best, bool) or best < 0:
+            raise bad("best_epoch", f"must be a non-negative integer, got {best!r}"[:200])
+        hist = doc.get("history") or {}
+        if not isinstance(hist, dict):
+            raise bad("history", f"must be an object of RMSE lists (train_rmse, val_rmse), got {hist!r}"[:200])
+        history = {}
+        for k, a in hist.items():
+            try:
+                history[k] = np.array([np.nan if v is None else v for v in a], dtype=float).reshape(-1)
+            except (TypeError, ValueError, OverflowError):
+                raise bad(f"history.{k}", "must be a list of numbers or nulls") from None
         model.premise_, model.consequents_ = premise, C
         model.n_features_in_, model.n_mfs_ = d, n_mfs
         model.rules_ = np.array(np.unravel_index(np.arange(int(np.prod(n_mfs))), n_mfs)).T
         model.input_range_ = rng
         model.input_names_ = None if names is None else [str(s) for s in names]
-        tn = doc.get("target_name")
         model.target_name_ = None if tn is None else str(tn)
-        model.best_epoch_ = int(doc.get("best_epoch", 0))
-        hist = doc.get("history") or {}
-        model.history_ = {k: np.array([np.nan if v is None else v for v in a], dtype=float) for k, a in hist.items()}
+        model.best_epoch_ = best
+        model.history_ = history
         return model
 
     def save(self, path: str | os.PathLike) -> None:
@@ -739,15 +799,26 @@ class ANFIS(RegressorMixin, BaseEstimator):
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "ANFIS":
-        """Read a model written by :meth:`save`; ValueError if it is not one."""
+        """Read a model written by :meth:`save`.
+
+        Raises
+        ------
+        InputError
+            Not a model file (a ``ValueError``): one line naming ``path`` and the field.
+        OSError
+            The file cannot be opened.
+        """
         with open(path, encoding="utf-8") as fh:
             try:
                 doc = json.load(fh)
             except json.JSONDecodeError as err:
-                raise ValueError(f"not valid JSON: {err}") from None
-        if not isinstance(doc, dict):
-            raise ValueError("not an ANFIS model file (top level is not an object)")
-        return cls.from_dict(doc)
+                raise InputError(f"not valid JSON: {err}", file=path) from None
+            except (UnicodeDecodeError, ValueError, RecursionError) as err:  # bad bytes, a 5000-digit integer
+                raise InputError(f"not a readable JSON file ({type(err).__name__})", file=path) from None
+        try:
+            return cls.from_dict(doc)
+        except InputError as err:
+            raise InputError(err.message, file=path, field=err.field) from None
 
 
 def _json_scalar(v):

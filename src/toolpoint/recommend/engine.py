@@ -167,10 +167,11 @@ def evaluate_tool(job: ToolJob) -> dict:
     Returns
     -------
     dict
-        ``summary`` (JSON-able: joint quantiles SI, points, notes, seconds) and
+        ``summary`` (JSON-able: joint quantiles SI, points, notes, ``seconds`` wall and ``cpu_seconds``
+        of this process) and
         ``arrays`` (name → ndarray: FRF band, limits in mm, probability map).
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     family = job.family
     if job.flute_length_mm is not None:
         family = replace(family, flute_length_ratio=job.flute_length_mm / job.diameter_mm)
@@ -218,6 +219,7 @@ def evaluate_tool(job: ToolJob) -> dict:
         "margin": job.margin,
         "rpm_tolerance": job.rpm_tolerance,
         "seconds": time.perf_counter() - t0,
+        "cpu_seconds": time.process_time() - c0,
     }
     arrays = {
         "freq_hz": job.freq_hz, "frf_nominal": H[0], "frf_abs_q": hq,

@@ -41,13 +41,13 @@ Examples
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError
+from ..io.table import read_table
 from ..stability.cutting import CuttingConditions
 from .materials import PRESETS, preset
 
@@ -188,16 +188,7 @@ def read_library(path: str | os.PathLike) -> tuple[list[LibraryTool], list[BadRo
         column, or has no data rows.
     """
     path = Path(path)
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            reader = csv.DictReader(fh)
-            header = [h.strip() for h in (reader.fieldnames or [])]
-            reader.fieldnames = header
-            rows = [(reader.line_num, r) for r in reader if any((v or "").strip() for v in r.values() if
-                                                              isinstance(v, str))]
-    except (OSError, UnicodeDecodeError, csv.Error) as err:
-        raise InputError(f"cannot read the tool library: {getattr(err, 'strerror', None) or err}",
-                         file=path) from None
+    header, rows = read_table(path, what="the tool library")
     if not header:
         raise InputError("empty file (no header row)", file=path)
     for name in REQUIRED:

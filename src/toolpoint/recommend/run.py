@@ -34,9 +34,10 @@ from ..campaign.run import execute
 from ..errors import ExtrapolationWarning, InputError
 from ..identification.params import PARAMS
 from ..io.atomic import atomic_open, atomic_path
+from ..io.table import read_table
 from .engine import ToolJob, evaluate_tool
 from .library import read_library
-from .uncertainty import JointPredictor
+from .uncertainty import WIDEN_PER_RANGE, JointPredictor
 
 __all__ = ["COLUMNS", "FILE_NAME", "run_library"]
 
@@ -47,22 +48,27 @@ COLUMNS = (["id", "status", "holder", "diameter_mm", "overhang_mm", "teeth", "ma
               "min_limit_p05_mm", "notes", "error"])
 
 
-def _resume(path: Path, tools_dir: Path, ids: set) -> set:
-    """Rewrite ``path`` with its finished ok rows of ``ids`` whose files exist; their ids."""
+def _resume(path: Path, tools_dir: Path, ids: set, model: str) -> set:
+    """Rewrite ``path`` with its finished ok rows of ``ids`` whose files exist and were computed with
+    ``model`` (a run with the other joint model starts those tools again); their ids."""
     keep = []
     if path.exists():
-        try:
-            with open(path, newline="", encoding="utf-8") as fh:
-                rows = list(csv.DictReader(fh))
-        except (OSError, UnicodeDecodeError, csv.Error) as e:
-            raise InputError(f"cannot read the results to resume ({e})", file=path) from None
+        rows = [r for _, r in read_table(path, what="the results to resume")[1]]
         keep = [r for r in rows if r.get("status") == "ok" and r.get("id") in ids and r.get("error") is not None
-                and (tools_dir / f"{r['id']}.npz").exists() and (tools_dir / f"{r['id']}.json").exists()]
+                and (tools_dir / f"{r['id']}.npz").exists() and _tool_model(tools_dir / f"{r['id']}.json") == model]
     with atomic_open(path, "w", newline="", encoding="utf-8") as fh:
         w = csv.DictWriter(fh, COLUMNS, extrasaction="ignore")
         w.writeheader()
         w.writerows(keep)
     return {r["id"] for r in keep}
+
+
+def _tool_model(path: Path) -> str | None:
+    """The joint model (``"anfis"``/``"gp"``) a finished tool's JSON records; None if unreadable."""
+    try:
+        return json.loads(path.read_text(encoding="utf-8")).get("model", "anfis")
+    except (OSError, UnicodeDecodeError, ValueError, AttributeError):
+        return None
 
 
 def _seed(seed: int, tool_id: str) -> int:
@@ -103,7 +109,7 @@ def _write_tool(tools_dir: Path, tool_id: str, result: dict, extra: dict) -> Non
 
 def run_library(library, campaign, models, out_dir, *, workers: int | None = None, dask: str | None = None,
                 n_samples: int = 200, rpm_points: int = 500, seed: int = 0, margin: float = 0.1,
-                rpm_tolerance: float = 0.01, outside: str = "widen", progress: bool = True,
+                rpm_tolerance: float = 0.01, outside: str = "widen", model: str = "anfis", progress: bool = True,
                 on_bad=None) -> dict:
     """Recommend operating points for every tool of a library (module docstring).
 
@@ -132,7 +138,10 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
     rpm_tolerance : float, default 0.01
         Relative spindle-speed tolerance of the robust limit.
     outside : {"widen", "refuse"}
-        A tool outside the learned (D, L) range: widen its σ (warn) or refuse it.
+        A tool outside the learned (D, L) range: widen its σ (warn; the GP's σ is its own) or refuse it.
+    model : {"anfis", "gp"}, default "anfis"
+        Predictive joint distribution from the ANFIS models or from the GP baselines ``campaign learn``
+        saved (:class:`~.uncertainty.JointPredictor`).
     progress : bool
         Progress bar on stderr.
     on_bad : callable, optional
@@ -160,7 +169,7 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
         raise InputError(f"must be in [0, 0.5), got {rpm_tolerance!r}", field="rpm_tolerance")
     tools, bad = read_library(library)
     c = load_campaign(campaign)
-    predictor = JointPredictor(models)
+    predictor = JointPredictor(models, model)
     from ..campaign.run import dask_client
 
     client = dask_client(dask) if dask else None
@@ -168,7 +177,7 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
     tools_dir = out / "tools"
     tools_dir.mkdir(parents=True, exist_ok=True)
     path = out / FILE_NAME
-    done = _resume(path, tools_dir, {t.id for t in tools})
+    done = _resume(path, tools_dir, {t.id for t in tools}, model)
     todo = [t for t in tools if t.id not in done]
     t0 = time.perf_counter()
     report = on_bad or (lambda line: None)
@@ -194,7 +203,8 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
                 failed_rows.append(_row(t, "failed", outside_range=delta, error=f"{t.id}: {where}: refused "
                                                                                 "(--outside widen to allow)"))
                 continue
-            notes.append(f"{where}: σ widened ×{1 + 5 * delta:.2g}")
+            notes.append(f"{where}: σ widened ×{1 + WIDEN_PER_RANGE * delta:.2g}" if model == "anfis" else
+                         f"{where}: the GP's own σ (not widened)")
             report(f"warning: {t.id}: {notes[-1]}")
         if t.holder not in subs:
             kind = c.holders[t.holder].kind
@@ -244,7 +254,8 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
                                                                   "milling": t.cutting.milling,
                                                                   "source": t.cutting_source},
                                                       "holder": t.holder, "diameter_mm": t.diameter_mm,
-                                                      "overhang_mm": t.overhang_mm, "material": t.material})
+                                                      "overhang_mm": t.overhang_mm, "material": t.material,
+                                                      "model": model})
                 append(_ok_row(t, result["summary"], delta, notes))
     finally:
         bar.close()

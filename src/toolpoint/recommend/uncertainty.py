@@ -13,10 +13,16 @@ Each joint parameter p is log-normal: log10 p ~ Normal(m(D, L), σ²), with
   uses), σ the standard deviation of log10 p over the campaign's ok rows (the
   spread of the family, since D and L are not used).
 
+With ``model="gp"`` a learned parameter takes the GP baseline that
+``campaign learn`` saved instead (:class:`~toolpoint.campaign.predict.GPModel`):
+m its predictive mean of log10 p and σ its own predictive standard deviation
+(posterior of the latent function plus the fitted white noise), per tool.
+
 The four parameters are sampled independently. A tool outside the (D, L) range
-the models were trained on gets its σ widened by the factor 1 + 5 δ, δ the
+the models were trained on gets its ANFIS σ widened by the factor 1 + 5 δ, δ the
 largest distance outside the range in units of the range's width (or is
-refused). Why these choices and what they gave: ``docs/design/recommend.md``.
+refused); the GP's σ grows away from its data by itself and is not widened.
+Why these choices and what they gave: ``docs/design/recommend.md``.
 """
 
 from __future__ import annotations
@@ -28,16 +34,18 @@ from pathlib import Path
 import numpy as np
 
 from ..campaign.learn import INPUTS
-from ..campaign.predict import load_models
+from ..campaign.predict import load_gp_models, load_models
 from ..campaign.results import FILE_NAME, read_identified
 from ..errors import InputError
 from ..identification.params import PARAMS
 from ..learning.anfis import predict_quietly
 
-__all__ = ["WIDEN_PER_RANGE", "JointPredictor", "JointDistribution"]
+__all__ = ["WIDEN_PER_RANGE", "MODELS", "JointPredictor", "JointDistribution"]
 
-#: σ is multiplied by 1 + WIDEN_PER_RANGE · δ outside the training range (δ in range widths).
+#: σ is multiplied by 1 + WIDEN_PER_RANGE · δ outside the training range (δ in range widths; ANFIS only).
 WIDEN_PER_RANGE = 5.0
+#: The learned models a predictive distribution can come from.
+MODELS = ("anfis", "gp")
 
 
 @dataclass(frozen=True)
@@ -83,14 +91,21 @@ class JointPredictor:
     Parameters
     ----------
     models_dir : path-like
-        Models folder (``<p>.json``, ``split.csv``); ``identified.csv`` beside it.
+        Models folder (``<p>.json``, ``split.csv``, for ``gp`` the saved ``gp_<p>.json``);
+        ``identified.csv`` beside it.
+    model : {"anfis", "gp"}, default "anfis"
+        The ANFIS models with σ from their training residuals and the identification intervals, or
+        the GP baselines with their own predictive σ.
 
     Attributes
     ----------
+    kind : str
+        ``model``.
     models : dict
-        Parameter → ANFIS.
+        Parameter → ANFIS (or :class:`~toolpoint.campaign.predict.GPModel`).
     sigma_log10 : ndarray, shape (4,)
-        σ of each parameter inside the training range, decades.
+        σ of each parameter inside the training range, decades (GP: NaN for a learned parameter,
+        whose σ depends on the tool).
     source : dict
         Parameter → how its distribution is made (one line).
     lo, hi : ndarray, shape (2,)
@@ -99,12 +114,16 @@ class JointPredictor:
     Raises
     ------
     InputError
-        Missing models, ``identified.csv`` or ``split.csv``.
+        Missing models (no saved GP baselines for ``gp``), ``identified.csv`` or ``split.csv``, an
+        unknown ``model``.
     """
 
-    def __init__(self, models_dir):
+    def __init__(self, models_dir, model: str = "anfis"):
+        if model not in MODELS:
+            raise InputError(f"must be one of {', '.join(MODELS)}, got {model!r}", field="model")
         d = Path(models_dir)
-        self.models = load_models(d)
+        self.kind = model
+        self.models = load_models(d) if model == "anfis" else load_gp_models(d)
         rows = read_identified(d.parent / FILE_NAME, required=list(INPUTS) + list(PARAMS)).ok()
         split = d / "split.csv"
         try:
@@ -122,7 +141,10 @@ class JointPredictor:
         self.source = {}
         for j, p in enumerate(PARAMS):
             v = rows.column(p, required=False)
-            if p in self.models:
+            if p in self.models and model == "gp":
+                self.sigma_log10[j] = np.nan
+                self.source[p] = f"GP baseline {self.models[p].kernel}; σ its predictive standard deviation per tool"
+            elif p in self.models:
                 use = is_train & np.isfinite(v) & (v > 0) & rows.identified(p)
                 if use.sum() < 3:
                     raise InputError(f"fewer than 3 training rows identified {p}: no residual spread",
@@ -159,18 +181,20 @@ class JointPredictor:
         Returns
         -------
         JointDistribution
-            σ widened by 1 + :data:`WIDEN_PER_RANGE` · δ outside the training range.
+            ANFIS σ widened by 1 + :data:`WIDEN_PER_RANGE` · δ outside the training range (GP σ as it is).
         """
         D, L = np.atleast_1d(np.asarray(diameter_mm, float)), np.atleast_1d(np.asarray(overhang_mm, float))
         X = np.column_stack([D, L])
         m = np.empty((len(D), len(PARAMS)))
+        delta = self.outside(D, L)
+        sig = self.sigma_log10[None, :] * (1.0 + WIDEN_PER_RANGE * delta[:, None])
         for j, p in enumerate(PARAMS):
-            if p in self.models:
+            if p in self.models and self.kind == "gp":
+                m[:, j], sig[:, j] = self.models[p].predict(X)
+            elif p in self.models:
                 pred, _ = predict_quietly(self.models[p], X)
                 with np.errstate(divide="ignore", invalid="ignore"):
                     m[:, j] = np.where(pred > 0, np.log10(np.where(pred > 0, pred, 1.0)), np.nan)
             else:
                 m[:, j] = np.log10(self.median[j])
-        delta = self.outside(D, L)
-        sig = self.sigma_log10[None, :] * (1.0 + WIDEN_PER_RANGE * delta[:, None])
         return JointDistribution(m, sig, delta)

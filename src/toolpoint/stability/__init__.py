@@ -5,9 +5,9 @@
 * :func:`sdm_lobes` — semi-discretisation (Insperger & Stépán 2002/2004) of a
   state-space model of the tool point (:class:`StateSpaceModel`: real or
   complex modes, cross terms); needed at low radial immersion.
-* :func:`fit_modes` — modal fit of an FRF (:class:`ModalModel`, real modes per
-  direction), one way to build the SDM's model; :func:`from_modal_fit` builds
-  it from common-pole fits of :mod:`toolpoint.dynamics.modal`.
+* :func:`from_modal_fit` builds the SDM's model from common-pole modal fits
+  (:func:`toolpoint.dynamics.modal.fit_frfs`: complex modes, cross FRFs);
+  :class:`ModalModel` holds real modes per direction given by hand.
 
 The cut is described once by :class:`CuttingConditions` (teeth, tangential
 cutting coefficient K_t in N/m², radial force ratio K_r = K_n/K_t, radial
@@ -18,9 +18,8 @@ Geometry and sign conventions: :mod:`toolpoint.stability.milling`.
 
 from .cutting import CuttingConditions
 from .milling import Lobe, LobeResult, average_directional_matrix, directional_coefficients, immersion_angles
-from .modalfit import ModalModel, fit_modes
 from .sdm import sdm_lobes, sdm_spectral_radius
-from .statespace import StateSpaceModel, from_modal_fit
+from .statespace import ModalModel, StateSpaceModel, from_modal_fit
 from .zoa import zoa_lobes
 
 __all__ = [
@@ -31,7 +30,6 @@ __all__ = [
     "StateSpaceModel",
     "average_directional_matrix",
     "directional_coefficients",
-    "fit_modes",
     "from_modal_fit",
     "immersion_angles",
     "sdm_lobes",

@@ -48,6 +48,9 @@ from .cutting import MILLING  # noqa: F401  (re-exported: the old home of the na
 # Most spindle speeds one call evaluates: the envelope work grows with speeds ×
 # lobes, and a chart never needs more points than a screen has pixels × 10.
 MAX_RPM_POINTS = 100_000
+# Fastest spindle speed accepted, rpm: the fastest micro-milling spindles turn at ~5e5 rpm; a larger
+# number is a typo (and beyond it the tooth period falls below any FRF's resolution).
+MAX_RPM = 1e6
 
 
 # ----------------------------------------------------------------- validation
@@ -57,7 +60,7 @@ def check_rpm(rpm) -> np.ndarray:
     Parameters
     ----------
     rpm : array_like
-        Speeds, rpm: finite, > 0, strictly increasing, 1 … ``MAX_RPM_POINTS`` of them.
+        Speeds, rpm: finite, > 0, ≤ ``MAX_RPM``, strictly increasing, 1 … ``MAX_RPM_POINTS`` of them.
 
     Returns
     -------
@@ -79,6 +82,8 @@ def check_rpm(rpm) -> np.ndarray:
         raise InputError(f"{r.size} spindle speeds, at most {MAX_RPM_POINTS} are evaluated in one call", field="rpm")
     if not np.all(np.isfinite(r)) or r[0] <= 0:
         raise InputError("spindle speeds must be finite and > 0 rpm", field="rpm")
+    if r[-1] > MAX_RPM:
+        raise InputError(f"spindle speeds above {MAX_RPM:g} rpm are not spindle speeds (got {r[-1]:g})", field="rpm")
     if np.any(np.diff(r) <= 0):
         raise InputError(f"spindle speeds must increase (got {r[0]:g} … {r[-1]:g} rpm)", field="rpm")
     return r

@@ -1,4 +1,4 @@
-"""Semi-discretisation (SDM) of milling stability for state-space tool-point models.
+"""Semi-/full discretisation of milling stability for state-space tool-point models.
 
 Insperger & Stépán (2002) "Semi-discretization method for delayed systems",
 IJNME 55:503–518; (2004) "Updated semi-discretization method for periodic
@@ -16,43 +16,51 @@ T = 60/(N n) s the tooth period, so
 Only the d directions that move (non-zero rows of C) and the force
 directions that excite the model (non-zero columns of B) are kept.
 
-Discretisation. Time runs from a tooth's entry. H(t) is non-zero only on the
-cut [0, t_c], t_c = min(T, (φ_ex − φ_st)/Ω) s, Ω the spindle speed in rad/s.
-The cut is split into m steps Δt = t_c/m; on each, H is replaced by its
-exact average H_i (:func:`~toolpoint.stability.milling.interval_directional_matrix`)
-and the delayed displacement by the straight line between its values at the
-step's ends one period earlier (first order). Then exactly
+Discretisation (full discretisation: Ding, Zhu, Zhang & Ding, "A full-discretization
+method for prediction of milling stability", IJMTM 50 (2010) 502–509). Time
+runs from a tooth's entry. H(t) is non-zero only on the cut [0, t_c],
+t_c = min(T, (φ_ex − φ_st)/Ω) s, Ω the spindle speed in rad/s. The cut is
+split into m steps Δt = t_c/m; on each, H is replaced by its exact average
+H_i (:func:`~toolpoint.stability.milling.interval_directional_matrix`) and
+the regenerative displacement g = r(t − T) − C z(t) by the straight line
+between its values at the step's ends, so that, with P = e^{AΔt},
 
-    z_{i+1} = P_i z_i + (Γ0_i − Γ1_i) r'_i + Γ1_i r'_{i+1},
-    P_i = e^{A_iΔt},  Γ0_i = ∫₀^Δt e^{A_i(Δt−s)} ds B_i,  Γ1_i = ∫₀^Δt e^{A_i(Δt−s)} (s/Δt) ds B_i,
+    z_{i+1} = P z_i + a (Γ0 − Γ1) H_i g_i + a Γ1 H_i g_{i+1},
+    Γ0 = ∫₀^Δt e^{A(Δt−s)} ds B,   Γ1 = ∫₀^Δt e^{A(Δt−s)} (s/Δt) ds B.
 
-with A_i = A − a B H_i C, B_i = a B H_i and r' the delayed displacement; all
-three come from one exponential of the block matrix
-[[A_iΔt, B_iΔt, 0], [0, 0, I], [0, 0, 0]] (Van Loan). Free flight
-[t_c, T] has no delayed term and is solved exactly, z(T) = e^{A(T − t_c)} z(t_c).
+P, Γ0 and Γ1 do not depend on the depth: one exponential of the Van Loan
+block [[AΔt, BΔt, 0], [0, 0, I], [0, 0, 0]] per speed serves every depth
+(the first-order SDM of Insperger & Stépán puts a B H_i C into the
+exponential, one per step and depth). The term in z_{i+1} is solved exactly
+by the Woodbury identity (a d × d inverse). The error in the limit is
+O(Δt²), as for the first-order SDM, and both converge to the same limit
+(``docs/design/stability.md``). Free flight [t_c, T] has no delayed term and
+is solved exactly, z(T) = e^{A(T − t_c)} z(t_c). A model whose poles are all
+complex is first put in real modal coordinates (:func:`_modal_basis`).
 
 Delayed-displacement nodes. The delayed displacement is carried at every
 s-th step only (q + 1 = m/s + 1 nodes over the cut) and interpolated to the
-m + 1 step ends by local Lagrange polynomials of degree 7 (``s = 1``:
-every node, the plain first-order SDM). Because the delay is one tooth
-period, the state ζ = (z_0, r_0, …, r_q) of size n + (q + 1)d maps linearly
-over one period, ζ' = Φ ζ; the cut is stable iff the spectral radius
-ρ(Φ) < 1 (Floquet).
+m + 1 step ends by local Lagrange polynomials of degree 9 (``s = 1``:
+every node). Because the delay is one tooth period, the state
+ζ = (z_0, r_0, …, r_q) of size n + (q + 1)d maps linearly over one period,
+ζ' = Φ ζ; the cut is stable iff the spectral radius ρ(Φ) < 1 (Floquet).
 
 Default resolution. A chatter wave is a period of f_w = 1.1 × the highest
 zero-order chatter frequency of the speed range, Hz (1.1 × the highest
 natural frequency without a zero-order lobe, with ``seed=False`` and in
 :func:`sdm_spectral_radius`). Per speed,
-m = accuracy · 30 · f_w t_c on a ladder 20, 24, 28, 32, 40, … (≈ 2^(1/4)
-apart) within [20, m_max], and s is the largest divisor of m (≤ 16) leaving
-at least 8 · accuracy nodes per wave and 8 node intervals over the cut.
+m = accuracy · max(24 · f_w t_c, 20) on a ladder 20, 24, 28, 32, 40, …
+(≈ 2^(1/4) apart) within [20, m_max] (default 200 × max(accuracy, 1)), and
+s is the largest divisor of m (≤ 16) leaving at least 5 · max(accuracy, 1)
+nodes per wave and 8 node intervals over the cut.
 ``m`` counts steps over the cut, not over the tooth period. Measured
 accuracy and cost are in ``docs/design/stability.md``.
 
-Stability limit. Per speed the depth starts at half the zero-order limit
+Stability limit. Per speed the depth starts at 0.85 × the zero-order limit
 (or at ``depth_min`` where no zero-order lobe covers the speed, or where
-the start is already unstable), rises geometrically (ratio ``step``) until
-ρ ≥ 1, and the bracket is then shrunk by Illinois false position on ln ρ
+the start is already unstable) and rises by at most the ratio ``step`` per
+evaluation (less where the secant of ln ρ against ln a puts ρ = 1 nearer)
+until ρ ≥ 1; the bracket is then shrunk by Illinois false position on ln ρ
 against ln a, with bisection steps, to a relative width ``rtol``. An
 unstable band thinner than ``step`` in depth can be stepped over. Speeds are
 searched in blocks of 50, all still-open speeds of a block at once; BLAS is
@@ -72,15 +80,15 @@ from .statespace import StateSpaceModel
 
 __all__ = ["sdm_lobes", "sdm_spectral_radius", "as_state_space", "expm_batch", "STEPS_PER_WAVE", "NODES_PER_WAVE"]
 
-STEPS_PER_WAVE = 30
+STEPS_PER_WAVE = 24
 """Default steps of the cut per chatter wave at ``accuracy=1`` (module docstring)."""
-NODES_PER_WAVE = 8
+NODES_PER_WAVE = 5
 """Default delayed-displacement nodes per chatter wave at ``accuracy=1``."""
-INTERP_DEGREE = 7  # local Lagrange interpolation of the delayed displacement between nodes
+INTERP_DEGREE = 9  # local Lagrange interpolation of the delayed displacement between nodes
 MIN_NODES = 8  # fewest node intervals over the cut
 WAVE_MARGIN = 1.1  # resolution frequency / highest zero-order chatter frequency
 M_MIN, M_MAX = 20, 200  # bounds of the step count over the cut
-SEED_FRACTION = 0.5  # the seeded search starts at this fraction of the zero-order limit
+SEED_FRACTION = 0.85  # the seeded search starts at this fraction of the zero-order limit
 _BLOCK_SPEEDS = 50  # speeds searched together (progress is reported per block)
 _ZOA_POINTS = 200_000  # most frequency points of the zero-order seed
 # Soft cap on floats held by one batch (expm blocks and Floquet matrices).
@@ -161,6 +169,29 @@ def _interp_matrix(m: int, s: int, degree: int = None) -> np.ndarray:
     return L
 
 
+def _modal_basis(A: np.ndarray):
+    """Real modal basis of A: (T, λ), T⁻¹AT = [[Σ, Ω], [−Ω, Σ]], Σ = diag Re λ, Ω = diag Im λ; or None.
+
+    λ: the poles with Im λ > 0, sorted. Columns of T: Re v_k for every pole, then
+    Im v_k (v_k of unit norm, with the phase making Re v_k ⟂ Im v_k), so the
+    exponential of the transformed A is four diagonal blocks. None when A has a
+    real eigenvalue (overdamped or first-order states) or nearly dependent
+    eigenvectors (cond T > 1e8): the dense path is used then.
+    """
+    lam, V = np.linalg.eig(A)
+    up = lam.imag > 0
+    if 2 * up.sum() != lam.size:
+        return None
+    order = np.argsort(lam[up], kind="stable")
+    lam, V = lam[up][order], V[:, up][:, order]
+    V = V / np.linalg.norm(V, axis=0)
+    V = V * np.exp(-0.5j * np.angle(np.einsum("ik,ik->k", V, V)))  # Re v ⟂ Im v
+    T = np.hstack([V.real, V.imag])
+    if not np.linalg.cond(T) < 1e8:
+        return None
+    return T, lam
+
+
 class _System:
     """State-space matrices and cut geometry for one cutting condition; discretisations cached per m."""
 
@@ -170,37 +201,56 @@ class _System:
         self.teeth, self.tangential_coeff, self.radial_ratio = cut.teeth, cut.tangential_coeff, cut.radial_ratio
         self.phi_st, self.phi_ex = cut.immersion_angles
         self.out, self.inp = model.outputs, model.inputs
-        # Balance A by a diagonal similarity of powers of 2 (exact): second-order modal blocks
-        # [[0, 1], [−ω², ·]] have norm ω², [[0, ω], [−ω, ·]] only ω, which spares the exponentials
-        # many squarings.
-        A0, (scale, _) = matrix_balance(model.A, permute=False, separate=True)
-        self.A0 = A0
-        self.C = model.C[self.out] * scale[None, :]  # (d, n): displacement of each moving direction
-        self.Bin = model.B[:, self.inp] / scale[:, None]  # (n, p): forces that excite the model
         self.n = model.n_states
         self.d = self.out.size
         self.f_max = model.max_frequency_hz
+        basis = _modal_basis(model.A)
+        self.blocks = basis is not None  # real modal coordinates (A in four diagonal blocks)
+        if self.blocks:
+            # z = T z̃: A becomes blocks [[σ, ω], [−ω, σ]] per pole σ + iω (exact up to the eigen-solver's rounding).
+            T, lam = basis
+            self.A0 = np.block([[np.diag(lam.real), np.diag(lam.imag)], [-np.diag(lam.imag), np.diag(lam.real)]])
+            self.C = model.C[self.out] @ T
+            self.Bin = np.linalg.solve(T, model.B[:, self.inp])
+        else:
+            # Balance A by a diagonal similarity of powers of 2 (exact): second-order modal blocks
+            # [[0, 1], [−ω², ·]] have norm ω², [[0, ω], [−ω, ·]] only ω, which spares the exponentials squarings.
+            self.A0, (scale, _) = matrix_balance(model.A, permute=False, separate=True)
+            self.C = model.C[self.out] * scale[None, :]  # (d, n): displacement of each moving direction
+            self.Bin = model.B[:, self.inp] / scale[:, None]  # (n, p): forces that excite the model
         # Cut span of one tooth within a tooth period (several teeth may cut at once).
         self.cut_angle = min(self.phi_ex - self.phi_st, 2 * np.pi / self.teeth)
-        self._EF = {}
+        self._H = {}
         self._L = {}
 
-    def directional(self, m: int):
-        """(E_i, F_i) = (B H_i C, B H_i) for the m steps of the cut, shapes (m, n, n), (m, n, d)."""
-        if m not in self._EF:
+    def directional(self, m: int) -> np.ndarray:
+        """Exact averages H_i (N/m² per m of chip) over the m steps of the cut: (m, p, d), exciting × moving."""
+        if m not in self._H:
             edges = self.phi_st + self.cut_angle * np.arange(m + 1) / m
             H = interval_directional_matrix(edges, self.teeth, self.tangential_coeff, self.radial_ratio,
                                             self.phi_st, self.phi_ex)
-            Hd = H[:, self.inp][:, :, self.out]  # (m, p, d): rigid directions drop out
-            F = np.einsum("np,ipd->ind", self.Bin, Hd)
-            E = F @ self.C
-            self._EF[m] = (E, F)
-        return self._EF[m]
+            self._H[m] = H[:, self.inp][:, :, self.out]  # rigid directions drop out
+        return self._H[m]
 
     def interp(self, m: int, s: int) -> np.ndarray:
         if (m, s) not in self._L:
             self._L[m, s] = _interp_matrix(m, s)
         return self._L[m, s]
+
+    def stencils(self, m: int, s: int):
+        """Per step i: the first node ``lo[i]`` of a window of w nodes holding the weights of its delayed
+        displacements at both ends, and the window weights ``Lw`` (m, 2, w) (rows: ends i, i + 1)."""
+        if (m, s, "w") not in self._L:
+            L = self.interp(m, s)
+            nz = (L[:-1] != 0) | (L[1:] != 0)
+            first = np.argmax(nz, axis=1)
+            last = L.shape[1] - np.argmax(nz[:, ::-1], axis=1)
+            w = int((last - first).max())
+            lo = np.minimum(first, L.shape[1] - w)
+            cols = lo[:, None] + np.arange(w)
+            rows = np.arange(m)[:, None]
+            self._L[m, s, "w"] = lo, np.stack([L[rows, cols], L[rows + 1, cols]], axis=1)
+        return self._L[m, s, "w"]
 
     def cut_time(self, rpm):
         """(cut time t_c, free-flight time T − t_c), s."""
@@ -208,52 +258,75 @@ class _System:
         t_cut = self.cut_angle / omega
         return t_cut, np.maximum(2 * np.pi / (self.teeth * omega) - t_cut, 0.0)
 
-    def monodromy(self, rpm, depth, m: int, s: int = 1, cut_end: bool = False):
+    def step_maps(self, rpm, m: int):
+        """Depth-independent step matrices for speeds ``rpm``: P = e^{AΔt} (B, n, n), Γ0, Γ1 (B, n, p), e^{A(T − t_c)}.
+
+        Γ0 = ∫₀^Δt e^{A(Δt−s)} ds B, Γ1 = ∫₀^Δt e^{A(Δt−s)} (s/Δt) ds B, Δt = t_c/m, from one
+        exponential of the Van Loan block [[AΔt, BΔt, 0], [0, 0, I], [0, 0, 0]] per speed.
+        """
+        n, p = self.n, self.Bin.shape[1]
+        t_cut, t_free = self.cut_time(rpm)
+        dt = t_cut / m
+        X = np.zeros((rpm.size, n + 2 * p, n + 2 * p))
+        X[:, :n, :n] = self.A0 * dt[:, None, None]
+        # Input columns scaled to the norm of the state block (exact, undone below): the exponential's
+        # cost grows with the log of the block's norm.
+        c = max(np.abs(self.Bin).sum(axis=0).max() / max(np.abs(self.A0).sum(axis=0).max(), 1e-300), 1e-300)
+        X[:, :n, n: n + p] = (self.Bin / c) * dt[:, None, None]
+        X[:, n: n + p, n + p:] = np.eye(p)
+        Ex = expm_batch(X)
+        G1 = Ex[:, :n, n + p:] * c
+        return Ex[:, :n, :n], Ex[:, :n, n: n + p] * c - G1, G1, expm_batch(self.A0[None] * t_free[:, None, None])
+
+    def monodromy(self, rpm, depth, m: int, s: int = 1, cut_end: bool = False, maps=None):
         """Floquet transition matrices Φ, shape (B, D, D), for paired 1-D arrays rpm, depth.
 
         ``m`` steps over the cut; the delayed displacement is carried at every
         ``s``-th node (m/s + 1 nodes, local Lagrange interpolation of degree
-        ``INTERP_DEGREE`` in between; s = 1: every node — the plain first-order SDM).
-        ``cut_end=True`` also returns the map z ↦ y(t_c) to the end of the cut (B, n, D).
+        ``INTERP_DEGREE`` in between; s = 1: every node).
+        ``cut_end=True`` also returns the map z ↦ z(t_c) to the end of the cut (B, n, D).
+        ``maps``: :meth:`step_maps` of these speeds, if already computed.
+
+        Per step (module docstring) g = r(t − T) − C z is linear between the step's
+        ends, so z_{i+1} = P z_i + a(Γ0 − Γ1)H_i g_i + aΓ1 H_i g_{i+1}; the term in
+        z_{i+1} is solved by the Woodbury identity,
+        (I + U C)⁻¹ = I − U K C, U = aΓ1H_i, K = (I + C U)⁻¹ (d × d).
         """
         n, d = self.n, self.d
-        E, F = self.directional(m)
+        H = self.directional(m)
         L = self.interp(m, s)
         q1 = L.shape[1]
         B = rpm.size
-        t_cut, t_free = self.cut_time(rpm)
-        dt = t_cut / m
-        na = n + 2 * d
-        X = np.zeros((B, m, na, na))
-        X[:, :, :n, :n] = self.A0
-        X[:, :, :n, :n] -= depth[:, None, None, None] * E
-        X[:, :, :n, n: n + d] = depth[:, None, None, None] * F
-        X[:, :, :n] *= dt[:, None, None, None]
-        # Scale the input columns to the norm of the state block (exact, undone below): the
-        # exponential's cost grows with the log of the block's norm.
-        nm = np.abs(X[:, :, :n, :n]).sum(axis=-2).max(axis=(-2, -1))
-        nf = np.abs(X[:, :, :n, n: n + d]).sum(axis=-2).max(axis=(-2, -1))
-        c = np.maximum(nf / np.maximum(nm, 1e-3), 1.0)
-        X[:, :, :n, n: n + d] /= c[:, None, None, None]
-        X[:, :, n: n + d, n + d:] = np.eye(d)
-        Ex = expm_batch(X)
-        P = Ex[:, :, :n, :n]
-        G1 = Ex[:, :, :n, n + d:] * c[:, None, None, None]
-        G0 = Ex[:, :, :n, n: n + d] * c[:, None, None, None] - G1
-        Pfree = expm_batch(self.A0[None] * t_free[:, None, None])
-
+        P, G0, G1, Pfree = self.step_maps(rpm, m) if maps is None else maps
+        a = depth[:, None, None, None]
+        U0 = a * np.einsum("bnp,ipd->bind", G0, H)  # (B, m, n, d): a(Γ0 − Γ1)H_i
+        U1 = a * np.einsum("bnp,ipd->bind", G1, H)  # aΓ1H_i
+        # z_{i+1} = M_i z_i + E0_i r'_i + E1_i r'_{i+1} with S_i = I − W_i C, W_i = U1_i K_i:
+        # M_i = S_i (P − U0_i C) = P − U0_i C − W_i (C P − C U0_i C), E0_i = S_i U0_i, E1_i = S_i U1_i = W_i.
+        CU0, CU1 = self.C @ U0, self.C @ U1  # (B, m, d, d)
+        K = np.linalg.inv(np.eye(d) + CU1)
+        W = U1 @ K
+        right = np.concatenate([np.broadcast_to(self.C, CU0.shape[:2] + self.C.shape),
+                                (self.C @ P)[:, None] - CU0 @ self.C], axis=2)  # (B, m, 2d, n)
+        M = P[:, None] - np.concatenate([U0, W], axis=3) @ right
+        E0, E1 = U0 - W @ CU0, W
         D = n + q1 * d
         Y = np.zeros((B, n, D))
         Y[:, :, :n] = np.eye(n)
         Phi = np.empty((B, D, D))
-        Phi[:, n: n + d] = self.C @ Y
-        nz = L != 0
+        Phi[:, n: n + d] = 0.0
+        Phi[:, n: n + d, :n] = self.C
+        lo_c, Lw = self.stencils(m, s)
+        w = Lw.shape[-1]
+        # Delayed-displacement terms of every step at once: (B, m, n, w·d) over the window's nodes.
+        G = (np.stack([E0, E1], axis=4) @ Lw[:, None]).swapaxes(3, 4).reshape(B, m, n, w * d)
+        act = n  # columns of Y that can be non-zero so far (z_0, then the nodes reached)
         for i in range(m):  # loop over time steps of the cut (not over speeds or depths)
-            Y = P[:, i] @ Y
-            cols = np.flatnonzero(nz[i] | nz[i + 1])
-            a, b = cols[0], cols[-1] + 1
-            w = (G0[:, i, :, None, :] * L[i, a:b, None] + G1[:, i, :, None, :] * L[i + 1, a:b, None])
-            Y[:, :, n + a * d: n + b * d] += w.reshape(B, n, (b - a) * d)
+            c0 = n + lo_c[i] * d
+            new = max(act, c0 + w * d)
+            Y[:, :, :act] = M[:, i] @ Y[:, :, :act]
+            Y[:, :, c0: c0 + w * d] += G[:, i]
+            act = new
             if (i + 1) % s == 0:
                 j = (i + 1) // s
                 Phi[:, n + j * d: n + (j + 1) * d] = self.C @ Y
@@ -270,14 +343,14 @@ class _System:
         m = np.broadcast_to(np.asarray(m, int), rpm.shape)
         s = np.broadcast_to(np.asarray(s, int), rpm.shape)
         crit = np.empty(rpm.size, complex)
-        na = self.n + 2 * self.d
         with single_thread_blas():
             key = m * 1000 + s
             for kk in np.unique(key):
                 mm, ss = divmod(int(kk), 1000)
                 idx = np.flatnonzero(key == kk)
                 D = self.n + (mm // ss + 1) * self.d
-                chunk = max(1, _CHUNK_FLOATS // max(mm * na * na, D * D))
+                per_point = mm * self.n * (self.n + 2 * (INTERP_DEGREE + 2) * self.d) + self.n * D  # M, G, Y
+                chunk = max(1, _CHUNK_FLOATS // max(per_point, D * D))
                 for c in range(0, idx.size, chunk):
                     j = idx[c: c + chunk]
                     ev = np.linalg.eigvals(self.monodromy(rpm[j], depth[j], mm, ss))
@@ -352,10 +425,10 @@ class _System:
 
         A wave is a period of ``f_wave`` (Hz; default the highest natural
         frequency +10 %, chatter sitting just above a mode):
-        m = accuracy · STEPS_PER_WAVE · f_wave · t_c, on a ladder of values
+        m = accuracy · max(STEPS_PER_WAVE · f_wave · t_c, M_MIN), on a ladder of values
         within [20, m_max]; the delayed displacement is carried at every s-th
-        step, s the largest divisor of m leaving NODES_PER_WAVE · accuracy nodes
-        per wave and at least MIN_NODES intervals. A given ``m`` is used as it
+        step, s the largest divisor of m leaving NODES_PER_WAVE · max(accuracy, 1)
+        nodes per wave and at least MIN_NODES intervals. A given ``m`` is used as it
         is, with s = 1.
         """
         rpm = np.asarray(rpm, float)
@@ -364,11 +437,13 @@ class _System:
                 raise InputError(f"must be an integer ≥ 2, got {m!r}", field="m")
             return np.full(rpm.shape, int(m)), np.ones(rpm.shape, int)
         waves = (1.1 * self.f_max if f_wave is None else f_wave) * self.cut_time(rpm)[0]
-        need = np.ceil(accuracy * STEPS_PER_WAVE * waves)
+        # The floor M_MIN resolves H(t) over the cut whatever the waves: it scales with the accuracy too.
+        need = np.ceil(accuracy * np.maximum(STEPS_PER_WAVE * waves, M_MIN))
         ladder = _m_ladder(m_max)
         mm = ladder[np.minimum(np.searchsorted(ladder, need), ladder.size - 1)]
         # Largest divisor s of m with at least NODES_PER_WAVE nodes per wave and MIN_NODES + 1 nodes.
-        limit = np.minimum(mm / np.maximum(accuracy * NODES_PER_WAVE * waves, 1e-300), mm / MIN_NODES)
+        # Below accuracy 1 only the steps thin out: fewer than NODES_PER_WAVE nodes per wave do not interpolate.
+        limit = np.minimum(mm / np.maximum(max(accuracy, 1.0) * NODES_PER_WAVE * waves, 1e-300), mm / MIN_NODES)
         s = np.ones(mm.shape, int)
         for c in range(2, 17):  # candidate spacings, a handful
             s = np.where((mm % c == 0) & (c <= limit), c, s)
@@ -436,7 +511,7 @@ def sdm_spectral_radius(
     depth : array_like
         Axial depths, m (≥ 0), broadcast against ``rpm``.
     m : int, optional
-        Steps over the cut, every node carried (the plain first-order SDM); default: see :func:`sdm_lobes`.
+        Steps over the cut, every node carried; default: see :func:`sdm_lobes`.
     accuracy : float
         Resolution factor of the default discretisation (see :func:`sdm_lobes`).
     **deprecated
@@ -463,7 +538,7 @@ def sdm_spectral_radius(
     r, a = np.broadcast_arrays(np.asarray(rpm, float), np.asarray(depth, float))
     if np.any(~np.isfinite(r) | (r <= 0)) or np.any(~np.isfinite(a) | (a < 0)):
         raise InputError("speeds must be > 0 rpm and depths finite and ≥ 0 m", field="rpm/depth")
-    mm, ss = sysm.resolution(r.reshape(-1), m, acc)
+    mm, ss = sysm.resolution(r.reshape(-1), m, acc, int(round(M_MAX * max(acc, 1.0))))
     rho, _ = sysm.multipliers(r.reshape(-1), a.reshape(-1), mm, ss)
     return rho.reshape(r.shape)
 
@@ -483,7 +558,7 @@ def _zoa_minimum(sysm: _System, freq_hz: np.ndarray, phi: np.ndarray) -> float:
                                                            phi[:, 1, 0]))
     if valid.any():
         return float(depth[valid].min())
-    hmax = np.abs(sysm.directional(M_MIN)[1]).max() / max(np.abs(sysm.Bin).max(), 1e-300)
+    hmax = np.abs(sysm.directional(M_MIN)).max()
     return float(1.0 / max(hmax * np.abs(phi[0]).max(), 1e-300))
 
 
@@ -544,7 +619,7 @@ def sdm_lobes(
     rpm,
     m: int | None = None,
     accuracy: float = 1.0,
-    m_max: int = M_MAX,
+    m_max: int | None = None,
     depth_min: float | None = None,
     depth_max: float | None = None,
     step: float = 1.25,
@@ -566,15 +641,16 @@ def sdm_lobes(
     rpm : array_like
         Increasing spindle speeds, rpm.
     m : int, optional
-        Steps over the cut, the same at every speed, every node carried (the
-        plain first-order SDM); default ``None``: chosen per speed from
+        Steps over the cut, the same at every speed, every node carried;
+        default ``None``: chosen per speed from
         ``accuracy`` (module docstring).
     accuracy : float
-        Resolution factor (0.25 … 16) of the default discretisation: steps and
-        delayed-displacement nodes per chatter wave scale with it (steps up to
-        ``m_max``), and so does the time.
-    m_max : int
-        Largest default ``m``.
+        Resolution factor (0.25 … 16) of the default discretisation: steps per
+        chatter wave scale with it (up to ``m_max`` steps), delayed-displacement
+        nodes per wave with max(accuracy, 1), and so does the time (measured
+        error and cost: ``docs/design/stability.md``).
+    m_max : int, optional
+        Largest default ``m``; default 200 × max(accuracy, 1).
     depth_min, depth_max : float, optional
         Search range for the axial depth, m; default 1/4 and 100 times the
         zero-order minimum of the same model. Speeds still stable at
@@ -640,6 +716,8 @@ def sdm_lobes(
         if np.any(np.isfinite(zoa.chatter_hz)):
             # Chatter waves, not the highest mode, set the resolution: the exponentials integrate any mode exactly.
             f_wave = WAVE_MARGIN * float(np.nanmax(zoa.chatter_hz))
+    if m_max is None:
+        m_max = int(round(M_MAX * max(acc, 1.0)))
     msteps, spacing = sysm.resolution(grid, m, acc, m_max, f_wave)
 
     n = grid.size
@@ -686,13 +764,18 @@ class _Evaluator:
 def _search(ev, idx, start, depth_min, depth_max, step, lo, hi, rlo, rhi):
     """Bracket the limit of speeds ``idx``: ρ(lo) < 1 ≤ ρ(hi), in place.
 
-    Upward geometric search (ratio ``step``) from ``start``; a speed already
+    Upward search from ``start``: each step multiplies the depth by at most
+    ``step``; from the second stable point on, by less when the secant of
+    ln ρ against ln a through the last two points puts ρ = 1 closer
+    (aiming 0.5 % beyond it, so the bracket closes tight). A speed already
     unstable at a seeded start above ``depth_min`` is searched again from
     ``depth_min`` (the SDM limit can lie far below the zero-order one there).
     """
     a = start[idx].copy()
     todo = idx.copy()
     restarted = np.zeros(lo.size, bool)
+    prev_a = np.zeros(lo.size)  # last stable depth of the current upward run (0: none yet)
+    prev_g = np.zeros(lo.size)
     while todo.size:
         rho = ev(todo, a)
         uns = rho >= 1.0
@@ -704,17 +787,28 @@ def _search(ev, idx, start, depth_min, depth_max, step, lo, hi, rlo, rhi):
         hi[todo[uns]], rhi[todo[uns]] = a[uns], rho[uns]
         st = ~uns & ~again
         lo[todo[st]], rlo[todo[st]] = a[st], rho[st]
+        g = np.log(np.maximum(rho, 1e-300))
+        ratio = np.full(todo.size, step)
+        pa, pg = prev_a[todo], prev_g[todo]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            slope = (g - pg) / np.log(a / pa)
+            guess = np.exp(-g / slope) * 1.005
+        ok = st & (pa > 0) & (slope > 0) & np.isfinite(guess)
+        ratio[ok] = np.clip(guess[ok], 1.002, step)
+        prev_a[todo[st]], prev_g[todo[st]] = a[st], g[st]
         keep = ~uns & ~(st & (a >= depth_max))
-        todo, a = todo[keep], np.where(again, a, np.minimum(a * step, depth_max))[keep]
+        todo, a = todo[keep], np.where(again, a, np.minimum(a * ratio, depth_max))[keep]
 
 
 def _refine(ev, idx, lo, hi, rlo, rhi, rtol, max_iter=200):
     """Shrink every finite bracket [lo, hi] (ρ(lo) < 1 ≤ ρ(hi)) to hi − lo ≤ rtol·hi, in place.
 
-    Illinois (modified false position) on ln ρ against ln a, with a
-    bisection step (geometric mean; halving while lo = 0) whenever the last
-    step did not halve the bracket: the critical multiplier below the limit is
-    often not the one that crosses, so ln ρ(ln a) can have a kink inside the
+    Illinois (modified false position) on ln ρ against ln a; the estimate is
+    moved 0.4·rtol towards the far end of the bracket, so an accurate
+    estimate closes the bracket at the next evaluation. A bisection step
+    (geometric mean; halving while lo = 0) follows whenever the last step did
+    not halve the bracket: the critical multiplier below the limit is often
+    not the one that crosses, so ln ρ(ln a) can have a kink inside the
     bracket, where plain false position stalls.
     """
     br = idx[np.isfinite(hi[idx]) & (hi[idx] - lo[idx] > rtol * hi[idx])]
@@ -730,7 +824,8 @@ def _refine(ev, idx, lo, hi, rlo, rhi, rtol, max_iter=200):
         with np.errstate(divide="ignore", invalid="ignore"):
             xl, xh = np.log(l), np.log(h)
             x = xl - glo[br] * (xh - xl) / (ghi[br] - glo[br])
-            # Stay inside the bracket, at least a quarter of the tolerance from its ends.
+            # Overshoot towards the farther end, and stay at least a quarter of the tolerance inside.
+            x = x + np.where(x - xl > xh - x, -0.4, 0.4) * rtol
             eps = 0.25 * rtol
             x = np.clip(x, xl + eps, xh - eps)
         geo = np.where(l > 0, np.sqrt(l * h), 0.5 * h)

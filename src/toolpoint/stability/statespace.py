@@ -8,7 +8,7 @@ F = (F_x, F_y) (N), and two outputs, the displacements r = (x, y) (m):
 so its receptance matrix is Φ(iω) = C (iωI − A)⁻¹ B (m/N), cross terms
 Φ_xy, Φ_yx included. Every modal description enters the same way:
 
-* real modes per direction (:class:`~toolpoint.stability.modalfit.ModalModel`):
+* real modes per direction (:class:`ModalModel`):
   per mode the states (q_r, q̇_r) with q̈_r + 2ζ_rω_r q̇_r + ω_r² q_r = F_d/m_r,
   output d = Σ q_r (:meth:`StateSpaceModel.from_modes`);
 * complex poles λ_r = σ_r + iω_dr with complex 2×2 residue matrices R_r,
@@ -34,8 +34,117 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..frf import FRF
 
-__all__ = ["StateSpaceModel", "from_modal_fit"]
+__all__ = ["ModalModel", "StateSpaceModel", "from_modal_fit"]
+
+
+@dataclass(frozen=True)
+class ModalModel:
+    """Real modes of one direction (x or y) of the tool point (no fitting here: fits are
+    :func:`toolpoint.dynamics.modal.fit_frfs`, entering the SDM through :func:`from_modal_fit`).
+
+    Attributes
+    ----------
+    fn_hz, zeta, mass_kg : (n,) natural frequencies (Hz), damping ratios, modal masses (kg).
+    upper_residual : constant compliance R_u for modes above the band, m/N.
+    lower_residual : R_l in −R_l/ω² for modes below the band, 1/kg.
+    fit_error : relative RMS error of the fit (nan if not fitted).
+    """
+
+    fn_hz: np.ndarray
+    zeta: np.ndarray
+    mass_kg: np.ndarray
+    upper_residual: float = 0.0
+    lower_residual: float = 0.0
+    fit_error: float = float("nan")
+    label: str = ""
+
+    def __post_init__(self):
+        f, z, m = (np.atleast_1d(np.asarray(v, dtype=float)).reshape(-1) for v in (self.fn_hz, self.zeta, self.mass_kg))
+        if not (f.size == z.size == m.size):
+            raise InputError(f"{f.size} frequencies, {z.size} damping ratios, {m.size} masses", field="modes")
+        if np.any(~np.isfinite(f) | (f <= 0)):
+            raise InputError("natural frequencies must be finite and > 0 Hz", field="fn_hz")
+        if np.any(~np.isfinite(z) | (z < 0)):
+            raise InputError("damping ratios must be finite and ≥ 0", field="zeta")
+        if np.any(~np.isfinite(m) | (m == 0)):
+            raise InputError("modal masses must be finite and non-zero", field="mass_kg")
+        for name, v in (("fn_hz", f), ("zeta", z), ("mass_kg", m)):
+            object.__setattr__(self, name, v)
+
+    @property
+    def n_modes(self) -> int:
+        """Number of modes."""
+        return self.fn_hz.size
+
+    @property
+    def omega_n(self) -> np.ndarray:
+        """Natural angular frequencies ω_r = 2π f_r, rad/s."""
+        return 2 * np.pi * self.fn_hz
+
+    @property
+    def stiffness(self) -> np.ndarray:
+        """Modal stiffness k_r = m_r ω_r², N/m."""
+        return self.mass_kg * self.omega_n**2
+
+    @property
+    def damping(self) -> np.ndarray:
+        """Modal viscous damping c_r = 2 ζ_r m_r ω_r, N·s/m."""
+        return 2 * self.zeta * self.mass_kg * self.omega_n
+
+    def frf(self, freq_hz, *, residuals: bool = True) -> FRF:
+        """Re-synthesised receptance at ``freq_hz``.
+
+        Parameters
+        ----------
+        freq_hz : array_like
+            Increasing frequencies, Hz.
+        residuals : bool
+            Include the residual terms R_u − R_l/ω².
+
+        Returns
+        -------
+        FRF
+            Receptance, m/N.
+
+        Examples
+        --------
+        >>> m = ModalModel([100.0], [0.05], [2.0])
+        >>> k = m.stiffness[0]                         # N/m
+        >>> bool(np.isclose(m.frf([0.0]).values[0], 1 / k))   # static compliance 1/k, m/N
+        True
+        """
+        f = np.asarray(freq_hz, dtype=float).reshape(-1)
+        w = 2 * np.pi * f
+        basis = _mode_basis(w, self.omega_n, self.zeta)
+        v = basis @ (1.0 / self.mass_kg)
+        if residuals:
+            v = v + self.upper_residual
+            if self.lower_residual:
+                with np.errstate(divide="ignore"):
+                    v = v - self.lower_residual / w**2
+        return FRF(f, v, "receptance", self.label or "modal fit")
+
+    def table(self) -> str:
+        """Human-readable table of the modes (one line per mode)."""
+        lines = [f"{'mode':>4} {'fn [Hz]':>10} {'zeta [%]':>9} {'mass [kg]':>11} {'k [N/m]':>11}"]
+        for r in range(self.n_modes):
+            lines.append(
+                f"{r + 1:>4} {self.fn_hz[r]:>10.2f} {100 * self.zeta[r]:>9.3f} "
+                f"{self.mass_kg[r]:>11.4g} {self.stiffness[r]:>11.4g}"
+            )
+        if np.isfinite(self.fit_error):
+            lines.append(f"fit error (relative RMS): {100 * self.fit_error:.2f} %")
+        return "\n".join(lines)
+
+
+def _mode_basis(w, wn, zeta):
+    """Columns 1/(ω_r² − ω² + 2iζ_r ω_r ω), shape (n_freq, n_modes), s²."""
+    w = w[:, None]
+    return 1.0 / (wn**2 - w**2 + 2j * zeta * wn * w)
+
+
 
 
 def _matrix(value, shape, name):
@@ -194,8 +303,6 @@ class StateSpaceModel:
             States (q_r, q̇_r) per mode: A block [[0, 1], [−ω_r², −2ζ_rω_r]], B (0, 1/m_r) on the
             mode's direction, C (1, 0).
         """
-        from .modalfit import ModalModel
-
         if modes_x is None and modes_y is None:
             raise InputError("need modes in x, y or both", field="modes")
         blocks = []

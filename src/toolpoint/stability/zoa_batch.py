@@ -98,18 +98,25 @@ def zoa_limits(freq_hz, receptance, cutting: CuttingConditions, rpm, *, cap_m: f
     qmax = np.zeros((H.shape[0], G))  # 1/a_lim, 1/m; 0 = no lobe
     q_cap = 0.0 if not np.isfinite(cap_m) else 1.0 / cap_m
     rmin, rmax = grid[0], grid[-1]
+    step = (rmax - rmin) / (G - 1) if G > 1 else 0.0
+    step = step if G > 2 and np.allclose(np.diff(grid), step, rtol=1e-9, atol=0) else None
     chunk = max(1, int(_BLOCK_ENTRIES // max(1, 4 * G)))
     for s0 in range(0, H.shape[0], chunk):
         mu = lam[None, :, None] * H[s0:s0 + chunk, None, :]  # (n, 2, F)
-        _accumulate(qmax[s0:s0 + chunk], mu, f, 60.0 / cutting.teeth, period, rmin, rmax, q_cap, subdivide)
+        _accumulate(qmax[s0:s0 + chunk], mu, f, 60.0 / cutting.teeth, period, rmin, rmax, q_cap, subdivide, step)
     with np.errstate(divide="ignore"):
         limit = np.where(qmax > 0, 1.0 / np.where(qmax > 0, qmax, 1.0), np.inf)[:, ::-1]
     limit = np.minimum(limit, cap_m)
     return limit[0] if single else limit
 
 
-def _accumulate(qmax, mu, f, teeth_c, period, rmin, rmax, q_cap, subdivide):
-    """qmax[s, g] = max(qmax, 1/a_lim of every lobe piece of sample s at reversed-grid speed g)."""
+def _accumulate(qmax, mu, f, teeth_c, period, rmin, rmax, q_cap, subdivide, step):
+    """qmax[s, g] = max(qmax, 1/a_lim of every lobe piece of sample s at reversed-grid speed g).
+
+    Two passes: (piece, lobe) pairs whose period range (a conservative bound over the piece's
+    ``subdivide + 1`` points) holds no grid speed are dropped first — most of them on a grid of a
+    few hundred speeds — and only the rest are split into their ``subdivide`` parts.
+    """
     scale = np.abs(mu).max(axis=1, keepdims=True)
     valid = np.isfinite(mu) & (mu.real < -1e-9 * scale) & (f > 0)
     v0, v1 = valid[..., :-1], valid[..., 1:]
@@ -127,27 +134,36 @@ def _accumulate(qmax, mu, f, teeth_c, period, rmin, rmax, q_cap, subdivide):
     tb = np.where(both, 1.0, np.where(left, tstar, 1.0))
     ok = tb > ta
     s, i, m0, m1, ta, tb = s[ok], i[ok], m0[ok], m1[ok], ta[ok], tb[ok]
-    # each piece in `subdivide` parts: the speed n(t) is not linear in t where ε turns fast (sharp peaks)
-    j = np.tile(np.arange(subdivide), s.size)
-    s, i, m0, m1 = (np.repeat(v, subdivide) for v in (s, i, m0, m1))
-    ta, tb = np.repeat(ta, subdivide), np.repeat(tb, subdivide)
-    ta, tb = ta + (tb - ta) * j / subdivide, ta + (tb - ta) * (j + 1) / subdivide
-    ends = []
-    for t, is_crossing in ((ta, (ta > 0) & (j == 0)), (tb, (tb < 1) & (j == subdivide - 1))):
-        mt = m0 + t * (m1 - m0)
-        mt = np.where(is_crossing, 1j * mt.imag, mt)  # exactly Re μ = 0 at a crossing
-        ft = f[i] + t * (f[i + 1] - f[i])
-        frac = (np.pi + 2 * np.arctan2(-mt.imag, -mt.real)) / (2 * np.pi)
-        ends.append((np.maximum(-2.0 * mt.real, 0.0), teeth_c * ft, frac))
-    (qa, ca, fra), (qb, cb, frb) = ends
-    # lobes k with n = c/(k + frac) inside [rmin, rmax], over both ends
-    klo = np.maximum(np.minimum(np.ceil(ca / rmax - fra), np.ceil(cb / rmax - frb)), 0)
-    khi = np.maximum(np.floor(ca / rmin - fra), np.floor(cb / rmin - frb))
+    # the piece's subdivide + 1 points (each piece in `subdivide` parts: the speed n(t) is not linear in t
+    # where ε turns fast, at sharp peaks)
+    t = ta[:, None] + (tb - ta)[:, None] * (np.arange(subdivide + 1) / subdivide)[None, :]  # (P, S+1)
+    mt = m0[:, None] + t * (m1 - m0)[:, None]
+    mt[:, 0] = np.where(ta > 0, 1j * mt[:, 0].imag, mt[:, 0])  # exactly Re μ = 0 at a crossing
+    mt[:, -1] = np.where(tb < 1, 1j * mt[:, -1].imag, mt[:, -1])
+    c = teeth_c * (f[i][:, None] + t * (f[i + 1] - f[i])[:, None])  # 60 f / N, increasing along the piece
+    frac = (np.pi + 2 * np.arctan2(-mt.imag, -mt.real)) / (2 * np.pi)  # in [0, 1]
+    qt = np.maximum(-2.0 * mt.real, 0.0)
+    # pass 1: lobe k of the whole piece has its tooth period (1/rpm) within [(k + fr_lo)/c_hi, (k + fr_hi)/c_lo]
+    fr_lo, fr_hi, c_lo, c_hi = frac.min(axis=1), frac.max(axis=1), c[:, 0], c[:, -1]
+    klo = np.maximum(np.ceil(c_lo / rmax - fr_hi), 0)
+    khi = np.floor(c_hi / rmin - fr_lo)
     cnt = np.maximum(khi - klo + 1, 0).astype(np.int64)
     p = np.repeat(np.arange(cnt.size), cnt)
     k = klo[p] + (np.arange(p.size) - np.repeat(np.cumsum(cnt) - cnt, cnt))
-    pa = (k + fra[p]) / ca[p]  # tooth period × 60/N... in 1/rpm: n = c/(k+frac) → 1/n = (k+frac)/c
-    pb = (k + frb[p]) / cb[p]
+    if step is None:
+        hit = (np.searchsorted(period, (k + fr_hi[p]) / c_lo[p], "right")
+               > np.searchsorted(period, (k + fr_lo[p]) / c_hi[p], "left"))
+    else:  # evenly spaced speeds: grid index m = (rpm − rmin)/step, widened by 1e-6 step (pass 2 is exact)
+        with np.errstate(divide="ignore"):
+            m_hi = np.minimum((c_hi[p] / (k + fr_lo[p]) - rmin) / step + 1e-6, period.size - 1)
+        m_lo = np.maximum((c_lo[p] / (k + fr_hi[p]) - rmin) / step - 1e-6, 0.0)
+        hit = np.floor(m_hi) >= np.ceil(m_lo)
+    p, k = p[hit], k[hit]
+    # pass 2: the parts j of the pieces and lobes that hold a grid speed
+    j = np.tile(np.arange(subdivide), p.size)
+    p, k = np.repeat(p, subdivide), np.repeat(k, subdivide)
+    pa = (k + frac[p, j]) / c[p, j]  # 1/n = (k + frac)/c, 1/rpm
+    pb = (k + frac[p, j + 1]) / c[p, j + 1]
     lo = np.searchsorted(period, np.minimum(pa, pb), "left")
     hi = np.searchsorted(period, np.maximum(pa, pb), "right")
     n_g = np.maximum(hi - lo, 0)
@@ -155,12 +171,13 @@ def _accumulate(qmax, mu, f, teeth_c, period, rmin, rmax, q_cap, subdivide):
     g = lo[e] + (np.arange(e.size) - np.repeat(np.cumsum(n_g) - n_g, n_g))
     if e.size == 0:
         return
-    qa_e, qb_e, pa_e, pb_e = qa[p][e], qb[p][e], pa[e], pb[e]
+    pe, je = p[e], j[e]
+    qa_e, qb_e, pa_e, pb_e = qt[pe, je], qt[pe, je + 1], pa[e], pb[e]
     span = pb_e - pa_e
     with np.errstate(divide="ignore", invalid="ignore"):
         w = np.where(span != 0, (period[g] - pa_e) / span, 0.0)
     qg = np.where(span != 0, qa_e + np.clip(w, 0, 1) * (qb_e - qa_e), np.maximum(qa_e, qb_e))
     G = period.size
     flat = qmax.reshape(-1)
-    np.maximum.at(flat, s[p][e] * G + g, qg)
+    np.maximum.at(flat, s[pe] * G + g, qg)
     qmax[...] = flat.reshape(qmax.shape)

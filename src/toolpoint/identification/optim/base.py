@@ -41,7 +41,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 __all__ = ["CONVERGED", "MAXITER", "MAXFEV", "OTHER", "STATUS_MESSAGES", "Termination", "Optimizer", "Tracker",
-           "horizon", "to_unit", "from_unit"]
+           "horizon", "to_unit", "from_unit", "start_unit"]
 
 CONVERGED, MAXITER, MAXFEV, OTHER = 0, 1, 2, 3
 #: One-line meaning of each status code (the ``message`` adds the details).
@@ -332,3 +332,26 @@ def to_unit(problem, X):
 def from_unit(problem, U):
     """Map unit-cube points U to log10 points within the problem's bounds."""
     return problem.xl + np.asarray(U) * (problem.xu - problem.xl)
+
+
+def start_unit(problem) -> np.ndarray | None:
+    """The problem's starting point (its ``x_start``, log10, if it has one) on the unit cube, else None.
+
+    The population methods put one member there (GA, PSO: the first member; SA: the first chain; DE: scipy's
+    ``x0``); the hybrid also starts least squares from it. The problem has checked that it lies inside the
+    bounds (:class:`~toolpoint.identification.problem.FRFProblem` refuses a start outside them).
+
+    Examples
+    --------
+    >>> class P:
+    ...     xl, xu, x_start = np.zeros(2), np.full(2, 4.0), np.array([1.0, 3.0])
+    >>> start_unit(P()).tolist()
+    [0.25, 0.75]
+    """
+    x = getattr(problem, "x_start", None)
+    if x is None:
+        return None
+    u = to_unit(problem, np.asarray(x, float))
+    if not np.all((u >= -1e-9) & (u <= 1 + 1e-9)):  # round-off of log10 at a bound is allowed
+        raise ValueError("the starting point lies outside the bounds")
+    return np.clip(u, 0.0, 1.0)

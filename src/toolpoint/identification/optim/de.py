@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import differential_evolution
 
-from .base import CONVERGED, MAXITER, OTHER, Optimizer, Termination, Tracker
+from .base import CONVERGED, MAXITER, OTHER, Optimizer, Termination, Tracker, from_unit, start_unit
 
 __all__ = ["DE"]
 
@@ -88,6 +88,7 @@ class DE(Optimizer):
             updating="deferred",
             vectorized=True,
             callback=cb,
+            x0=None if (s0 := start_unit(problem)) is None else from_unit(problem, s0),  # one member at the start
         )
         if tr.status is None:  # scipy stopped by itself: pass its verdict through
             if res.success:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Optimizer, Tracker, from_unit, horizon, warn_renamed
+from .base import Optimizer, Tracker, from_unit, horizon, start_unit, warn_renamed
 
 __all__ = ["GA"]
 
@@ -179,6 +179,8 @@ class GA(Optimizer):
             return F
 
         U = rng.random((P, d))
+        if (s0 := start_unit(problem)) is not None:
+            U[0] = s0  # one member at the problem's start
         F = evaluate(U)
         gen = 0
         last_step = None

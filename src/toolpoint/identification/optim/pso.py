@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Optimizer, Tracker, from_unit, horizon
+from .base import Optimizer, Tracker, from_unit, horizon, start_unit
 
 __all__ = ["PSO"]
 
@@ -112,6 +112,8 @@ class PSO(Optimizer):
             n = max(1, min(n, term.maxfev))
         H = horizon(term, n, n)  # the inertia schedule follows the run's real length
         X = rng.random((n, d))
+        if (s0 := start_unit(problem)) is not None:
+            X[0] = s0  # one particle at the problem's start
         V = rng.uniform(-self.max_velocity, self.max_velocity, (n, d))
         F = problem.evaluate(from_unit(problem, X))
         P, PF = X.copy(), F.copy()

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Optimizer, Tracker, from_unit, warn_renamed
+from .base import Optimizer, Tracker, from_unit, start_unit, warn_renamed
 
 __all__ = ["SA"]
 
@@ -144,6 +144,8 @@ class SA(Optimizer):
             return np.log(np.maximum(F, 1e-300))
 
         X = rng.random((n, d))
+        if (s0 := start_unit(problem)) is not None:
+            X[0] = s0  # one chain from the problem's start
         L = lnf(X)
         V = np.repeat(np.eye(d)[None], n, axis=0)  # move directions, columns
         a = np.zeros((n, d))  # annealing parameters

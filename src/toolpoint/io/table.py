@@ -1,0 +1,87 @@
+"""CSV tables read one way: every unreadable file becomes one :class:`~toolpoint.errors.InputError`.
+
+The project's tables (campaign ``measurements.csv`` and ``identified.csv``, ANFIS
+training data, the tool library, the library's ``recommendations.csv``) are
+small CSV files written by people and spreadsheets. Reading them can fail in the
+operating system (missing file, a folder, no permission), in decoding (not
+UTF-8, binary) or in the CSV parser (a NUL byte, a runaway quote); all of these
+must reach the user as one line naming the file, never as a traceback.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+from pathlib import Path
+
+from ..errors import InputError
+
+__all__ = ["read_rows", "read_table"]
+
+
+def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, list[str]]]:
+    """The non-blank rows of a CSV file with their line numbers (1-based, as an editor shows them).
+
+    UTF-8 with or without a byte-order mark; a row whose cells are all blank is skipped.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    what : str, default "CSV"
+        What the file is, for the message (e.g. ``"the tool library"``).
+
+    Raises
+    ------
+    InputError
+        A missing file, a folder, an unreadable or undecodable file, or CSV syntax
+        the parser refuses (field ``file``'s name in the message).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "t.csv"
+    >>> _ = p.write_text("a,b\\n\\n1,2\\n")
+    >>> read_rows(p)
+    [(1, ['a', 'b']), (3, ['1', '2'])]
+    """
+    p = Path(path)
+    if p.is_dir():
+        raise InputError(f"cannot read {what}: is a folder, not a file", file=p)
+    try:
+        with open(p, newline="", encoding="utf-8-sig") as fh:
+            reader = csv.reader(fh)
+            return [(reader.line_num, row) for row in reader if any(c.strip() for c in row)]
+    except FileNotFoundError:
+        raise InputError(f"cannot read {what}: file not found", file=p) from None
+    except UnicodeDecodeError as err:
+        raise InputError(f"cannot read {what}: not UTF-8 text (byte {err.start})", file=p) from None
+    except (OSError, csv.Error) as err:
+        raise InputError(f"cannot read {what}: {getattr(err, 'strerror', None) or err}", file=p) from None
+
+
+def read_table(path: str | os.PathLike, *, what: str = "CSV") -> tuple[list[str], list[tuple[int, dict]]]:
+    """Header (stripped names) and (line number, row dict) of every data row of a CSV file.
+
+    Like :class:`csv.DictReader`: a short row has ``None`` for its missing cells, a
+    long row keeps its extra cells under the key ``None``. An empty file has an
+    empty header and no rows.
+
+    Raises
+    ------
+    InputError
+        As :func:`read_rows`.
+    """
+    rows = read_rows(path, what=what)
+    if not rows:
+        return [], []
+    header = [h.strip() for h in rows[0][1]]
+    out = []
+    for line, row in rows[1:]:
+        d: dict = dict(zip(header, row))
+        if len(row) < len(header):
+            d.update({h: None for h in header[len(row):]})
+        elif len(row) > len(header):
+            d[None] = row[len(header):]
+        out.append((line, d))
+    return header, out
