@@ -46,6 +46,8 @@ __all__ = ["COLUMNS", "FILE_NAME", "new_row", "resume", "Appender", "read_identi
 FILE_NAME = "identified.csv"
 #: Largest tool diameter or overhang accepted, mm (a 10 m tool: beyond it the number is not a tool size).
 MAX_LENGTH_MM = 1e4
+#: Smallest tool diameter or overhang accepted, mm (a 1 µm tool: below it D⁴ and the beam model underflow).
+MIN_LENGTH_MM = 1e-3
 #: Largest magnitude of any other required number (squares and sums of squares stay finite).
 MAX_ABS_VALUE = 1e100
 COLUMNS = (
@@ -238,7 +240,7 @@ class IdentifiedRows:
             Column name.
         required : bool, default True
             True: every row must hold a finite number, within ±:data:`MAX_ABS_VALUE`
-            (diameter and overhang: in (0, :data:`MAX_LENGTH_MM`] mm) — an InputError
+            (diameter and overhang: in [:data:`MIN_LENGTH_MM`, :data:`MAX_LENGTH_MM`] mm) — an InputError
             naming the line and the cell otherwise; False: NaN where it is not a finite number.
 
         Returns
@@ -268,8 +270,8 @@ class IdentifiedRows:
                 raise InputError(f"line {line}: {cell!r} is not a finite number (status ok)", file=self.path,
                                  field=name)
             return math.nan
-        if required and name in ("diameter_mm", "overhang_mm") and not 0 < v <= MAX_LENGTH_MM:
-            raise InputError(f"line {line}: {cell!r} mm is not a tool size (0 to {MAX_LENGTH_MM:g} mm)",
+        if required and name in ("diameter_mm", "overhang_mm") and not MIN_LENGTH_MM <= v <= MAX_LENGTH_MM:
+            raise InputError(f"line {line}: {cell!r} mm is not a tool size ({MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm)",
                              file=self.path, field=name)
         if required and abs(v) > MAX_ABS_VALUE:
             raise InputError(f"line {line}: {cell!r} is beyond ±{MAX_ABS_VALUE:g} (models square it)",
@@ -281,8 +283,12 @@ class IdentifiedRows:
         return self.has(f"{param}_lo") and self.has(f"{param}_hi")
 
     def interval(self, param: str) -> tuple[np.ndarray, np.ndarray]:
-        """(lo, hi) of the 95 % intervals of ``param`` (its unit; NaN where not a number)."""
-        return self.column(f"{param}_lo", required=False), self.column(f"{param}_hi", required=False)
+        """(lo, hi) of the 95 % intervals of ``param`` (its unit; NaN where not a number or not an interval of a
+        positive parameter: lo < 0, hi ≤ 0 or hi < lo — then the row has no interval)."""
+        lo, hi = self.column(f"{param}_lo", required=False), self.column(f"{param}_hi", required=False)
+        bad = (lo < 0) | (hi <= 0) | (hi < lo)
+        lo[bad] = hi[bad] = np.nan
+        return lo, hi
 
     def identified(self, param: str) -> np.ndarray:
         """Per row: whether ``param`` was identified (:func:`~toolpoint.identification.params.is_identified`).

@@ -28,11 +28,12 @@ def run(args) -> int:
     """Predict the joint of a tool (D, L in mm) from the learned models and write its tool-point FRF."""
     from ..campaign.predict import predict_frf
 
-    from ..campaign.results import MAX_LENGTH_MM
+    from ..campaign.results import MAX_LENGTH_MM, MIN_LENGTH_MM
 
     for name in ("diameter", "overhang"):
-        if not (math.isfinite(getattr(args, name)) and 0 < getattr(args, name) <= MAX_LENGTH_MM):
-            raise InputError(f"must be a number > 0 and ≤ {MAX_LENGTH_MM:g} mm, got {getattr(args, name):g}",
+        if not (math.isfinite(getattr(args, name)) and MIN_LENGTH_MM <= getattr(args, name) <= MAX_LENGTH_MM):
+            raise InputError(f"must be a number from {MIN_LENGTH_MM:g} to {MAX_LENGTH_MM:g} mm, got "
+                             f"{getattr(args, name):g}",
                              file="command line", field=f"--{name}")
     inputs = _inputs(args)
     out = out_path(args.out, "--out", inputs=inputs)

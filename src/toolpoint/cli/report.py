@@ -17,12 +17,13 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``toolpoint report``."""
-    from .common import out_path, use_agg
+    from .common import out_path, use_agg, warnings_to_stderr
     from ..recommend.report import write_report
 
     use_agg()
     d = Path(args.dir)
     inputs = [d / "recommendations.csv", *sorted((d / "tools").glob("*"))]  # what the report reads
     out = out_path(args.out, "--out", inputs=inputs) if args.out else None
-    print(f"report → {write_report(args.dir, out)}")
+    with warnings_to_stderr():
+        print(f"report → {write_report(args.dir, out)}")
     return 0

@@ -762,6 +762,12 @@ class ANFIS(RegressorMixin, BaseEstimator):
             premise.append(P)
         C = array("consequents", (int(np.prod(n_mfs)), d + 1 if model.order == 1 else 1))
         rng = array("input_range", (d, 2))
+        for i, P in enumerate(premise):  # the MFs training keeps valid (_make_valid): σ, a, b > 0, sorted corners
+            span = float(rng[i, 1] - rng[i, 0])
+            if not np.array_equal(_make_valid(model.mf, P, span if span > 0 else 0.0), P) or (
+                    model.mf in ("gauss", "gbell") and np.any(P[:, 0] <= 0)):
+                raise bad(f"premise[{i}]", f"invalid {model.mf} membership functions (widths must be > 0, "
+                                           "corners sorted with gaps)")
         names = doc.get("input_names")
         if names is not None and (not isinstance(names, list) or len(names) != d):
             raise bad("input_names", f"must be a list of {d} names (one per input)")

@@ -21,6 +21,8 @@ import base64
 import html
 import io
 import json
+import warnings
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -172,6 +174,38 @@ def _joint_table(s) -> str:
             f"</tr></thead><tbody>{rows}</tbody></table>")
 
 
+#: What a damaged tool file raises while its section is built (missing or cut file, bad JSON, missing keys,
+#: wrong types or shapes, numbers that do not format).
+_DAMAGED = (OSError, ValueError, KeyError, IndexError, TypeError, AttributeError, OverflowError,
+            zipfile.BadZipFile)
+
+
+def _section(d: Path, tid: str, n_data: int) -> str:
+    """One tool's collapsible section (its data read from ``d/tools/<tid>.npz`` and ``.json``)."""
+    with np.load(d / "tools" / f"{tid}.npz") as z:
+        a = {k: z[k] for k in z.files}
+    s = json.loads((d / "tools" / f"{tid}.json").read_text(encoding="utf-8"))
+    data = json.dumps(_plot_data(a, s), separators=(",", ":"), allow_nan=False)
+    pts = "".join(f"<tr><td class=t>{html.escape(str(p['kind']))}</td><td>{p['rpm']:.0f}</td><td>{p['depth_mm']:.3g}"
+                  f"</td><td>{p['limit_p05_mm']:.3g}</td><td>{p['limit_p50_mm']:.3g}</td><td>{p['p_stable']:.2f}</td>"
+                  "</tr>" for p in s["points"])
+    best = s["points"][0]
+    notes = "".join(f"<li>{html.escape(str(n))}</li>" for n in s.get("notes", []))
+    cut = s.get("cutting", {})
+    return (f'<details id="tool-{html.escape(tid)}" data-src="d{n_data}" ontoggle="draw(this)"'
+            f'{" open" if n_data == 1 else ""}><summary><b>{html.escape(tid)}</b>: {best["rpm"]:.0f} rpm, '
+            f'{best["depth_mm"]:.3g} mm ({html.escape(str(best["kind"]))})</summary>'
+            f"<p>D {s.get('diameter_mm', '')} mm, L {s.get('overhang_mm', '')} mm, holder "
+            f"{html.escape(str(s.get('holder', '')))}; {cut.get('teeth', '')} teeth, K<sub>t</sub> "
+            f"{cut.get('tangential_coeff', 0) / 1e6:.4g} N/mm², K<sub>r</sub> {cut.get('radial_ratio', 0):.3g} "
+            f"({html.escape(str(cut.get('source', '')))}), a<sub>e</sub>/D {cut.get('radial_immersion', '')}, "
+            f"{cut.get('milling', '')} milling; {s['n_samples']} joint samples</p>"
+            f"<ul>{notes}</ul><table><thead><tr><th>point</th><th>rpm</th><th>depth mm (recommended)</th>"
+            f"<th>5 % limit mm</th><th>50 % limit mm</th><th>P(stable)</th></tr></thead><tbody>{pts}</tbody></table>"
+            f'{_joint_table(s)}<div class="figs"></div>'
+            f'<script type="application/json" id="d{n_data}">{data}</script></details>')
+
+
 def write_report(out_dir, path=None) -> Path:
     """Write the HTML report of a library run.
 
@@ -190,16 +224,21 @@ def write_report(out_dir, path=None) -> Path:
     Raises
     ------
     InputError
-        No ``recommendations.csv`` in ``out_dir``, or one without rows.
+        No ``recommendations.csv`` in ``out_dir``, one without rows or without its ``id``/``status``
+        columns. (A tool whose own files are damaged gets a section saying so, and a warning.)
     """
     d = Path(out_dir)
     table = d / FILE_NAME
     if not table.is_file():
         raise InputError("not found: run 'toolpoint library' first", file=table)
-    rows = [r for _, r in read_table(table, what="the library's results")[1]]
+    header, rows = read_table(table, what="the library's results")
+    for name in ("id", "status"):
+        if name not in header:
+            raise InputError(f"no column {name!r}: not a 'toolpoint library' results table", file=table, field=name)
+    rows = [r for _, r in rows]
     if not rows:
         raise InputError("no tools in the results", file=table)
-    rows.sort(key=lambda r: r.get("id", ""))
+    rows.sort(key=lambda r: r.get("id") or "")
     head = "".join(f'<th onclick="sortBy(this)">{html.escape(h)}</th>' for h in SHOWN.values())
     body, sections, n_data = [], [], 0
     for r in rows:
@@ -220,36 +259,16 @@ def write_report(out_dir, path=None) -> Path:
         body.append(f'<tr class="{html.escape(r.get("status", ""))}">{"".join(cells)}</tr>')
         if r.get("status") != "ok":
             continue
-        tid = r["id"]
+        tid = r.get("id") or ""
         try:
-            with np.load(d / "tools" / f"{tid}.npz") as z:
-                a = {k: z[k] for k in z.files}
-            s = json.loads((d / "tools" / f"{tid}.json").read_text(encoding="utf-8"))
-            data = json.dumps(_plot_data(a, s), separators=(",", ":"), allow_nan=False)
-        except (OSError, ValueError, KeyError, IndexError) as e:
+            sections.append(_section(d, tid, n_data + 1))
+            n_data += 1
+        except _DAMAGED as e:  # a damaged tool is named on the page and on stderr; the others go on
+            where = d / "tools" / tid
+            warnings.warn(f"{where}.json/.npz: unreadable or incomplete ({type(e).__name__}: {e}); "
+                          "its section of the report says so (run 'toolpoint library' again to redo it)")
             sections.append(f'<details id="tool-{html.escape(tid)}"><summary>{html.escape(tid)}</summary>'
                             f"<p>files missing or unreadable: {html.escape(str(e))}</p></details>")
-            continue
-        pts = "".join(f"<tr><td class=t>{p['kind']}</td><td>{p['rpm']:.0f}</td><td>{p['depth_mm']:.3g}</td>"
-                      f"<td>{p['limit_p05_mm']:.3g}</td><td>{p['limit_p50_mm']:.3g}</td><td>{p['p_stable']:.2f}</td>"
-                      "</tr>" for p in s["points"])
-        n_data += 1
-        best = s["points"][0]
-        notes = "".join(f"<li>{html.escape(n)}</li>" for n in s.get("notes", []))
-        cut = s.get("cutting", {})
-        sections.append(
-            f'<details id="tool-{html.escape(tid)}" data-src="d{n_data}" ontoggle="draw(this)"'
-            f'{" open" if n_data == 1 else ""}><summary><b>{html.escape(tid)}</b>: {best["rpm"]:.0f} rpm, '
-            f'{best["depth_mm"]:.3g} mm ({best["kind"]})</summary>'
-            f"<p>D {s.get('diameter_mm', '')} mm, L {s.get('overhang_mm', '')} mm, holder "
-            f"{html.escape(str(s.get('holder', '')))}; {cut.get('teeth', '')} teeth, K<sub>t</sub> "
-            f"{cut.get('tangential_coeff', 0) / 1e6:.4g} N/mm², K<sub>r</sub> {cut.get('radial_ratio', 0):.3g} "
-            f"({html.escape(str(cut.get('source', '')))}), a<sub>e</sub>/D {cut.get('radial_immersion', '')}, "
-            f"{cut.get('milling', '')} milling; {s['n_samples']} joint samples</p>"
-            f"<ul>{notes}</ul><table><thead><tr><th>point</th><th>rpm</th><th>depth mm (recommended)</th>"
-            f"<th>5 % limit mm</th><th>50 % limit mm</th><th>P(stable)</th></tr></thead><tbody>{pts}</tbody></table>"
-            f'{_joint_table(s)}<div class="figs"></div>'
-            f'<script type="application/json" id="d{n_data}">{data}</script></details>')
     page = (f"<!DOCTYPE html><html lang=en><head><meta charset=utf-8><title>toolpoint library report</title>"
             f"<style>{_STYLE}</style><script>{_SCRIPT}</script></head><body>"
             f"<h1>Recommended spindle speeds and depths</h1>"
