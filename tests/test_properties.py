@@ -346,16 +346,15 @@ def _fresh(base: Path) -> tuple[Path, Path]:
 
 def _out(data, out_dir: Path, name: str, inputs) -> str:
     """The --out value: usually a new file in the output folder, sometimes a bad one."""
-    kind = data.draw(st.sampled_from(["ok"] * 16 + ["input", "folder", "under_file", "nested"]))
-    if kind == "input":
-        return str(inputs[0])
-    if kind == "folder":
-        return str(out_dir)
-    if kind == "under_file":
-        return str(inputs[0] / name)
-    if kind == "nested":
-        return str(out_dir / "new" / name)
-    return str(out_dir / name)
+    return _out_path(data.draw(st.sampled_from(["ok"] * 16 + ["input", "folder", "under_file", "nested"])),
+                     out_dir, name, inputs)
+
+
+def _out_path(kind: str, out_dir: Path, name: str, inputs) -> str:
+    """An --out value of one kind: ok, input, folder, under_file (a path under an input file), nested."""
+    return {"input": lambda: str(inputs[0]), "folder": lambda: str(out_dir),
+            "under_file": lambda: str(inputs[0] / name), "nested": lambda: str(out_dir / "new" / name),
+            "ok": lambda: str(out_dir / name)}[kind]()
 
 
 NUMBERS = ["nan", "inf", "-inf", "-1", "0", "1e300", "-6e8", "abc", "", "1e-300", "99999999999"]
@@ -556,15 +555,7 @@ def _out_value(data, plan, out_dir: Path, name: str, inputs) -> str:
     """``--out``: a new file in the output folder, or (plan ``out``) an existing folder, an input, a path
     under a file."""
     kind = data.draw(st.sampled_from(BAD_OUT)) if plan == "out" else data.draw(st.sampled_from(["ok", "nested"]))
-    if kind == "input":
-        return str(inputs[0])
-    if kind == "folder":
-        return str(out_dir)
-    if kind == "under_file":
-        return str(inputs[0] / name)
-    if kind == "nested":
-        return str(out_dir / "new" / name)
-    return str(out_dir / name)
+    return _out_path(kind, out_dir, name, inputs)
 
 
 @_n(40)
