@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import math
 import sys
-from pathlib import Path
 
 from ..errors import InputError
-from .common import check_number
+from .common import check_number, out_folder
 
 #: Model key → the name printed in the ``campaign learn`` table.
 MODEL_LABELS = {"anfis": "ANFIS", "gpr": "GP regression", "gbr": "gradient boosting", "paper": "Čiča et al. ANFIS"}
@@ -203,12 +202,7 @@ def _synth(args) -> int:
     check_number(args.seed, "--seed", minimum=0)
     check_number(args.noise, "--noise", minimum=0)
     check_number(args.blank_noise, "--blank-noise", minimum=0)
-    out = Path(args.out_dir)
-    parent = out
-    while not parent.exists():  # the first existing ancestor must be a folder, checked before any work
-        parent = parent.parent
-    if not parent.is_dir():
-        raise InputError(f"is a file or under one ({parent}), expected a folder", file=out, field="OUT_DIR")
+    out = out_folder(args.out_dir, "OUT_DIR")  # checked before any work
     if out.exists() and any(out.iterdir()):
         raise InputError("folder exists and is not empty", file=out, field="OUT_DIR")
     s = synthesise(out, n=args.n, seed=args.seed, noise=args.noise, blank_noise=args.blank_noise, fmt=args.format)

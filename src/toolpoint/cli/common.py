@@ -26,16 +26,33 @@ def out_path(value: str, flag: str, *, inputs=()) -> Path:
     for q in inputs:
         if q is not None and Path(q).exists() and p.exists() and p.resolve() == Path(q).resolve():
             raise InputError("is one of this command's inputs: choose another output file", file=p, field=flag)
-    parent = p.parent
-    while not parent.exists():  # the first existing ancestor must be a writable folder
+    _check_parent(p.parent, p, flag)
+    if flag in ("--plot", "--plots"):
+        check_figure_suffix(p, flag)
+    return p
+
+
+def out_folder(value: str, flag: str) -> Path:
+    """An output folder path, checked before any work is done.
+
+    Refused (:class:`~toolpoint.errors.InputError` naming the path and ``flag``): an
+    existing file; a path under a file; a first existing ancestor that cannot be written.
+    """
+    out = Path(value)
+    if out.exists() and not out.is_dir():
+        raise InputError("exists and is not a folder", file=out, field=flag)
+    _check_parent(out, out, flag)
+    return out
+
+
+def _check_parent(parent: Path, p: Path, flag: str) -> None:
+    """The first existing ancestor of ``parent`` (itself included) must be a writable folder."""
+    while not parent.exists():
         parent = parent.parent
     if not parent.is_dir():
         raise InputError(f"cannot write under {parent}: it is a file, not a folder", file=p, field=flag)
     if not os.access(parent, os.W_OK | os.X_OK):
         raise InputError(f"folder {parent} is not writable", file=p, field=flag)
-    if flag in ("--plot", "--plots"):
-        check_figure_suffix(p, flag)
-    return p
 
 
 def check_number(value, flag: str, *, minimum: float | None = None, above: float | None = None,

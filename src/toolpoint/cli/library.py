@@ -12,7 +12,6 @@ other tools go on. An unreadable or empty library is one line, exit 2.
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 from ..errors import InputError
 
@@ -51,19 +50,12 @@ def register(sub) -> None:
 def run(args) -> int:
     """Run ``toolpoint library``."""
     from ..recommend.run import run_library
-    from .common import check_number
+    from .common import check_number, out_folder
 
     check_number(args.seed, "--seed", minimum=0)  # NumPy's generator refuses a negative seed with a ValueError
     if args.workers is not None:
         check_number(args.workers, "--workers", minimum=1)
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError("exists and is not a folder", file=out, field="--out")
-    parent = out
-    while not parent.exists():  # the first existing ancestor must be a folder, checked before any work
-        parent = parent.parent
-    if not parent.is_dir():
-        raise InputError(f"cannot write under {parent}: it is a file, not a folder", file=out, field="--out")
+    out_folder(args.out, "--out")  # checked before any work
 
     def say(line):
         print(line, file=sys.stderr)

@@ -24,7 +24,7 @@ from ..io.frf_files import write_csv_frf
 from ..identification.identify import make_algorithm, model_for, relative_errors
 from ..identification.params import PARAMS, UNITS
 from ..identification.optim import check_method
-from .common import check_number, save_figure, use_agg, warnings_to_stderr
+from .common import check_number, out_folder, save_figure, use_agg, warnings_to_stderr
 from .identify import _run_with_progress, result_document
 
 DEFAULT_ASSEMBLY = Path("examples") / "numerical_case.toml"
@@ -51,14 +51,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``toolpoint reproduce``; returns the exit code (0)."""
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError("exists and is not a folder", file=out, field="--out")
-    parent = out
-    while not parent.exists():  # the first existing ancestor must be a folder, checked before any work
-        parent = parent.parent
-    if not parent.is_dir():
-        raise InputError(f"cannot write under {parent}: it is a file, not a folder", file=out, field="--out")
+    out = out_folder(args.out, "--out")  # checked before any work
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     if not methods:
         raise InputError("names no method (give e.g. ga,sa,pso,hybrid)", file="command line", field="--methods")
