@@ -264,3 +264,27 @@ def test_bad_input_is_one_line(example, kw, field):
         b = param_bounds(parse_params(names, example), kw.get("bounds"))
         FRFProblem(example, names, [Measured(FRF(f, np.ones(f.size) * 1e-8), pt, pt)], b, with_tool=False)
     assert e.value.field == field and "\n" not in str(e.value)
+
+
+def test_profiling_reports_a_better_point_only_when_it_matters():
+    """x_better: set when the search stopped short of the minimum (by more than the profile's resolution),
+    None when the start is the minimum up to round-off. A linear least-squares problem, minimum in closed form."""
+    from toolpoint.identification.uncertainty import profile_intervals
+
+    class P:
+        xl, xu, nfev = np.array([-5.0, -5.0]), np.array([5.0, 5.0]), 0
+        t = np.linspace(0, 1, 40)
+        A = np.c_[t, np.ones_like(t)]
+        y = 2.0 * t + 0.5 + 0.05 * np.sin(37 * t)
+
+        def residuals(self, x):
+            return self.A @ x - self.y
+
+        def jacobian(self, x):
+            return self.A
+
+    p = P()
+    x_min = np.linalg.lstsq(p.A, p.y, rcond=None)[0]
+    assert profile_intervals(p, x_min * (1 + 1e-9)).x_better is None  # round-off away from the minimum
+    far = profile_intervals(p, x_min + np.array([0.05, 0.0]))  # well off it: profiling meets the minimum
+    assert far.x_better is not None and np.allclose(far.x_better, x_min, atol=1e-3)

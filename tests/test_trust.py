@@ -339,3 +339,12 @@ def test_noise_quantity_says_accelerance_for_noise_growing_as_one_over_omega_squ
     w = 2 * np.pi * np.maximum(f, 0.5)
     mob = clean + 3e-5 * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)) / w
     assert trusted_band(FRF(f, mob)).noise_quantity in ("", "mobility")
+
+
+def test_running_median_is_the_windowed_median_with_edge_padding():
+    from toolpoint.trust import _running_median
+
+    x = np.exp(3 * np.random.default_rng(1).standard_normal(301))
+    k = 7
+    want = [np.median([x[min(max(j, 0), x.size - 1)] for j in range(i - k, i + k + 1)]) for i in range(x.size)]
+    np.testing.assert_array_equal(_running_median(x, 2 * k + 1), want)

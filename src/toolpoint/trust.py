@@ -141,6 +141,16 @@ def _neighbour_residual(f: np.ndarray, h: np.ndarray) -> np.ndarray:
     return np.abs(r) / np.sqrt(1.0 + (h1**2 + h2**2) / (h1 + h2) ** 2)
 
 
+def _running_median(x: np.ndarray, n: int) -> np.ndarray:
+    """Median over a centred window of ``n`` (odd) points, the ends padded with the edge values.
+
+    The same as ``scipy.ndimage.median_filter(x, n, mode="nearest")``, written with NumPy because
+    scipy 1.15.0's 1-D median filter (our floor) returns wrong, run-to-run different values.
+    """
+    pad = np.pad(x, n // 2, mode="edge")
+    return np.median(np.lib.stride_tricks.sliding_window_view(pad, n), axis=1)
+
+
 def _first_run(ok: np.ndarray, n: int) -> int | None:
     """Index of the first point that starts ``n`` True values in a row, or None."""
     if ok.size < n:
@@ -153,15 +163,13 @@ def _first_run(ok: np.ndarray, n: int) -> int | None:
 def _noise_edge(frf: FRF, quantity_measured: str | None) -> tuple[int, str, str]:
     """Index of the first trusted point by the noise rule, the reason ("" when nothing is cut) and the
     quantity the noise looks white in ("" when not found)."""
-    from scipy.ndimage import median_filter
-
     f, h = frf.freq_hz, frf.values
     if f.size < 3 * WINDOW:
         return 0, "", ""
     resid = np.concatenate([[np.nan], _neighbour_residual(f, h), [np.nan]])
     resid[0], resid[-1] = resid[1], resid[-2]
-    sigma = median_filter(resid, size=WINDOW, mode="nearest") / math.sqrt(math.log(2.0))
-    signal = median_filter(np.abs(h), size=WINDOW, mode="nearest")
+    sigma = _running_median(resid, WINDOW) / math.sqrt(math.log(2.0))
+    signal = _running_median(np.abs(h), WINDOW)
     ok = signal >= SNR_MIN * sigma  # a zero FRF with zero noise is exact data, not noise
     i = _first_run(ok, WINDOW)
     if i is None:

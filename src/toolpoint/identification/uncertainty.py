@@ -185,8 +185,8 @@ class ProfileResult:
         True where the interval runs into the search bound on that side (the data do not bound the
         parameter there; the end reported is the bound).
     x_better : (n,) ndarray or None
-        A point (log10) with a lower sum of squares than ``x_log`` met while profiling (the search had not
-        found the least-squares minimum), else None.
+        A point (log10) met while profiling whose sum of squares is lower than at ``x_log`` by more than
+        0.1 % of the interval's threshold rise (the search had not found the least-squares minimum), else None.
     nfev : int
         Model evaluations spent (a Jacobian counted as ``n_var``).
     """
@@ -282,7 +282,9 @@ def profile_intervals(problem, x_log, se=None, level: float = 0.95, xtol: float 
             else:
                 r = problem.residuals(x)
                 S = float(r @ r)
-            if S < best[0] * (1 - 1e-9):
+            # lower by more than 0.1 % of the interval's threshold: a real minimum elsewhere, not round-off of
+            # the search (scipy versions end a converged search ~1e-7 S0 apart)
+            if S < best[0] and S < S0 - 1e-3 * thr:
                 best[0], best[1] = S, x.copy()
             return S - S0 - thr
 
