@@ -311,7 +311,7 @@ def test_inverse_rcsa_band_keyword(example):
     np.testing.assert_allclose(exact.R, sub.R, rtol=1e-6, atol=1e-12)
     cut = subassembly_from_blank(blank, 0.045, G11, G12, G22, band=(100.0, 2000.0))
     assert (cut.freq_hz[0], cut.freq_hz[-1]) == (100.0, 2000.0) and "band 100–2000 Hz: given" in cut.label
-    np.testing.assert_array_equal(cut.R, exact.R[99:2000])
+    np.testing.assert_allclose(cut.R, exact.R[99:2000], rtol=1e-9, atol=0)  # same sums; numpy 1.26 differs at 1e-11
     rng = np.random.default_rng(0)
     w = 2 * np.pi * f
     junk = FRF(f, G11.values + 0.05 * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)) / -(w**2))
