@@ -4,7 +4,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-stamp
 OUT ?= toolpoint-out
 
-.PHONY: demo test lint browser bench clean
+.PHONY: demo test lint browser bench docs clean
 
 $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
@@ -34,5 +34,12 @@ bench: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[test,bench]"
 	for b in benchmarks/bench_*.py; do echo "== $$b"; OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(PY) $$b || exit 1; done
 
+# The HTML documentation (Sphinx + numpydoc API reference, the design notes, a gallery that runs the tour's
+# examples) → docs/_build/html; warnings are errors.
+docs: $(STAMP)
+	$(PY) -m pip install --quiet -e ".[test,docs]"
+	$(VENV)/bin/sphinx-build -W --keep-going -q -b html docs docs/_build/html
+	@echo "documentation: docs/_build/html/index.html"
+
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(OUT) .pytest_cache docs/_build docs/api/generated docs/gallery

@@ -1,2 +1,2 @@
-"""Learning across a tool family: ANFIS (:mod:`.anfis`), the paper's metrics (:mod:`.metrics`), figures
-(:mod:`.figures`)."""
+"""Learning across a tool family: ANFIS (:mod:`toolpoint.learning.anfis`), the paper's metrics
+(:mod:`toolpoint.learning.metrics`), figures (:mod:`toolpoint.learning.figures`)."""
