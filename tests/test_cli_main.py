@@ -115,3 +115,38 @@ def test_anfis_refuses_to_overwrite_its_input(tmp_path, capsys):
     before = data.read_bytes()
     assert main(["anfis", "train", str(data), "--inputs", "x", "--target", "y", "--out", str(data)]) == 2
     assert "inputs" in capsys.readouterr().err and data.read_bytes() == before
+
+
+@pytest.mark.parametrize("argv, named, suggestion", [
+    (["lobes", "x.csv", "--outt", "a.csv", "--teeth", "2"], "--outt", "--out"),
+    (["lobes", "x.csv", "--teth", "2", "--immersion", "1", "--rpm", "1:2"], "--teth", "--teeth"),
+    (["frf", "a.toml", "--out", "f.csv", "--plott", "p.png"], "--plott", "--plot"),
+])
+def test_a_mistyped_option_is_named_with_the_closest_valid_one(argv, named, suggestion, capsys):
+    # argparse alone reports the required --out missing after --outt; the typo is the cause and is named first
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert f"unknown option {named} (did you mean {suggestion}?)" in err[0]
+
+
+def test_an_option_with_no_close_match_is_named_alone(capsys):
+    with pytest.raises(SystemExit):
+        main(["frf", "a.toml", "--out", "f.csv", "--zzzzzz"])
+    err = capsys.readouterr().err
+    assert "unknown option --zzzzzz" in err and "did you mean" not in err
+
+
+def test_every_command_has_a_description():
+    import argparse
+
+    def walk(parser, path):
+        for a in parser._actions:
+            if isinstance(a, argparse._SubParsersAction):
+                for name, sp in a.choices.items():
+                    assert sp.description, f"toolpoint {' '.join(path + [name])} has no description"
+                    walk(sp, path + [name])
+
+    walk(build_parser(None), [])

@@ -13,6 +13,7 @@ exit code 2, never a traceback; so does a bad command-line value.
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
 import re
 import sys
@@ -49,9 +50,40 @@ class _Parser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = _NEGATIVE_NUMBER
+        self._seen: list[str] = []
+
+    _innermost: "_Parser | None" = None  # the (sub-)command parser that ran last: the one that owns the words
+
+    def parse_known_args(self, args=None, namespace=None):
+        self._seen = list(sys.argv[1:] if args is None else args)
+        _Parser._innermost = self
+        return super().parse_known_args(args, namespace)
+
+    def _unknown_option(self) -> str | None:
+        """The first ``--word`` on the command line that is no option of this parser, with the closest valid one.
+
+        A typo is the likely cause of most other errors ("the following arguments are required: --out" after
+        ``--outt``), so it is named first.
+        """
+        known = [s for s in self._option_string_actions if s.startswith("--")]
+        for word in self._seen:
+            if word == "--":
+                break
+            name = word.split("=", 1)[0]
+            if not name.startswith("--") or name in known or any(k.startswith(name) for k in known):
+                continue
+            close = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
+            return f"unknown option {name}" + (f" (did you mean {close[0]}?)" if close else "")
+        return None
 
     def error(self, message):
-        self.exit(2, f"{self.prog}: error: {' '.join(str(message).split())} (see --help)\n")
+        message = " ".join(str(message).split())
+        # unrecognised words reach the top-level parser: judge them against the sub-command that got them
+        owner = _Parser._innermost if message.startswith("unrecognized arguments") and _Parser._innermost else self
+        typo = owner._unknown_option()
+        if typo:
+            message = typo
+        self.exit(2, f"{owner.prog}: error: {message} (see --help)\n")
 
 
 def _command_in(argv: list[str]) -> str | None:
@@ -81,7 +113,19 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
             importlib.import_module(f"{__package__}.{name}").register(sub)
         else:
             sub.add_parser(name, help=help_text)
+    _describe(p)
     return p
+
+
+def _describe(parser: argparse.ArgumentParser) -> None:
+    """Give every (sub-)command without a description its one-line help as description (shown by ``--help``)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            helps = {a.dest: a.help for a in action._choices_actions}
+            for name, sp in action.choices.items():
+                if not sp.description and helps.get(name):
+                    sp.description = helps[name][0].upper() + helps[name][1:] + "."
+                _describe(sp)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -63,7 +63,8 @@ def plot_lobes(result, ax=None, *, show_lobes: bool | None = None, ymax_mm: floa
     top = chart_top_mm(result) if ymax_mm is None else float(ymax_mm)
     rpm = result.rpm
     d = np.minimum(result.depth_mm, top)  # inf and tall pockets clip to the chart top
-    ax.fill_between(rpm, d, top, color="tab:red", alpha=0.18, linewidth=0, label="unstable (chatter)")
+    # blue limit over an orange unstable region: told apart with every common colour-vision deficiency
+    ax.fill_between(rpm, d, top, color="tab:orange", alpha=0.25, linewidth=0, label="unstable (chatter)")
     if show_lobes is None:
         show_lobes = result.method == "zoa"
     if show_lobes:
@@ -80,7 +81,7 @@ def plot_lobes(result, ax=None, *, show_lobes: bool | None = None, ymax_mm: floa
             ax.plot([mr], [md], "v", color="k", ms=6, label=f"minimum {md:.3g} mm @ {mr:.0f} rpm")
         pr, pd = result.pocket()
         if inside(pr, 1e3 * pd):
-            ax.plot([pr], [1e3 * pd], "^", color="tab:green", ms=7,
+            ax.plot([pr], [1e3 * pd], "^", mfc="white", mec="k", ms=7,
                     label=f"best pocket {1e3 * pd:.3g} mm @ {pr:.0f} rpm")
     ax.set_xlim(rpm[0], rpm[-1])
     ax.set_ylim(0, top)
