@@ -9,6 +9,7 @@ from sklearn.base import clone
 from sklearn.utils.estimator_checks import parametrize_with_checks
 from threadpoolctl import threadpool_limits
 
+from toolpoint.learning.figures import plot_membership
 from toolpoint.learning.anfis import (
     ANFIS,
     MF_PARAMS,
@@ -20,7 +21,6 @@ from toolpoint.learning.anfis import (
     genfis_params,
     load_model,
     membership,
-    plot_membership,
     save_model,
 )
 from toolpoint.errors import ExtrapolationWarning

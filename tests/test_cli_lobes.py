@@ -98,8 +98,6 @@ def test_assembly_toml_input(tmp_path, example_path, capsys):
         ["--tangential-coeff", "-6e8"],
         ["--tangential-coeff", "nan"],
         ["--radial-ratio", "-1"],
-        ["--kt", "0"],
-        ["--kr", "-0.3"],
         ["--rpm-points", "100001"],
         ["--immersion", "0"],
         ["--immersion", "1.5"],
@@ -113,8 +111,6 @@ def test_assembly_toml_input(tmp_path, example_path, capsys):
 def test_bad_options(tmp_path, frf_files, capsys, change):
     x, _ = frf_files
     args = dict(zip(BASE[::2], BASE[1::2]))
-    renamed = {"--kt": "--tangential-coeff", "--kr": "--radial-ratio"}
-    args.pop(renamed.get(change[0]), None)  # a deprecated flag replaces its new name
     args[change[0]] = change[1]
     out, png = tmp_path / "o.csv", tmp_path / "o.png"
     argv = ["lobes", str(x), *[f"{k}={v}" for k, v in args.items()], "--out", str(out), "--plot", str(png)]
@@ -144,27 +140,18 @@ def test_wrong_frf_file(tmp_path, capsys, make):
     assert not out.exists() and not (tmp_path / "a.csv").exists()
 
 
-def test_readme_command_with_deprecated_flags(tmp_path, example_path, capsys):
-    """README's command keeps working for one release; each old flag prints one deprecation line."""
-    out, png = tmp_path / "lobes.csv", tmp_path / "lobes.png"
-    code = main(["lobes", str(example_path), "--teeth", "2", "--kt", "6e8", "--kr", "0.3", "--immersion", "0.5",
-                 "--rpm", "5000:30000", "--rpm-points", "200", "--out", str(out), "--plot", str(png)])
-    assert code == 0
+@pytest.mark.parametrize("old, new", [("--kt", "--tangential-coeff"), ("--kr", "--radial-ratio")])
+def test_removed_flags_name_their_replacement(tmp_path, example_path, capsys, old, new):
+    """--kt/--kr were the cutting coefficient and force ratio, easily taken for the joint stiffnesses."""
+    out = tmp_path / "lobes.csv"
+    argv = ["lobes", str(example_path), "--teeth", "2", "--tangential-coeff", "6e8", "--radial-ratio", "0.3",
+            "--immersion", "0.5", "--rpm", "5000:30000", "--out", str(out), old, "1"]
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["warning: --kt is deprecated, use --tangential-coeff (cutting coefficient, N/m²)",
-                   "warning: --kr is deprecated, use --radial-ratio (force ratio Kn/Kt, dimensionless)"]
-    new = tmp_path / "new.csv"
-    assert main(["lobes", str(example_path), "--teeth", "2", "--tangential-coeff", "6e8", "--radial-ratio", "0.3",
-                 "--immersion", "0.5", "--rpm", "5000:30000", "--rpm-points", "200", "--out", str(new)]) == 0
-    assert capsys.readouterr().err == ""
-    assert read(out)[1] == pytest.approx(read(new)[1], nan_ok=True)
-
-
-def test_old_and_new_flag_together_is_refused(tmp_path, frf_files, capsys):
-    x, _ = frf_files
-    assert main(["lobes", str(x), *BASE, "--kt", "6e8", "--out", str(tmp_path / "o.csv")]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "--kt" in err[0]
+    assert len(err) == 1 and old in err[0] and new in err[0]
+    assert not out.exists()
 
 
 @pytest.mark.parametrize("what", ["zero", "nan"])

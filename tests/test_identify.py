@@ -65,8 +65,7 @@ def test_unknown_method_is_an_input_error(case):
     model, _, meas = case
     with pytest.raises(InputError, match="^method: unknown method 'magic'"):
         identify(model, meas, "magic")
-    with pytest.raises(InputError):
-        make_algorithm("GA")
+    assert make_algorithm("GA").name == "ga"  # method names in any case, as `--method SDM` in lobes
 
 
 def test_same_seed_same_result(case):
@@ -82,10 +81,16 @@ def test_same_seed_same_result(case):
 
 def test_pso_beats_the_paper(case):
     """Paper Table 1, PSO: kt 0.3 %, ct 9.33 %, kr 49.8 %, cr 200 %."""
+    # With the paper's settings PSO stops on its 280-iteration cap, not converged, and where it stops varies
+    # with the seed (seeds 0–4: cr error 1e-4 … 99×). Seed 0 measured kt 1.9e-5, ct 0.029, kr 6.7e-4, cr 0.65;
+    # the limits leave ×5 (kt, kr) and ×3 (ct) for other platforms; cr only beats the paper. The result must
+    # say it is capped, and the profile interval must flag the undetermined cr.
     model, exact, meas = case
-    r = identify(model, meas, "pso", seed=0)
+    with pytest.warns(IdentifiabilityWarning, match="cr"):
+        r = identify(model, meas, "pso", seed=0)
     e = relative_errors(r.x, exact)
-    assert e["kt"] < 0.003 and e["ct"] < 0.0933 and e["kr"] < 0.498 and e["cr"] < 2.0
+    assert e["kt"] < 1e-4 and e["ct"] < 0.09 and e["kr"] < 3.5e-3 and e["cr"] < 2.0, e
+    assert not r.success and r.status == 1
 
 
 def test_bad_cr_is_flagged_when_the_fit_cannot_see_it(case, example):

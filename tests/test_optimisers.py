@@ -11,7 +11,7 @@ from toolpoint.errors import IdentifiabilityWarning
 from toolpoint.frf import FRF
 from toolpoint.identification.identify import identify, model_for, relative_errors
 from toolpoint.identification.objective import JointProblem
-from toolpoint.identification.optim import DE, GA, PSO, SA, Hybrid, Termination
+from toolpoint.identification.optim import DE, GA, PSO, SA, Hybrid
 from toolpoint.identification.params import Bounds
 
 F = np.arange(1.0, 3001.0)
@@ -67,6 +67,12 @@ def _beats(method, errors):
     return {k: errors[k] < PAPER[method][k] for k in PAPER[method]}
 
 
+# What GA and SA reach with their default settings on the noise-free case: the objective's round-off floor. Seeds
+# 0–54 (GA) and 0–99 (SA) measured ≤ 1.3e-9 relative error on every parameter (numpy 2.4 / scipy 1.17); the limit
+# leaves ×80 for other platforms and library versions (numpy 1.26 / scipy 1.15 in CI).
+ROUND_OFF = 1e-7
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", range(5))
 def test_ga_beats_the_paper(case, seed):
@@ -74,7 +80,7 @@ def test_ga_beats_the_paper(case, seed):
     model, exact, meas = case
     r = identify(model, meas, "ga", seed=seed)
     e = relative_errors(r.x, exact)
-    assert all(_beats("ga", e).values()), e
+    assert max(e.values()) < ROUND_OFF, e
     assert r.nit < GA().maxiter  # stopped on the stall test, not the cap ...
     assert r.success and r.status == 0 and r.message.startswith("converged")  # ... and says so
 
@@ -85,7 +91,7 @@ def test_sa_beats_the_paper(case, seed):
     model, exact, meas = case
     r = identify(model, meas, "sa", seed=seed)
     e = relative_errors(r.x, exact)
-    assert all(_beats("sa", e).values()), e
+    assert max(e.values()) < ROUND_OFF, e
     assert r.optimizer.reanneals > 0
     assert r.success == (r.nit < SA().maxiter)  # converged exactly when it stopped before the cap
 
@@ -154,7 +160,7 @@ def test_unknown_operator_is_rejected():
 
 def test_unknown_option_is_rejected():
     for cls in (GA, SA, PSO, Hybrid):
-        with pytest.raises(TypeError, match="unknown option"):
+        with pytest.raises(TypeError, match="generation"):
             cls(generation=3)
     with pytest.raises(TypeError):
         DE(stall_iter=3)
@@ -244,46 +250,25 @@ def test_ga_mutation_schedule_ends_at_the_budget():
     assert ga.step_factor(H, H) == 0.0  # the schedule's end value at the horizon
 
 
-# --------------------------------------------------------------------------- deprecated option names
+# --------------------------------------------------------------------------- options: new names only, by keyword
 
-@pytest.mark.parametrize(
-    "cls, old, new, value, expected",
-    [
-        (GA, "generations", "maxiter", 7, 7),
-        (GA, "population_size", "popsize", 30, 30),
-        (GA, "stall_generations", "stall_iter", 9, 9),
-        (GA, "function_tolerance", "tol", 1e-6, 1e-6 * 50),  # average per generation → total over the window
-        (SA, "max_iterations", "maxiter", 7, 7),
-        (SA, "stall_iterations", "stall_iter", 9, 9),
-        (SA, "function_tolerance", "tol", 1e-6, 1e-6 * 500),
-        (PSO, "iterations", "maxiter", 7, 7),
-        (PSO, "swarm_size", "popsize", 30, 30),
-        (PSO, "stall_iterations", "stall_iter", 9, 9),
-        (PSO, "function_tolerance", "tol", 1e-3, 1e-3),  # PSO's was already the total change
-        (Hybrid, "max_local_iterations", "local_maxfev", 50, 50),
-    ],
-)
-def test_deprecated_option_names_warn_and_map(cls, old, new, value, expected):
-    with pytest.warns(DeprecationWarning, match=f"'{old}' is deprecated, use '{new}'"):
-        algo = cls(**{old: value})
-    assert getattr(algo, new) == pytest.approx(expected)
+@pytest.mark.parametrize("cls, old", [(GA, "population_size"), (GA, "function_tolerance"), (SA, "max_iterations"),
+                                      (PSO, "swarm_size"), (Hybrid, "max_local_iterations")])
+def test_old_option_names_are_refused(cls, old):
+    with pytest.raises(TypeError, match=old):
+        cls(**{old: 7})
 
 
-def test_deprecated_termination_warns_and_maps(case):
-    with pytest.warns(DeprecationWarning, match="'max_iter' is deprecated, use 'maxiter'"):
-        assert Termination(max_iter=5).maxiter == 5
-    with pytest.warns(DeprecationWarning, match="'max_evals' is deprecated, use 'maxfev'"):
-        assert Termination(max_evals=900).maxfev == 900
-    with pytest.warns(DeprecationWarning, match="'ftol' is deprecated, use 'tol'"):
-        assert Termination(ftol=1e-3).tol == 1e-3
-    with pytest.warns(DeprecationWarning, match="minimize"):
-        old = GA().minimize(Bowl(), np.random.default_rng(0), Termination(maxiter=5))
-    new = GA(maxiter=5, stall_iter=None).minimize(Bowl(), np.random.default_rng(0))
-    assert np.array_equal(old.x, new.x) and old.nfev == new.nfev
+@pytest.mark.parametrize("cls", [GA, SA, PSO, DE, Hybrid])
+def test_options_are_keyword_only(cls):
+    with pytest.raises(TypeError):
+        cls(30)
+
+
+def test_identify_options_set_the_stopping_rules(case):
     model, _, meas = case
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", IdentifiabilityWarning)
-        with pytest.warns(DeprecationWarning, match="identify"):
-            a = identify(model, meas, "de", seed=1, termination=Termination(maxiter=5))
-        b = identify(model, meas, "de", seed=1, options={"maxiter": 5})
-    assert np.array_equal(a.x, b.x) and a.nfev == b.nfev
+        a = identify(model, meas, "de", seed=1, options={"maxiter": 5})
+        b = identify(model, meas, "DE", seed=1, options={"maxiter": 5})
+    assert a.optimizer.nit <= 5 and np.array_equal(a.x, b.x) and a.nfev == b.nfev

@@ -147,15 +147,11 @@ def test_bad_input(args, kw):
         sdm_lobes(*args, **base)
 
 
-def test_old_keywords_still_work_with_a_deprecation_warning():
-    rpm = [9000.0, 15000.0]
-    new = sdm_lobes(MODE, None, cut(0.05), rpm=rpm, m=20)
-    with pytest.warns(DeprecationWarning, match="sdm_lobes"):
-        old = sdm_lobes(MODE, None, teeth=2, kt=6e8, kr=1 / 3, radial_immersion=0.05, rpm=rpm, m=20)
-    assert old.depth_m == pytest.approx(new.depth_m, rel=0, abs=0)
-    with pytest.warns(DeprecationWarning, match="sdm_spectral_radius"):
-        rho = sdm_spectral_radius(MODE, None, teeth=2, kt=6e8, kr=1 / 3, radial_immersion=0.05, rpm=rpm, depth=0.0)
-    assert rho == pytest.approx(sdm_spectral_radius(MODE, None, cut(0.05), rpm=rpm, depth=0.0), rel=0, abs=0)
+def test_old_loose_keywords_are_refused():
+    with pytest.raises(TypeError, match="kt"):
+        sdm_lobes(MODE, None, teeth=2, kt=6e8, kr=1 / 3, radial_immersion=0.05, rpm=[9000.0], m=20)
+    with pytest.raises(InputError, match="CuttingConditions"):
+        sdm_spectral_radius(MODE, None, None, rpm=[9000.0], depth=0.0)
 
 
 def _plain_sdm_limit(rpm, ri, m, lo=1e-4, hi=2e-2):

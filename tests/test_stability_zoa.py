@@ -249,13 +249,7 @@ def test_bad_speeds(rpm):
     assert err.value.field == "rpm"
 
 
-def test_old_keywords_still_work_with_a_deprecation_warning():
+def test_old_loose_keywords_are_refused():
     f = np.linspace(0.0, 3000.0, 301)
-    rpm = np.linspace(5000, 20000, 50)
-    new = zoa_lobes(single_mode(f), None, cut(0.5), rpm=rpm)
-    with pytest.warns(DeprecationWarning, match="tangential_coeff"):
-        old = zoa_lobes(single_mode(f), None, teeth=2, kt=KT, kr=KR, radial_immersion=0.5, rpm=rpm)
-    assert old.depth_m == pytest.approx(new.depth_m, rel=0, abs=0)
-    with pytest.warns(DeprecationWarning), pytest.raises(InputError) as err:
-        zoa_lobes(single_mode(f), teeth=2, kt=-1.0, kr=KR, radial_immersion=0.5, rpm=rpm)
-    assert err.value.field == "tangential_coeff"
+    with pytest.raises(TypeError, match="kt"):
+        zoa_lobes(single_mode(f), None, teeth=2, kt=KT, kr=KR, radial_immersion=0.5, rpm=[5000.0, 6000.0])

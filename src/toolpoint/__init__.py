@@ -24,14 +24,13 @@ _LAZY = {
     "AssemblyModel": "toolpoint.dynamics.model",
     "ToolPointModel": "toolpoint.dynamics.model",
     "ANFIS": "toolpoint.learning.anfis",
+    "identify": "toolpoint.identification.identify",
 }
 
-__all__ = ["__version__", "identify", *_LAZY]
+__all__ = ["__version__", *_LAZY]
 
 
 def __getattr__(name):
-    if name == "identify":  # the callable compatibility module (see toolpoint/identify.py)
-        return importlib.import_module("toolpoint.identify")
     if name in _LAZY:
         return getattr(importlib.import_module(_LAZY[name]), name)
     raise AttributeError(f"module 'toolpoint' has no attribute {name!r}")

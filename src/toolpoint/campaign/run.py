@@ -134,7 +134,7 @@ def identify_item(item: Item) -> dict:
         sub = Subassembly(item.freq_hz, item.sub_R, item.holder)
         model = ToolPointModel(item.tool, sub, item.freq_hz)
         res = identify(model, FRF(item.freq_hz, item.values), item.method, item.seed,
-                       Bounds(item.bounds_lo, item.bounds_hi))
+                       bounds=Bounds(item.bounds_lo, item.bounds_hi))
     row = new_row(item.id, item.holder, item.diameter_mm, item.overhang_mm, status="ok",
                   objective=f"{res.fun:.6g}", evaluations=int(res.nfev),
                   seconds=f"{time.perf_counter() - t0:.3f}",

@@ -53,8 +53,7 @@ def register(sub) -> None:
                    help="fit only from LO to HI Hz (default: [identify] band_hz = [LO, HI] of the assembly file, "
                    "else the trusted band found in each measured file — low-frequency noise ×1/ω² and low "
                    "coherence left out, with a note on stderr)")
-    p.add_argument("--fmin", type=float, help="fit only from this frequency (Hz); older spelling of --band")
-    p.add_argument("--fmax", type=float, help="fit only up to this frequency (Hz); older spelling of --band")
+    p.removed = {"--fmin": "--band LO:HI (fitted band, Hz)", "--fmax": "--band LO:HI (fitted band, Hz)"}
     p.add_argument("--quantity", choices=("receptance", "mobility", "accelerance"),
                    help="what the measured file holds (default: as the file says; CSV means receptance)")
     p.set_defaults(func=run)
@@ -89,7 +88,7 @@ def load_problem_inputs(args):
 
 def run(args) -> int:
     """Run ``toolpoint identify``; returns the exit code (0)."""
-    check_method(args.method)
+    args.method = check_method(args.method)
     check_number(args.seed, "--seed", minimum=0)  # NumPy's generator refuses a negative seed with a ValueError
     if general_requested(args):
         return run_general(args)
@@ -106,8 +105,7 @@ def run(args) -> int:
     with warnings_to_stderr():
         assembly, bounds = load_problem_inputs(args)
         meas = read_frf(args.measured, quantity=args.quantity, min_points=MIN_POINTS)
-        if meas.freq_hz[0] == 0:
-            warnings.warn(f"{args.measured}: the 0 Hz point is not used (free–free components are singular there)")
+        if meas.freq_hz[0] == 0:  # free–free components are singular there; the band note names what is fitted
             meas = meas.band(fmin=np.nextafter(0.0, 1.0))
         meas, note = fit_band(meas, args.measured, band_spec(args))
         if len(meas) < MIN_POINTS:
@@ -156,7 +154,7 @@ def _run_with_progress(model, meas, method, seed, bounds, algo):
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", IdentifiabilityWarning)
-            return identify(model, meas, method, seed, bounds, callback=cb)
+            return identify(model, meas, method, seed, bounds=bounds, callback=cb)
 
 
 def result_document(res, method, seed, *, names=PARAMS, units=None, key=None, **extra) -> dict:
@@ -198,22 +196,17 @@ def _report(res, args, names=PARAMS, units=UNITS) -> None:
 
 
 def band_spec(args) -> tuple:
-    """Where the fitted band comes from: ``("given", (lo, hi), field)``, ``("fminmax", fmin, fmax)`` or ``("auto",)``.
+    """Where the fitted band comes from: ``("given", (lo, hi), field)`` or ``("auto",)``.
 
-    ``--band`` first, then the old ``--fmin``/``--fmax`` (not both spellings at once), then
+    ``--band`` first, then
     ``band_hz = [LO, HI]`` in the assembly file's ``[identify]`` table; otherwise the trusted
     band of each measured file (:func:`toolpoint.trust.trusted_band`).
     """
     from ..trust import check_band
 
     band = parse_band(getattr(args, "band", None))
-    fmin, fmax = getattr(args, "fmin", None), getattr(args, "fmax", None)
-    if band is not None and (fmin is not None or fmax is not None):
-        raise InputError("give --band or --fmin/--fmax, not both", file="command line", field="--band")
     if band is not None:
         return ("given", band, "--band")
-    if fmin is not None or fmax is not None:
-        return ("fminmax", fmin, fmax)
     t = _file_identify(args.assembly)
     if "band_hz" in t:
         return ("given", check_band(t["band_hz"], file=args.assembly, field="identify.band_hz"), "identify.band_hz")
@@ -222,8 +215,6 @@ def band_spec(args) -> tuple:
 
 def fit_band(frf, path, spec):
     """``frf`` (read from ``path``) cut to the band of ``spec`` (:func:`band_spec`), and the note for stderr."""
-    if spec[0] == "fminmax":
-        return frf.band(spec[1], spec[2]), ""
     band, field = (spec[1], spec[2]) if spec[0] == "given" else (None, "--band")
     hint = "--band LO:HI or [identify] band_hz"
     cut, _, note = trusted(frf, path, band, field=field, hint=hint)
@@ -320,8 +311,7 @@ def _general_setup(args):
     args.band_notes = []
     for path, (resp, force), w in zip(args.measured, pts, weights):
         frf = read_frf(path, quantity=args.quantity, min_points=MIN_POINTS)
-        if frf.freq_hz[0] == 0:
-            warnings.warn(f"{path}: the 0 Hz point is not used (free–free components are singular there)")
+        if frf.freq_hz[0] == 0:  # free–free components are singular there; the band note names what is fitted
             frf = frf.band(fmin=np.nextafter(0.0, 1.0))
         frf, note = fit_band(frf, path, spec)
         if note:

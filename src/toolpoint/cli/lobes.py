@@ -18,8 +18,7 @@ lies on a cutting edge of the band are named on stderr as not trusted.
 
 ``--tangential-coeff`` is the cutting coefficient K_t in N/m² and
 ``--radial-ratio`` the force ratio K_r = K_n/K_t (not the joint stiffnesses
-kt, kr of ``identify``); the old ``--kt``/``--kr`` still work for one release
-and print a deprecation line on stderr.
+kt, kr of ``identify``; ``--kt``/``--kr`` are refused with one line naming these).
 
 Outputs (written only when everything succeeded, all or none):
 
@@ -50,9 +49,9 @@ from ..io.atomic import atomic_open, atomic_path
 from ..stability.milling import MAX_RPM, MAX_RPM_POINTS
 from .common import out_path, parse_band, trusted, use_agg, warnings_to_stderr
 
-# Deprecated flag → (new flag, what it is), for one release.
-_RENAMED = {"--kt": ("--tangential-coeff", "cutting coefficient, N/m²"),
-            "--kr": ("--radial-ratio", "force ratio Kn/Kt, dimensionless")}
+# Flags of earlier versions → what to give instead (one line naming it, exit 2).
+REMOVED = {"--kt": "--tangential-coeff (the cutting coefficient Kt, N/m²; not the joint stiffness kt)",
+           "--kr": "--radial-ratio (the force ratio Kn/Kt; not the joint stiffness kr)"}
 
 
 def register(sub) -> None:
@@ -71,8 +70,7 @@ def register(sub) -> None:
     p.add_argument("--teeth", required=True, help="number of teeth N (integer ≥ 1)")
     p.add_argument("--tangential-coeff", help="tangential cutting coefficient Kt, N/m² (e.g. 6e8 = 600 N/mm²)")
     p.add_argument("--radial-ratio", help="radial force ratio Kr = Kn/Kt, dimensionless (≥ 0)")
-    p.add_argument("--kt", help="deprecated: use --tangential-coeff")
-    p.add_argument("--kr", help="deprecated: use --radial-ratio")
+    p.removed = REMOVED
     p.add_argument("--immersion", required=True, help="radial immersion a_e/D in (0, 1] (1 = slotting)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--down", dest="milling", action="store_const", const="down", help="down-milling (default)")
@@ -145,33 +143,30 @@ def _load(path: str, flag: str, freq_hz=None):
 
 # ----------------------------------------------------------------- command
 def _cutting(args):
-    """The cutting conditions from the flags, errors naming the flag given; and the deprecated flags used."""
+    """The cutting conditions from the flags, errors naming the flag given."""
     from ..stability import CuttingConditions
 
-    used, values = [], {}
-    for old, (new, _) in _RENAMED.items():
-        given_old, given_new = getattr(args, old[2:]), getattr(args, new[2:].replace("-", "_"))
-        if given_old is not None and given_new is not None:
-            raise InputError(f"give {new} only ({old} is its deprecated name)", field=old)
-        if given_old is None and given_new is None:
-            raise InputError(f"required ({_RENAMED[old][1]})", field=new)
-        flag = old if given_old is not None else new
-        if given_old is not None:
-            used.append(old)
-        values[old] = (_number(given_old if given_old is not None else given_new, flag), flag)
+    values = {}
+    for flag, what in (("--tangential-coeff", "cutting coefficient Kt, N/m²"),
+                       ("--radial-ratio", "force ratio Kn/Kt, dimensionless")):
+        given = getattr(args, flag[2:].replace("-", "_"))
+        if given is None:
+            raise InputError(f"required ({what})", field=flag)
+        values[flag] = _number(given, flag)
     teeth = _number(args.teeth, "--teeth", int)
     immersion = _number(args.immersion, "--immersion")
-    flags = {"teeth": "--teeth", "tangential_coeff": values["--kt"][1], "radial_ratio": values["--kr"][1],
+    flags = {"teeth": "--teeth", "tangential_coeff": "--tangential-coeff", "radial_ratio": "--radial-ratio",
              "radial_immersion": "--immersion", "milling": "--down/--up"}
     try:
-        cut = CuttingConditions(teeth=teeth, tangential_coeff=values["--kt"][0], radial_ratio=values["--kr"][0],
-                                radial_immersion=immersion, milling=args.milling)
+        cut = CuttingConditions(teeth=teeth, tangential_coeff=values["--tangential-coeff"],
+                                radial_ratio=values["--radial-ratio"], radial_immersion=immersion,
+                                milling=args.milling)
     except InputError as err:
         raise InputError(err.message, field=flags.get(err.field, err.field)) from None
     if cut.tangential_coeff > KT_MAX:  # finite but overflowing the lobe arithmetic (1e300 × depth × …)
         raise InputError(f"{cut.tangential_coeff:g} N/m² is beyond any material (typical 1e8–3e9 N/m², "
-                         f"refused above {KT_MAX:g})", field=values["--kt"][1])
-    return cut, used
+                         f"refused above {KT_MAX:g})", field="--tangential-coeff")
+    return cut
 
 
 #: Largest specific cutting force accepted, N/m² (1e6 N/mm²: 300 × the hardest alloys' ~3e9 N/m²).
@@ -180,7 +175,7 @@ KT_MAX = 1e12
 
 def run(args) -> int:
     """Run ``toolpoint lobes``; returns the exit code (InputErrors are left to the caller: exit 2)."""
-    cut, deprecated = _cutting(args)
+    cut = _cutting(args)
     lo, hi = _rpm_range(args.rpm)
     npts = _number(args.rpm_points, "--rpm-points", int)
     if not 2 <= npts <= MAX_RPM_POINTS:
@@ -206,9 +201,6 @@ def run(args) -> int:
         frfs[flag] = None if path is None else _load(path, flag, freq_hz=frf_x.freq_hz)
     data_hz = frf_x.freq_hz
     frf_x, frfs, band, notes, noise = _trusted_band(frf_x, frfs, args, band)
-    for old in deprecated:  # only once the input is known good: bad input gives one line
-        new, what = _RENAMED[old]
-        print(f"warning: {old} is deprecated, use {new} ({what})", file=sys.stderr)
     with warnings_to_stderr():
         rpm = np.linspace(lo, hi, npts)
         if cut.tangential_coeff < 1e6:

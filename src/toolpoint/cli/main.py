@@ -51,6 +51,7 @@ class _Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = _NEGATIVE_NUMBER
         self._seen: list[str] = []
+        self.removed: dict[str, str] = {}  # option of an earlier version → what to give instead
 
     _innermost: "_Parser | None" = None  # the (sub-)command parser that ran last: the one that owns the words
 
@@ -66,10 +67,13 @@ class _Parser(argparse.ArgumentParser):
         ``--outt``), so it is named first.
         """
         known = [s for s in self._option_string_actions if s.startswith("--")]
+        removed = getattr(self, "removed", {})
         for word in self._seen:
             if word == "--":
                 break
             name = word.split("=", 1)[0]
+            if name in removed:
+                return f"{name} is no longer an option: give {removed[name]}"
             if not name.startswith("--") or name in known or any(k.startswith(name) for k in known):
                 continue
             close = difflib.get_close_matches(name, known, n=1, cutoff=0.6)

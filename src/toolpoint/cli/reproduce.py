@@ -55,8 +55,7 @@ def run(args) -> int:
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     if not methods:
         raise InputError("names no method (give e.g. ga,sa,pso,hybrid)", file="command line", field="--methods")
-    for m in methods:
-        check_method(m, field="--methods")
+    methods = [check_method(m, field="--methods") for m in methods]
     check_number(args.noise, "--noise", minimum=0)
     check_number(args.seed, "--seed", minimum=0)
     with warnings_to_stderr():

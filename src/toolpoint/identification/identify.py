@@ -25,11 +25,15 @@ from ..dynamics.subassembly import Subassembly
 from ..errors import IdentifiabilityWarning, InputError
 from ..frf import FRF
 from .objective import JointProblem
-from .optim import METHODS, Termination, check_method
+from .optim import METHODS, check_method
 from .params import PARAMS, UNITS, Bounds
 from .uncertainty import identifiability_warnings, intervals_and_correlation, open_end_warnings, profile_intervals
 
-__all__ = ["IdentificationResult", "make_algorithm", "model_for", "identify", "relative_errors"]
+__all__ = ["IdentificationResult", "INTERVALS_DEFAULT", "make_algorithm", "model_for", "identify", "solve",
+           "relative_errors"]
+
+# 95 % intervals by default from the profile likelihood (measured: docs/design/identification.md)
+INTERVALS_DEFAULT = "profile"
 
 
 def make_algorithm(method: str, options: dict | None = None):
@@ -52,8 +56,7 @@ def make_algorithm(method: str, options: dict | None = None):
     >>> make_algorithm("pso", {"maxiter": 50}).maxiter
     50
     """
-    check_method(method, file=None, field="method")
-    return METHODS[method](**(options or {}))
+    return METHODS[check_method(method, file=None, field="method")](**(options or {}))
 
 
 def model_for(assembly: Assembly, freq_hz, subassembly: Subassembly | None = None) -> ToolPointModel:
@@ -177,16 +180,18 @@ def identify(
     measured: FRF,
     method: str = "hybrid",
     seed: int | None = 0,
+    *,
     bounds: Bounds | None = None,
     options: dict | None = None,
-    termination: Termination | None = None,
     callback=None,
-    intervals: str = "linear",
+    intervals: str = INTERVALS_DEFAULT,
 ) -> IdentificationResult:
     """Identify the holder–tool joint p = [kt, ct, kr, cr] from a measured tool-point FRF.
 
     Minimises the paper's Eq. (8), f(x) = ‖h(10^x) − h̄‖₂ (m/N), over x = log10 p within ``bounds``, then
-    computes linearised 95 % intervals and identifiability warnings (see :mod:`.uncertainty`).
+    computes 95 % intervals and identifiability warnings (see :mod:`toolpoint.identification.uncertainty`).
+    The same pipeline (:func:`solve`) serves the general problem of
+    :func:`toolpoint.identification.problem.identify_frfs`.
 
     Parameters
     ----------
@@ -195,21 +200,22 @@ def identify(
     measured : FRF
         Measured tool-point FRF (converted to receptance, m/N).
     method : str, default "hybrid"
-        ``hybrid``, ``ga``, ``sa``, ``pso`` or ``de``.
+        ``hybrid``, ``ga``, ``sa``, ``pso`` or ``de`` (any case).
     seed : int or None, default 0
         Seed of the ``numpy.random.Generator`` that drives the search.
     bounds : Bounds, optional
         Search bounds, SI; default the paper's (:data:`~toolpoint.identification.params.PAPER_BOUNDS`).
     options : dict, optional
         Options of the optimiser (see its class, e.g. ``{"maxiter": 100}``).
-    termination : Termination, optional
-        Deprecated: use ``options`` (``maxiter``, ``maxfev``, ``stall_iter``, ``tol``, ``f_target``).
     callback : callable, optional
         ``callback(nit, best_f, nfev)`` after every iteration.
-    intervals : {"linear", "profile"}, default "linear"
-        95 % intervals linearised at the optimum, or from the profile likelihood
-        (:func:`~toolpoint.identification.uncertainty.profile_intervals`; an end that reaches a search bound
-        is then also a warning).
+    intervals : {"profile", "linear"}, default "profile"
+        95 % intervals from the profile likelihood
+        (:func:`~toolpoint.identification.uncertainty.profile_intervals`: follows the curved valleys along
+        which parameters trade off; an end that reaches a search bound is also a warning) or linearised at the
+        optimum (cheaper, too narrow where the fit is far from linear). The default is chosen by measurement
+        (``docs/design/identification.md``): on FE data with 1 % noise the linearised intervals held c_r in
+        too few trials, the profile ones close to 95 %.
 
     Returns
     -------
@@ -231,46 +237,74 @@ def identify(
     >>> r.success, round(r.params["kt"] / 2.1e7, 6), r.warnings
     (True, 1.0, ())
     """
-    if intervals not in ("profile", "linear"):
-        raise InputError(f"unknown interval method {intervals!r} (profile or linear)", field="intervals")
     if not np.array_equal(measured.freq_hz, model.freq_hz):
         raise ValueError("measured FRF and model frequencies differ: build the model on measured.freq_hz")
-    algo = make_algorithm(method, options)
-    if termination is not None:
-        warnings.warn("identify(termination=…) is deprecated: pass options={'maxiter': …, 'maxfev': …, "
-                      "'stall_iter': …, 'tol': …}", DeprecationWarning, stacklevel=2)
-        algo = algo._with_termination(termination)
     problem = JointProblem(model.coupler, measured.to_receptance().values, bounds)
+    return solve(problem, method, seed, options=options, callback=callback, intervals=intervals,
+                 model_frfs=lambda x_log: (FRF(model.freq_hz, problem.model(x_log), "receptance",
+                                               f"identified ({str(method).lower()})"),))
+
+
+def solve(problem, method: str = "hybrid", seed: int | None = 0, *, options: dict | None = None, callback=None,
+          intervals: str = INTERVALS_DEFAULT, model_frfs=None) -> IdentificationResult:
+    """The one identification pipeline: search, 95 % intervals, identifiability and trade-off warnings.
+
+    Parameters
+    ----------
+    problem : JointProblem or FRFProblem
+        Objective in log10 space with ``bounds`` (and, for the general problem, ``names``, ``units`` and
+        ``model_frfs(x_log)``).
+    method, seed, options, callback, intervals
+        As in :func:`identify`.
+    model_frfs : callable, optional
+        ``model_frfs(x_log)`` → tuple of the model's FRFs at the optimum (default ``problem.model_frfs``).
+
+    Returns
+    -------
+    IdentificationResult
+    """
+    if intervals not in ("profile", "linear"):
+        raise InputError(f"unknown interval method {intervals!r} (profile or linear)", field="intervals")
+    method = str(method).lower()
+    names = tuple(getattr(problem, "names", PARAMS))
+    units = getattr(problem, "units", UNITS)
+    general = hasattr(problem, "names")
+    algo = make_algorithm(method, options)
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
     opt = algo.minimize(problem, rng, callback=callback)
     x_log = np.asarray(opt.x, float)
     ci, se, corr = intervals_and_correlation(problem, x_log)
-    extra = ()
+    extra: tuple = ()
     if intervals == "profile":
         prof = profile_intervals(problem, x_log, se)
         ci = prof.ci
-        extra = tuple(open_end_warnings(prof, PARAMS, UNITS))
+        extra = tuple(open_end_warnings(prof, names, units))
     seconds = time.perf_counter() - t0  # includes the uncertainty step
-    found = tuple(identifiability_warnings(x_log, ci, problem.bounds, corr=corr)) + extra
+    kw = dict(names=names, units=units, pairs=True) if general else {}
+    found = tuple(identifiability_warnings(x_log, ci, problem.bounds, corr=corr, **kw)) + extra
     for w in found:
-        warnings.warn(w, IdentifiabilityWarning, stacklevel=2)
+        warnings.warn(w, IdentifiabilityWarning, stacklevel=3)
     x = 10.0**x_log
+    frfs = tuple((model_frfs or problem.model_frfs)(x_log))
+    bounds = ({k: [float(a), float(b)] for k, a, b in zip(names, problem.bounds.lo, problem.bounds.hi)} if general
+              else problem.bounds.as_dict())
     return IdentificationResult(
-        params=dict(zip(PARAMS, map(float, x))),
+        params=dict(zip(names, map(float, x))),
         x=x,
-        ci95={k: [float(a), float(b)] for k, (a, b) in zip(PARAMS, ci)},
-        se_log10=dict(zip(PARAMS, map(float, se))),
+        ci95={k: [float(a), float(b)] for k, (a, b) in zip(names, ci)},
+        se_log10=dict(zip(names, map(float, se))),
         warnings=found,
-        model_frf=FRF(model.freq_hz, problem.model(x_log), "receptance", f"identified ({method})"),
+        model_frf=frfs[0],
         method=method,
         seed=seed,
-        bounds=problem.bounds.as_dict(),
+        bounds=bounds,
         seconds=seconds,
         optimizer=opt,
         correlation=corr,
-        model_frfs=(),
+        model_frfs=frfs if general else (),
         intervals=intervals,
+        names=names,
     )
 
 

@@ -18,8 +18,6 @@ Both give exact Jacobians.
 from __future__ import annotations
 
 import re
-import time
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,12 +25,11 @@ import numpy as np
 from ..dynamics.assembly import Assembly
 from ..dynamics.coupling import ToolPointCoupler
 from ..dynamics.points import Point, ReceptanceModel, element_names
-from ..errors import IdentifiabilityWarning, InputError
+from ..errors import InputError
 from ..frf import FRF
-from .identify import IdentificationResult, make_algorithm
+from .identify import INTERVALS_DEFAULT, IdentificationResult, solve
 from .objective import JointProblem
 from .params import DEFAULT_BOUNDS, ELEMENT_PARAMS, ELEMENT_UNITS, Bounds
-from .uncertainty import identifiability_warnings, intervals_and_correlation, open_end_warnings, profile_intervals
 
 __all__ = ["Measured", "parse_params", "param_bounds", "FRFProblem", "identify_frfs"]
 
@@ -441,9 +438,9 @@ class FRFProblem:
                 for m, sl in zip(self.measurements, self._slices)]
 
 
-def identify_frfs(problem: FRFProblem, method: str = "hybrid", seed: int | None = 0, options: dict | None = None,
-                  callback=None, intervals: str = "profile") -> IdentificationResult:
-    """Identify ``problem``'s parameters: search, 95 % intervals, identifiability and trade-off warnings.
+def identify_frfs(problem: FRFProblem, method: str = "hybrid", seed: int | None = 0, *, options: dict | None = None,
+                  callback=None, intervals: str = INTERVALS_DEFAULT) -> IdentificationResult:
+    r"""Identify ``problem``'s parameters with the one pipeline (:func:`toolpoint.identification.identify.solve`).
 
     Parameters
     ----------
@@ -456,17 +453,14 @@ def identify_frfs(problem: FRFProblem, method: str = "hybrid", seed: int | None 
     callback : callable, optional
         ``callback(nit, best_f, nfev)``.
     intervals : {"profile", "linear"}, default "profile"
-        95 % intervals from the profile likelihood (:func:`~.uncertainty.profile_intervals`: follows the
-        curved valleys along which parameters trade off, stops at the search bounds) or linearised at the
-        optimum (:func:`~.uncertainty.intervals_and_correlation`: cheaper, too narrow where the fit is
-        not close to linear — see ``docs/design/identification.md``).
+        As in :func:`toolpoint.identification.identify.identify`.
 
     Returns
     -------
     IdentificationResult
         ``params``, ``ci95``, ``se_log10`` (linearised) keyed by the full names (``result.names``);
         ``correlation`` (linearised); ``model_frfs`` (one per measurement); ``warnings`` include one per
-        pair of parameters whose log10 estimates correlate with |ρ| > 0.95, and one per interval that
+        pair of parameters whose log10 estimates correlate with \|ρ\| > 0.95, and one per interval that
         runs into a search bound.
 
     Warns
@@ -474,43 +468,7 @@ def identify_frfs(problem: FRFProblem, method: str = "hybrid", seed: int | None 
     IdentifiabilityWarning
         Once per entry of ``result.warnings``.
     """
-    if intervals not in ("profile", "linear"):
-        raise InputError(f"unknown interval method {intervals!r} (profile or linear)", field="intervals")
-    algo = make_algorithm(method, options)
-    rng = np.random.default_rng(seed)
-    t0 = time.perf_counter()
-    opt = algo.minimize(problem, rng, callback=callback)
-    x_log = np.asarray(opt.x, float)
-    ci, se, corr = intervals_and_correlation(problem, x_log)
-    extra = []
-    if intervals == "profile":
-        prof = profile_intervals(problem, x_log, se)
-        ci = prof.ci
-        extra = open_end_warnings(prof, problem.names, problem.units)
-    seconds = time.perf_counter() - t0
-    found = tuple(identifiability_warnings(x_log, ci, problem.bounds, names=problem.names, units=problem.units,
-                                           corr=corr, pairs=True)) + tuple(extra)
-    for w in found:
-        warnings.warn(w, IdentifiabilityWarning, stacklevel=2)
-    x = 10.0**x_log
-    frfs = tuple(problem.model_frfs(x_log))
-    return IdentificationResult(
-        params=dict(zip(problem.names, map(float, x))),
-        x=x,
-        ci95={k: [float(a), float(b)] for k, (a, b) in zip(problem.names, ci)},
-        se_log10=dict(zip(problem.names, map(float, se))),
-        warnings=found,
-        model_frf=frfs[0],
-        method=method,
-        seed=seed,
-        bounds={k: [float(a), float(b)] for k, a, b in zip(problem.names, problem.bounds.lo, problem.bounds.hi)},
-        seconds=seconds,
-        optimizer=opt,
-        names=problem.names,
-        correlation=corr,
-        model_frfs=frfs,
-        intervals=intervals,
-    )
+    return solve(problem, method, seed, options=options, callback=callback, intervals=intervals)
 
 
 def joint_names(element: str) -> list[str]:

@@ -292,6 +292,11 @@ def profile_intervals(problem, x_log, se=None, level: float = 0.95, xtol: float 
             ci[i] = x_hat[i]
             continue
         sd = se[i] if se is not None and np.isfinite(se[i]) and se[i] > 0 else 0.05 * (xu[i] - xl[i])
+        if ci_quantile(dof, level) * sd < LINEAR_SCALE:
+            # an interval this narrow (in decades) is where every smooth model is linear: the profile would only
+            # follow round-off of the re-solves (noise-free data), so it is the linearised interval
+            ci[i] = x_hat[i] + np.array([-1.0, 1.0]) * ci_quantile(dof, level) * sd
+            continue
         tol = min(xtol, 1e-3 * ci_quantile(dof, level) * sd)  # narrow intervals: 0.1 % of their half-width
         for side, (lim, col) in enumerate(((xl[i], 0), (xu[i], 1))):
             sign = -1.0 if side == 0 else 1.0
@@ -306,7 +311,14 @@ def profile_intervals(problem, x_log, se=None, level: float = 0.95, xtol: float 
                     b = lim
                 if rise(b) > 0:
                     lo_, hi_ = sorted((a, b))
-                    end = brentq(rise, lo_, hi_, xtol=tol) if hi_ - lo_ > tol else b
+                    if hi_ - lo_ <= tol:
+                        end = b
+                    elif a == x_hat[i] and rise(a) >= 0:
+                        # a fit at round-off (noise-free data): re-solving at x̂ itself lands above Ŝ + thr, so
+                        # the interval is narrower than the search can resolve; it ends at x̂
+                        end = a
+                    else:
+                        end = brentq(rise, lo_, hi_, xtol=tol)
                 elif b == lim:
                     end, open_end[i, col] = lim, True
                 else:
@@ -314,6 +326,11 @@ def profile_intervals(problem, x_log, se=None, level: float = 0.95, xtol: float 
             ci[i, col] = end
     ci = 10.0**ci
     return ProfileResult(ci, open_end, best[1], problem.nfev - nfev0)
+
+
+#: Half-width (decades of the parameter) below which a profile interval is the linearised one: 1e-6 decade is a
+#: relative change of 2.3e-6, where a smooth model's curvature is below the re-solves' round-off.
+LINEAR_SCALE = 1e-6
 
 
 def open_end_warnings(prof: ProfileResult, names, units) -> list[str]:

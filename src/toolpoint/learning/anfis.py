@@ -96,7 +96,6 @@ from ..errors import ExtrapolationWarning, InputError
 
 __all__ = [
     "ANFIS", "MF_PARAMS", "membership", "genfis_params", "save_model", "load_model", "predict_quietly",
-    "plot_membership",
 ]
 
 #: Parameter names per membership-function type (MATLAB order).
@@ -487,7 +486,7 @@ class ANFIS(RegressorMixin, BaseEstimator):
         return np.sum(_firing(nus) * self._rule_outputs(X), axis=1)
 
     # ---------------------------------------------------------------- API
-    def fit(self, X, y, X_val=None, y_val=None, sample_weight=None):
+    def fit(self, X, y, *, sample_weight=None, X_val=None, y_val=None):
         """Train by hybrid learning; see the module docstring for the algorithm.
 
         ``sample_weight`` (n,) ≥ 0, optional: weighted least squares, E = Σ s_n (t_n − f_n)²
@@ -867,10 +866,3 @@ def predict_quietly(model: ANFIS, X) -> tuple[np.ndarray, bool]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ExtrapolationWarning)
         return model.predict(X), outside
-
-
-def plot_membership(model: ANFIS, ax=None, input_names=None, n_points: int = 400):
-    """Same as :func:`toolpoint.learning.figures.plot_membership` (kept here for compatibility)."""
-    from .figures import plot_membership as plot
-
-    return plot(model, ax=ax, input_names=input_names, n_points=n_points)

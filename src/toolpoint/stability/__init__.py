@@ -17,7 +17,8 @@ Geometry and sign conventions: :mod:`toolpoint.stability.milling`.
 """
 
 from .cutting import CuttingConditions
-from .milling import Lobe, LobeResult, average_directional_matrix, directional_coefficients, immersion_angles
+from .cutting import immersion_angles
+from .milling import Lobe, LobeResult, average_directional_matrix, directional_coefficients
 from .sdm import sdm_lobes, sdm_spectral_radius
 from .statespace import ModalModel, StateSpaceModel, from_modal_fit
 from .zoa import zoa_lobes

@@ -13,20 +13,16 @@ K_r = K_n/K_t. These are *not* the joint stiffnesses ``kt`` (N/m) and ``kr``
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["CuttingConditions", "MILLING"]
+__all__ = ["CuttingConditions", "MILLING", "check_cutting", "immersion_angles"]
 
 MILLING = ("down", "up")
 
-# Old loose keywords of zoa_lobes / sdm_lobes / sdm_spectral_radius → field of CuttingConditions.
-_LEGACY = {"teeth": "teeth", "kt": "tangential_coeff", "kr": "radial_ratio",
-           "radial_immersion": "radial_immersion", "milling": "milling"}
 
 
 @dataclass(frozen=True)
@@ -101,15 +97,40 @@ class CuttingConditions:
 
     @property
     def immersion_angles(self) -> tuple[float, float]:
-        """Entry and exit angles (φ_st, φ_ex), rad (see :func:`~toolpoint.stability.milling.immersion_angles`)."""
-        from .milling import immersion_angles
-
+        """Entry and exit angles (φ_st, φ_ex), rad (see :func:`immersion_angles`)."""
         return immersion_angles(self.radial_immersion, self.milling)
 
     def as_dict(self) -> dict:
         """The five fields as a plain dict (for result metadata and reports)."""
         return dict(teeth=self.teeth, tangential_coeff=self.tangential_coeff, radial_ratio=self.radial_ratio,
                     radial_immersion=self.radial_immersion, milling=self.milling)
+
+
+def immersion_angles(radial_immersion: float, milling: str = "down") -> tuple[float, float]:
+    """Entry and exit angles of a tooth.
+
+    Parameters
+    ----------
+    radial_immersion : float
+        a_e/D ∈ (0, 1], dimensionless.
+    milling : {"down", "up"}
+
+    Returns
+    -------
+    (phi_st, phi_ex) : tuple of float
+        rad; up-milling (0, arccos(1 − 2a_e/D)), down-milling (arccos(2a_e/D − 1), π).
+
+    Examples
+    --------
+    >>> immersion_angles(1.0, "up") == (0.0, float(np.pi))
+    True
+    """
+    ri = float(radial_immersion)
+    if milling == "up":
+        return 0.0, float(np.arccos(1.0 - 2.0 * ri))
+    if milling == "down":
+        return float(np.arccos(2.0 * ri - 1.0)), float(np.pi)
+    raise InputError(f"must be 'down' or 'up', got {milling!r}", field="milling")
 
 
 def _real(value, name: str) -> float:
@@ -119,41 +140,18 @@ def _real(value, name: str) -> float:
         raise InputError(f"must be a number, got {value!r}", field=name) from None
 
 
-def resolve_cutting(cutting, legacy: dict, func: str) -> CuttingConditions:
-    """The :class:`CuttingConditions` of a call, accepting the deprecated loose keywords for one release.
+def check_cutting(cutting) -> CuttingConditions:
+    """``cutting`` if it is a :class:`CuttingConditions`, else one line naming the field.
 
     Parameters
     ----------
-    cutting : CuttingConditions or None
+    cutting : object
         What the caller passed as ``cutting``.
-    legacy : dict
-        The other keyword arguments the solver received (``teeth``, ``kt``
-        [N/m²], ``kr`` [-], ``radial_immersion`` [-], ``milling``); they emit a
-        :class:`DeprecationWarning` naming the replacement. Unknown keywords
-        raise ``TypeError`` as Python would.
-    func : str
-        The solver's name, for messages.
 
     Returns
     -------
     CuttingConditions
     """
-    unknown = set(legacy) - set(_LEGACY)
-    if unknown:
-        raise TypeError(f"{func}() got an unexpected keyword argument {sorted(unknown)[0]!r}")
-    if legacy:
-        if cutting is not None:
-            raise InputError("give either cutting=CuttingConditions(...) or the old keywords, not both",
-                             field="cutting")
-        warnings.warn(
-            f"{func}({', '.join(f'{k}=' for k in legacy)}...) is deprecated: pass cutting=CuttingConditions(teeth, "
-            "tangential_coeff (Kt, N/m²), radial_ratio (Kn/Kt), radial_immersion, milling)",
-            DeprecationWarning, stacklevel=3,
-        )
-        missing = [k for k in ("teeth", "kt", "kr", "radial_immersion") if k not in legacy]
-        if missing:
-            raise TypeError(f"{func}() missing keyword argument {missing[0]!r} (or pass cutting=...)")
-        return CuttingConditions(**{_LEGACY[k]: v for k, v in legacy.items()})
     if not isinstance(cutting, CuttingConditions):
         raise InputError(f"expected CuttingConditions, got {type(cutting).__name__}", field="cutting")
     return cutting

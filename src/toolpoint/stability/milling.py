@@ -43,7 +43,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .cutting import MILLING  # noqa: F401  (re-exported: the old home of the name)
 
 # Most spindle speeds one call evaluates: the envelope work grows with speeds ×
 # lobes, and a chart never needs more points than a screen has pixels × 10.
@@ -90,33 +89,6 @@ def check_rpm(rpm) -> np.ndarray:
 
 
 # ----------------------------------------------------------------- geometry
-def immersion_angles(radial_immersion: float, milling: str = "down") -> tuple[float, float]:
-    """Entry and exit angles of a tooth.
-
-    Parameters
-    ----------
-    radial_immersion : float
-        a_e/D ∈ (0, 1], dimensionless.
-    milling : {"down", "up"}
-
-    Returns
-    -------
-    (phi_st, phi_ex) : tuple of float
-        rad; up-milling (0, arccos(1 − 2a_e/D)), down-milling (arccos(2a_e/D − 1), π).
-
-    Examples
-    --------
-    >>> immersion_angles(1.0, "up") == (0.0, float(np.pi))
-    True
-    """
-    ri = float(radial_immersion)
-    if milling == "up":
-        return 0.0, float(np.arccos(1.0 - 2.0 * ri))
-    if milling == "down":
-        return float(np.arccos(2.0 * ri - 1.0)), float(np.pi)
-    raise InputError(f"must be 'down' or 'up', got {milling!r}", field="milling")
-
-
 def _h_integral(phi, radial_ratio: float) -> np.ndarray:
     """Antiderivative ∫ H(φ) dφ / K_t of one tooth's directional matrix, shape (..., 2, 2).
 

@@ -74,7 +74,7 @@ from scipy.linalg import matrix_balance
 
 from ..blas import single_thread_blas
 from ..errors import InputError
-from .cutting import CuttingConditions, resolve_cutting
+from .cutting import CuttingConditions, check_cutting
 from .milling import Lobe, LobeResult, check_rpm, interval_directional_matrix
 from .statespace import StateSpaceModel
 
@@ -492,7 +492,6 @@ def sdm_spectral_radius(
     depth,
     m: int | None = None,
     accuracy: float = 1.0,
-    **deprecated,
 ) -> np.ndarray:
     """Spectral radius ρ of the Floquet transition matrix at (rpm, depth), broadcast.
 
@@ -514,8 +513,6 @@ def sdm_spectral_radius(
         Steps over the cut, every node carried; default: see :func:`sdm_lobes`.
     accuracy : float
         Resolution factor of the default discretisation (see :func:`sdm_lobes`).
-    **deprecated
-        Old keywords ``teeth, kt, kr, radial_immersion, milling`` (DeprecationWarning).
 
     Returns
     -------
@@ -532,7 +529,7 @@ def sdm_spectral_radius(
     >>> bool(np.isclose(rho, np.exp(-0.011 * 2 * np.pi * 922.0 * 60 / (2 * 10000.0))))
     True
     """
-    cut = resolve_cutting(cutting, deprecated, "sdm_spectral_radius")
+    cut = check_cutting(cutting)
     sysm = _System(as_state_space(modes_x, modes_y), cut)
     acc = _check_accuracy(accuracy)
     r, a = np.broadcast_arrays(np.asarray(rpm, float), np.asarray(depth, float))
@@ -626,7 +623,6 @@ def sdm_lobes(
     rtol: float = 1e-3,
     seed: bool = True,
     progress=None,
-    **deprecated,
 ) -> LobeResult:
     """Stability limit by semi-discretisation, per spindle speed.
 
@@ -666,8 +662,6 @@ def sdm_lobes(
     progress : bool or callable, optional
         ``True``: a tqdm bar on stderr; a callable is called as
         ``progress(speeds_done, speeds_total)`` after each block of 50 speeds.
-    **deprecated
-        Old keywords ``teeth, kt, kr, radial_immersion, milling`` (DeprecationWarning).
 
     Returns
     -------
@@ -694,7 +688,7 @@ def sdm_lobes(
     >>> round(float(res.depth_mm[0]), 2)
     4.09
     """
-    cut = resolve_cutting(cutting, deprecated, "sdm_lobes")
+    cut = check_cutting(cutting)
     sysm = _System(as_state_space(modes_x, modes_y), cut)
     acc = _check_accuracy(accuracy)
     grid = check_rpm(rpm)

@@ -48,7 +48,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..frf import FRF, check_freq_hz
-from .cutting import CuttingConditions, resolve_cutting
+from .cutting import CuttingConditions, check_cutting
 from .milling import Lobe, LobeResult, average_directional_matrix, check_rpm
 
 __all__ = ["zoa_lobes", "oriented_eigenvalues", "depth_and_phase", "MAX_LOBE_POINTS"]
@@ -190,7 +190,6 @@ def zoa_lobes(
     rpm,
     frf_xy: FRF | None = None,
     frf_yx: FRF | None = None,
-    **deprecated,
 ) -> LobeResult:
     """Stability lobes by the zero-order approximation, from tool-point receptances.
 
@@ -207,9 +206,6 @@ def zoa_lobes(
         Increasing spindle speeds, rpm, on which the limit is returned.
     frf_xy, frf_yx : FRF, optional
         Cross receptances Φ_xy (x response to a y force) and Φ_yx, m/N; default 0.
-    **deprecated
-        The old keywords ``teeth, kt, kr, radial_immersion, milling``: still
-        accepted for one release, with a :class:`DeprecationWarning`.
 
     Returns
     -------
@@ -242,7 +238,7 @@ def zoa_lobes(
     >>> round(res.min_depth_m * 1e3, 3)                # mm
     0.298
     """
-    cut = resolve_cutting(cutting, deprecated, "zoa_lobes")
+    cut = check_cutting(cutting)
     grid = check_rpm(rpm)
     frf_x = _as_receptance(frf_x, "frf_x")
     f, phi = _common_grid(frf_x, {"frf_y": frf_y, "frf_xy": frf_xy, "frf_yx": frf_yx})

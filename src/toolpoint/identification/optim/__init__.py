@@ -32,7 +32,7 @@ def check_method(name, *, file: str | None = "command line", field: str | None =
     Returns
     -------
     str
-        ``name``.
+        ``name`` in lower case (``"GA"`` and ``"ga"`` are the same method).
 
     Raises
     ------
@@ -41,7 +41,7 @@ def check_method(name, *, file: str | None = "command line", field: str | None =
 
     Examples
     --------
-    >>> check_method("ga")
+    >>> check_method("GA")
     'ga'
     >>> check_method("magic", file=None, field="method")
     Traceback (most recent call last):
@@ -50,6 +50,6 @@ def check_method(name, *, file: str | None = "command line", field: str | None =
     """
     from ...errors import InputError
 
-    if not isinstance(name, str) or name not in METHODS:
+    if not isinstance(name, str) or name.strip().lower() not in METHODS:
         raise InputError(f"unknown method {name!r} (one of {', '.join(METHODS)})", file=file, field=field)
-    return name
+    return name.strip().lower()

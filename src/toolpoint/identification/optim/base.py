@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,16 +50,6 @@ STATUS_MESSAGES = {
     MAXFEV: "maximum number of evaluations reached",
     OTHER: "stopped",
 }
-
-# Old Termination field names (one release of grace).
-_OLD_TERMINATION = {"max_iter": "maxiter", "max_evals": "maxfev", "ftol": "tol"}
-
-
-def warn_renamed(owner: str, old: str, new: str, extra: str = "", stacklevel: int = 3) -> None:
-    """Emit the :class:`DeprecationWarning` for an option renamed from ``old`` to ``new``."""
-    warnings.warn(f"{owner}: option {old!r} is deprecated, use {new!r}{extra}", DeprecationWarning,
-                  stacklevel=stacklevel)
-
 
 @dataclass(frozen=True, init=False)
 class Termination:
@@ -81,12 +70,6 @@ class Termination:
     f_target : float or None
         Stop (converged) when the best objective is ≤ this value, m/N.
 
-    Notes
-    -----
-    The old field names ``max_iter``, ``max_evals`` and ``ftol`` are accepted for one release with a
-    :class:`DeprecationWarning`. Passing a Termination to ``minimize`` or ``identify`` is deprecated: set the
-    same options on the algorithm.
-
     Examples
     --------
     >>> Termination(maxiter=100, stall_iter=10, tol=1e-6).maxfev is None
@@ -100,17 +83,11 @@ class Termination:
     f_target: float | None
 
     def __init__(self, maxiter: int | None = None, maxfev: int | None = None, stall_iter: int | None = None,
-                 tol: float = 1e-6, f_target: float | None = None, **old):
-        given = {"maxiter": maxiter, "maxfev": maxfev, "tol": tol}
-        for name, value in old.items():
-            if name not in _OLD_TERMINATION:
-                raise TypeError(f"Termination: unknown field {name!r}")
-            warn_renamed("Termination", name, _OLD_TERMINATION[name])
-            given[_OLD_TERMINATION[name]] = value
-        object.__setattr__(self, "maxiter", given["maxiter"])
-        object.__setattr__(self, "maxfev", given["maxfev"])
+                 tol: float = 1e-6, f_target: float | None = None):
+        object.__setattr__(self, "maxiter", maxiter)
+        object.__setattr__(self, "maxfev", maxfev)
         object.__setattr__(self, "stall_iter", stall_iter)
-        object.__setattr__(self, "tol", float(given["tol"]))
+        object.__setattr__(self, "tol", float(tol))
         object.__setattr__(self, "f_target", f_target)
 
     def as_options(self) -> dict:
@@ -153,13 +130,12 @@ def horizon(term: Termination, first: int, per_iter: int) -> int | None:
 class Optimizer:
     """Shared machinery of the optimisers: options, stopping rules and the ``minimize`` entry point.
 
-    Subclasses set ``name``, ``_OPTIONS`` (their ``__init__`` arguments, in order), ``_RENAMED`` (old option
-    name → new) and implement ``_minimize(problem, rng, callback)``.
+    Subclasses set ``name``, ``_OPTIONS`` (their keyword-only ``__init__`` arguments) and implement
+    ``_minimize(problem, rng, callback)``.
     """
 
     name = ""
     _OPTIONS: tuple[str, ...] = ()
-    _RENAMED: dict[str, str] = {}
 
     # These stopping options exist on every population method (DE and the hybrid override the defaults).
     maxiter: int | None = None
@@ -167,17 +143,6 @@ class Optimizer:
     stall_iter: int | None = None
     tol: float = 0.0
     f_target: float | None = None
-
-    def _renamed(self, old: dict) -> dict:
-        """Map deprecated option names in ``old`` to the new ones (with a DeprecationWarning each)."""
-        cls = type(self).__name__
-        out = {}
-        for name, value in old.items():
-            if name not in self._RENAMED:
-                raise TypeError(f"{cls}: unknown option {name!r} (options: {', '.join(self._OPTIONS)})")
-            warn_renamed(cls, name, self._RENAMED[name], stacklevel=4)
-            out[self._RENAMED[name]] = value
-        return out
 
     def options(self) -> dict:
         """The options of this instance, as keyword arguments of its class."""
@@ -190,17 +155,12 @@ class Optimizer:
             raise TypeError(f"{type(self).__name__}: unknown option(s) {', '.join(sorted(unknown))}")
         return type(self)(**{**self.options(), **changes})
 
-    def _with_termination(self, term: Termination) -> "Optimizer":
-        """A copy whose stopping options are replaced by ``term`` (the deprecated API)."""
-        return self.with_options(**{k: v for k, v in term.as_options().items() if k in self._OPTIONS})
-
     def termination(self) -> Termination:
         """The stopping rules these options define."""
         return Termination(maxiter=self.maxiter, maxfev=self.maxfev, stall_iter=self.stall_iter, tol=self.tol,
                            f_target=self.f_target)
 
-    def minimize(self, problem, rng: np.random.Generator, termination: Termination | None = None,
-                 callback=None) -> OptimizeResult:
+    def minimize(self, problem, rng: np.random.Generator, callback=None) -> OptimizeResult:
         """Minimise ``problem`` from the random state ``rng``.
 
         Parameters
@@ -209,8 +169,6 @@ class Optimizer:
             ``evaluate(X)`` for X (N, 4) in log10 space, bounds ``xl``/``xu``, counter ``nfev``.
         rng : numpy.random.Generator
             The only source of randomness: the same seed gives the same run.
-        termination : Termination, optional
-            Deprecated: replaces this instance's stopping options for this run (as the old API did).
         callback : callable, optional
             ``callback(nit, best_f, nfev)`` after every iteration.
 
@@ -220,10 +178,6 @@ class Optimizer:
             ``x`` (log10 p), ``fun`` (m/N), ``nfev``, ``nit``, ``success``, ``status`` (see the module
             table), ``message``, ``history`` (best objective per iteration, m/N), ``seconds``, ``method``.
         """
-        if termination is not None:
-            warnings.warn("minimize(termination=…) is deprecated: set maxiter, maxfev, stall_iter, tol and "
-                          "f_target on the algorithm", DeprecationWarning, stacklevel=2)
-            return self._with_termination(termination)._minimize(problem, rng, callback)
         return self._minimize(problem, rng, callback)
 
     def _minimize(self, problem, rng, callback) -> OptimizeResult:  # pragma: no cover - abstract

@@ -42,7 +42,7 @@ class DE(Optimizer):
     name = "de"
     _OPTIONS = ("popsize", "maxiter", "tol", "maxfev", "f_target", "mutation", "recombination", "init")
 
-    def __init__(self, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8, maxfev: int | None = None,
+    def __init__(self, *, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8, maxfev: int | None = None,
                  f_target: float | None = None, mutation=(0.5, 1.0), recombination: float = 0.7,
                  init: str = "latinhypercube"):
         self.popsize = popsize

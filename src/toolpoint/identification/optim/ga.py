@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Optimizer, Tracker, from_unit, horizon, start_unit, warn_renamed
+from .base import Optimizer, Tracker, from_unit, horizon, start_unit
 
 __all__ = ["GA"]
 
@@ -82,10 +82,10 @@ class GA(Optimizer):
     _OPTIONS = ("popsize", "maxiter", "maxfev", "stall_iter", "tol", "f_target", "elite_fraction",
                 "crossover_fraction", "mutation_probability", "crossover", "crossover_ratio", "heuristic_ratio",
                 "mutation", "mutation_scale", "mutation_shrink", "selection", "tournament_size")
-    _RENAMED = {"population_size": "popsize", "generations": "maxiter", "stall_generations": "stall_iter"}
 
     def __init__(
         self,
+        *,
         popsize: int = 420,
         maxiter: int | None = 2430,
         maxfev: int | None = None,
@@ -103,16 +103,7 @@ class GA(Optimizer):
         mutation_shrink: float = 1.0,
         selection: str = "stochastic_uniform",
         tournament_size: int = 4,
-        **deprecated,
     ):
-        ftol = deprecated.pop("function_tolerance", None)
-        new = self._renamed(deprecated)
-        popsize = new.get("popsize", popsize)
-        maxiter = new.get("maxiter", maxiter)
-        stall_iter = new.get("stall_iter", stall_iter)
-        if ftol is not None:
-            warn_renamed("GA", "function_tolerance", "tol", " (tol = function_tolerance × stall_iter)")
-            tol = ftol * max(stall_iter or 0, 1)
         if crossover not in ("intermediate", "heuristic"):
             raise ValueError(f"crossover must be 'intermediate' or 'heuristic', got {crossover!r}")
         if mutation not in ("elite_covariance", "gaussian"):

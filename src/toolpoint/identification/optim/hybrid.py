@@ -103,11 +103,9 @@ class Hybrid(Optimizer):
 
     name = "hybrid"
     _OPTIONS = ("global_stage", "starts", "tol", "local_maxfev", "maxiter", "maxfev", "use_start")
-    _RENAMED = {"max_local_iterations": "local_maxfev"}
 
-    def __init__(self, global_stage=None, starts: int = 3, tol: float = 1e-14, local_maxfev: int = 200,
-                 maxiter: int | None = None, maxfev: int | None = None, use_start: str = "seed", **deprecated):
-        new = self._renamed(deprecated)
+    def __init__(self, *, global_stage=None, starts: int = 3, tol: float = 1e-14, local_maxfev: int = 200,
+                 maxiter: int | None = None, maxfev: int | None = None, use_start: str = "seed"):
         if use_start not in ("seed", "local", "ignore"):
             raise ValueError(f"Hybrid: use_start must be 'seed', 'local' or 'ignore', got {use_start!r}")
         self.use_start = use_start
@@ -116,7 +114,7 @@ class Hybrid(Optimizer):
         self.global_stage = stage.with_options(**changes) if changes else stage
         self.starts = starts
         self.tol = tol
-        self.local_maxfev = new.get("local_maxfev", local_maxfev)
+        self.local_maxfev = local_maxfev
         self.maxiter = maxiter
         self.maxfev = maxfev
 

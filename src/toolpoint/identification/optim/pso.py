@@ -69,11 +69,10 @@ class PSO(Optimizer):
     name = "pso"
     _OPTIONS = ("popsize", "maxiter", "maxfev", "stall_iter", "tol", "f_target", "cognitive", "social", "inertia",
                 "max_velocity")
-    _RENAMED = {"swarm_size": "popsize", "iterations": "maxiter", "stall_iterations": "stall_iter",
-                "function_tolerance": "tol"}
 
     def __init__(
         self,
+        *,
         popsize: int = 120,
         maxiter: int | None = 280,
         maxfev: int | None = None,
@@ -84,14 +83,12 @@ class PSO(Optimizer):
         social: float = 1.35,
         inertia: tuple[float, float] = (0.9, 0.4),
         max_velocity: float = 0.2,
-        **deprecated,
     ):
-        new = self._renamed(deprecated)
-        self.popsize = new.get("popsize", popsize)
-        self.maxiter = new.get("maxiter", maxiter)
+        self.popsize = popsize
+        self.maxiter = maxiter
         self.maxfev = maxfev
-        self.stall_iter = new.get("stall_iter", stall_iter)
-        self.tol = new.get("tol", tol)
+        self.stall_iter = stall_iter
+        self.tol = tol
         self.f_target = f_target
         self.cognitive = cognitive
         self.social = social

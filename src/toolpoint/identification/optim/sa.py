@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Optimizer, Tracker, from_unit, start_unit, warn_renamed
+from .base import Optimizer, Tracker, from_unit, start_unit
 
 __all__ = ["SA"]
 
@@ -70,10 +70,10 @@ class SA(Optimizer):
     name = "sa"
     _OPTIONS = ("maxiter", "maxfev", "stall_iter", "tol", "f_target", "initial_temperature", "reanneal_interval",
                 "chains", "step", "cooling")
-    _RENAMED = {"max_iterations": "maxiter", "stall_iterations": "stall_iter"}
 
     def __init__(
         self,
+        *,
         maxiter: int | None = 4000,
         maxfev: int | None = None,
         stall_iter: int | None = 500,
@@ -84,15 +84,7 @@ class SA(Optimizer):
         chains: int = 16,
         step: float = 0.5,
         cooling: float = 0.95,
-        **deprecated,
     ):
-        ftol = deprecated.pop("function_tolerance", None)
-        new = self._renamed(deprecated)
-        maxiter = new.get("maxiter", maxiter)
-        stall_iter = new.get("stall_iter", stall_iter)
-        if ftol is not None:
-            warn_renamed("SA", "function_tolerance", "tol", " (tol = function_tolerance × stall_iter)")
-            tol = ftol * max(stall_iter or 0, 1)
         self.maxiter = maxiter
         self.maxfev = maxfev
         self.stall_iter = stall_iter
