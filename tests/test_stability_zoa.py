@@ -251,5 +251,5 @@ def test_bad_speeds(rpm):
 
 def test_old_loose_keywords_are_refused():
     f = np.linspace(0.0, 3000.0, 301)
-    with pytest.raises(TypeError, match="kt"):
+    with pytest.raises(TypeError, match="teeth"):
         zoa_lobes(single_mode(f), None, teeth=2, kt=KT, kr=KR, radial_immersion=0.5, rpm=[5000.0, 6000.0])

@@ -28,6 +28,26 @@ data alone and excluded, one rule each:
   receptance itself over a small static compliance is not the conversion's
   junk, and a fit can weigh it. The note says whether the excluded noise grows
   like 1/ω² (slope between −2.5 and −1.5: "looks like accelerance noise ×1/ω²").
+* **A receptance that rises towards 0 Hz** (physical plausibility). A tool
+  clamped in a spindle is grounded: its receptance tends to a finite static
+  compliance at 0 Hz and cannot rise towards 0 Hz like a free mass. An offset
+  or slow drift in the acceleration channel, divided by −ω², makes exactly such
+  a rise — smooth, not noisy, so the noise rule above does not see it (a lab's
+  end mill: |H| 1.2e-2 m/N at 1 Hz falling as f⁻²…f⁻³ to the static compliance
+  ≈ 1e-7 m/N near 60 Hz). The rule: |H| smoothed over :data:`WINDOW` points
+  is followed up from the lowest frequency while it falls; its *valley* is the
+  lowest value before it climbs again to :data:`RISE_CLIMB` × that value (the
+  static compliance, or the flank of the first mode). When the log–log slope
+  of |H| from the first point (> 0 Hz) to the valley is ≤ :data:`RISE_SLOPE`,
+  the band starts at :data:`RISE_MARGIN` × the valley frequency: at the valley
+  the artefact is as large as the structure's response, and one octave up an
+  f⁻² rise has fallen to a quarter, f⁻³ to an eighth. When the rise never
+  levels off, the data cannot tell the structure from the artefact: an
+  :class:`~toolpoint.errors.InputError` says so and asks for ``--band``.
+  Only a smooth rise counts (neighbouring residuals correlated above
+  :data:`RISE_SMOOTH`: a rise made of noise ×1/ω² is the noise rule's), only data that start near
+  0 Hz (:data:`RISE_NEAR_ZERO`) and only receptances (mobility and
+  accelerance of a grounded structure vanish at 0 Hz).
 * **Low coherence at either end.** When ``frf.meta["coherence"]`` holds the
   ordinary coherence γ² (e.g. from ``toolpoint tap`` or a file with a
   coherence column), the band starts at the first point from which
@@ -54,8 +74,9 @@ import numpy as np
 from .errors import InputError
 from .frf import FRF
 
-__all__ = ["COHERENCE_MIN", "SNR_MIN", "WINDOW", "MIN_SLOPE_POINTS", "TrustedBand", "check_band", "trusted_band",
-           "edge_hits"]
+__all__ = ["COHERENCE_MIN", "SNR_MIN", "WINDOW", "MIN_SLOPE_POINTS", "RISE_SLOPE", "RISE_CLIMB", "RISE_MARGIN",
+           "RISE_SMOOTH", "RISE_NEAR_ZERO",
+           "TrustedBand", "Band", "check_band", "trusted_band", "common_band", "edge_hits"]
 
 COHERENCE_MIN = 0.8
 """Lowest ordinary coherence γ² trusted at the band ends (γ² = 0.8: noise-to-signal power ratio 0.25)."""
@@ -134,6 +155,74 @@ def check_band(band, *, file=None, field: str = "--band") -> tuple[float, float]
     return lo, hi
 
 
+RISE_SLOPE = -1.0
+"""Log–log slope of |H| towards 0 Hz at or below which a receptance is taken to rise like a free mass (f⁻²)."""
+
+RISE_CLIMB = 1.5
+"""Factor by which the smoothed |H| must climb again above its running minimum to end the falling low end."""
+
+RISE_MARGIN = 2.0
+"""The band starts this factor (one octave) above the valley of a rising low end."""
+
+RISE_SMOOTH = 0.0
+"""Lag-1 correlation of the point-to-point residuals above which a rise is smooth (an artefact of the signal
+chain: curvature, correlation ≈ +1), not noise ×1/ω² (white noise: −2/3)."""
+
+RISE_NEAR_ZERO = 0.05
+"""The rise rule judges only data that start below this share of their last frequency: near 0 Hz, where a grounded
+structure shows its static compliance (data that start above a mode fall as f⁻² legitimately)."""
+
+
+def _rise_edge(frf: FRF, file) -> tuple[int, str]:
+    """Index of the first trusted point by the rise rule, and the reason ("" when nothing is cut)."""
+    f, h = frf.freq_hz, frf.values
+    if frf.quantity != "receptance" or f.size < 3 * WINDOW:
+        return 0, ""
+    k0 = int(np.searchsorted(f, 0.0, side="right"))  # first point above 0 Hz
+    if f[k0] > RISE_NEAR_ZERO * f[-1]:
+        return 0, ""  # data far from 0 Hz (above a mode, say) say nothing about the static compliance
+    mag = _running_median(np.abs(h[k0:]), WINDOW)
+    fk = f[k0:]
+    if not np.all(mag > 0):
+        return 0, ""
+    run_min = np.minimum.accumulate(mag)
+    climbed = np.flatnonzero(mag > RISE_CLIMB * run_min)
+    end = int(climbed[0]) if climbed.size else mag.size - 1
+    v = int(np.argmin(mag[: end + 1]))  # the valley: lowest point before the first climb
+    if v < 2:
+        return 0, ""
+    slope = np.log(mag[v] / mag[0]) / np.log(fk[v] / fk[0])
+    if slope > RISE_SLOPE:
+        return 0, ""
+    n = min(v + 1, 2 * WINDOW)  # where the rise starts: steepest, the artefact (if any) far above the noise
+    if _lag1_correlation(fk[:n], h[k0:][:n]) < RISE_SMOOTH:
+        return 0, ""  # a rise made of noise ×1/ω²: the noise rule's to judge
+    if not climbed.size:
+        raise InputError(f"the receptance rises towards 0 Hz over the whole band (log–log slope {slope:.1f} from "
+                         f"{fk[0]:g} to {fk[v]:g} Hz), as an accelerometer offset or drift divided by −ω² does, and "
+                         "never levels off: the data cannot tell the structure from the artefact; give the band "
+                         "to trust with --band LO:HI", file=file, field="values")
+    lo = RISE_MARGIN * fk[v]
+    i = int(np.searchsorted(f, lo))
+    if i >= f.size - 1:
+        raise InputError(f"the receptance rises towards 0 Hz up to {fk[v]:g} Hz (log–log slope {slope:.1f}), too "
+                         "close to the end of the data to leave a band; give the band to trust with --band LO:HI",
+                         file=file, field="values")
+    return i, (f"below {f[i]:g} Hz the receptance rises towards 0 Hz as f^{slope:.1f} (a grounded structure tends "
+               "to its static compliance: an offset or drift in the acceleration signal ÷ −ω²)")
+
+
+def _lag1_correlation(f: np.ndarray, h: np.ndarray) -> float:
+    """Correlation of neighbouring point-to-point residuals r_k (see :func:`_neighbour_residual`): ≈ +1 where they
+    are the curvature of a smooth FRF, −2/3 where they are white noise."""
+    if f.size < 4:
+        return 1.0
+    h1, h2 = np.diff(f)[:-1], np.diff(f)[1:]
+    r = h[1:-1] - (h2 * h[:-2] + h1 * h[2:]) / (h1 + h2)
+    r = r / np.maximum(np.abs(h[1:-1]), 1e-300)  # relative: the steep low end does not outweigh the rest
+    return float(np.real(np.sum(r[:-1] * np.conj(r[1:]))) / max(np.sum(np.abs(r[:-1]) ** 2), 1e-300))
+
+
 def _neighbour_residual(f: np.ndarray, h: np.ndarray) -> np.ndarray:
     """|r̃_k| for the interior points: the value minus the line through its neighbours, scaled to noise σ."""
     h1, h2 = np.diff(f)[:-1], np.diff(f)[1:]
@@ -194,6 +283,31 @@ def _noise_edge(frf: FRF, quantity_measured: str | None) -> tuple[int, str, str]
     how = ("the receptance looks like accelerance noise ×1/ω²" if accel else
            f"the noise, growing towards 0 Hz as f^{slope:.1f}, exceeds the signal")
     return i, f"below {lo:g} Hz {how}", "accelerance" if accel else ("mobility" if slope > -1.5 else "")
+
+
+def _noise_slope(frf: FRF) -> str:
+    """The quantity the noise of ``frf`` looks white in over its whole grid: log–log slope of the point-to-point
+    noise estimate against f near −2 → ``"accelerance"``, near −1 → ``"mobility"``, else ``""`` (judged white in
+    the receptance itself, or too little noise to tell)."""
+    f, h = frf.freq_hz, frf.values
+    if f.size < 3 * WINDOW or frf.quantity != "receptance":
+        return ""
+    h1, h2 = np.diff(f)[:-1], np.diff(f)[1:]
+    r = h[1:-1] - (h2 * h[:-2] + h1 * h[2:]) / (h1 + h2)
+    resid = np.abs(r) / np.sqrt(1.0 + (h1**2 + h2**2) / (h1 + h2) ** 2)
+    n = 4 * WINDOW + 1
+    sigma = _running_median(resid, n) / math.sqrt(math.log(2.0))
+    # Noise or curvature? For white noise neighbouring residuals correlate at −2/3; for a smooth FRF's curvature
+    # at ≈ +1. Only points where the local lag-1 correlation is clearly negative measure noise.
+    c = np.real(r[:-1] * np.conj(r[1:]))
+    kernel = np.ones(n) / n
+    corr = np.convolve(c, kernel, "same") / np.maximum(np.convolve(np.abs(r[:-1]) ** 2, kernel, "same"), 1e-300)
+    fk, sigma = f[1:-2], sigma[:-1]
+    ok = (fk > 0) & (sigma > 0) & (corr < -0.3)
+    if ok.sum() < MIN_SLOPE_POINTS or fk[ok][-1] < 2 * fk[ok][0]:
+        return ""  # less than an octave: the slope says nothing
+    slope = np.polyfit(np.log(fk[ok]), np.log(sigma[ok]), 1)[0]
+    return "accelerance" if -2.5 <= slope <= -1.5 else ("mobility" if -1.5 < slope <= -0.5 else "")
 
 
 def _coherence_edges(frf: FRF, coherence_min: float) -> tuple[int, int, str]:
@@ -282,6 +396,10 @@ def trusted_band(frf: FRF, *, quantity_measured: str | None = None, coherence_mi
     q = quantity_measured or frf.meta.get("file_quantity")
     i, why, noise_q = _noise_edge(frf, q)
     j, reasons = f.size - 1, [why] if why else []
+    # the rise rule judges what stands above the noise: a rise made of noise ×1/ω² is the noise rule's
+    i_rise, why_rise = _rise_edge(frf if i == 0 else frf.band(f[i], f[-1]), file)
+    if i_rise > 0:
+        i, reasons = i + i_rise, [why_rise]
     if frf.meta.get("coherence") is not None:
         ic, jc, cwhy = _coherence_edges(frf, coherence_min)
         if cwhy:
@@ -290,7 +408,97 @@ def trusted_band(frf: FRF, *, quantity_measured: str | None = None, coherence_mi
     if j - i < 1:
         return TrustedBand(float(f[0]), float(f[-1]), "; ".join(reasons + [
             "the rules leave no band: nothing trimmed, check the data"]), noise_quantity=noise_q)
+    if not noise_q and i > 0:
+        # a band cut for another reason (the rise, coherence): how the noise grows inside it still tells a fit
+        # how to weigh the data
+        noise_q = _noise_slope(frf.band(f[i], f[j]))
     return TrustedBand(float(f[i]), float(f[j]), "; ".join(reasons), noise_quantity=noise_q)
+
+
+class Band(NamedTuple):
+    """One band for several measured FRFs (:func:`common_band`).
+
+    Attributes
+    ----------
+    lo_hz, hi_hz : float
+        The band, Hz: given, or the intersection of the files' trusted bands.
+    noise_quantity : str
+        The quantity the FRFs' noise looks white in, when every FRF that tells agrees (else ``""``).
+    notes : tuple of str
+        One line per FRF whose band was trimmed (or the given band's line), for stderr.
+    bands : tuple of TrustedBand
+        Each FRF's own trusted band.
+    """
+
+    lo_hz: float
+    hi_hz: float
+    noise_quantity: str
+    notes: tuple
+    bands: tuple
+
+    def cut(self, frf: FRF) -> FRF:
+        """``frf`` cut to the smallest run of its own points covering the band (another grid: no extrapolation)."""
+        f = frf.freq_hz
+        i = max(int(np.searchsorted(f, self.lo_hz, side="right")) - 1, 0)
+        j = min(int(np.searchsorted(f, self.hi_hz, side="left")), f.size - 1)
+        if i == 0 and j == f.size - 1:
+            return frf
+        return frf.band(f[i], f[j])
+
+
+def common_band(frfs, *, band=None, files=None, field: str = "--band", hint: str = "--band LO:HI",
+                quantity_measured: str | None = None) -> Band:
+    """The one band in which several measured FRFs are used: the entry point of every command.
+
+    Parameters
+    ----------
+    frfs : sequence of FRF
+        Measured SISO FRFs (None entries are skipped).
+    band : (float, float), optional
+        A band given by the user, Hz: checked against every FRF, no detection.
+    files : sequence of str, optional
+        Where each FRF came from, for notes and errors (default ``frf.meta["source"]``).
+    field, hint : str
+        The option that sets the band (named by errors) and the hint in the notes.
+    quantity_measured : str, optional
+        See :func:`trusted_band`.
+
+    Returns
+    -------
+    Band
+
+    Raises
+    ------
+    InputError
+        A given band outside an FRF's data, data that cannot decide (a rise towards 0 Hz that never levels off),
+        or trusted bands that do not overlap — each naming the file and ``field``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.arange(1.0, 3001.0)
+    >>> h = 1 / (1e7 * (1 - (f / 900) ** 2 + 0.04j * f / 900))
+    >>> b = common_band([FRF(f, h), FRF(f, h)], band=(100, 2000), files=["x.csv", "y.csv"])
+    >>> b.lo_hz, b.hi_hz, b.notes
+    (100.0, 2000.0, ('note: band 100–2000 Hz given by --band (no automatic trimming)',))
+    >>> common_band([FRF(f, h)], band=(100, 2000), files=["x.csv"]).notes[0]
+    'note: x.csv: band 100–2000 Hz given by --band (no automatic trimming)'
+    """
+    pairs = [(g, (files[k] if files is not None else None)) for k, g in enumerate(frfs) if g is not None]
+    tbs = [trusted_band(g, band=band, file=name, field=field, quantity_measured=quantity_measured)
+           for g, name in pairs]
+    names = [name if name is not None else g.meta.get("source", "") for g, name in pairs]
+    lo, hi = max(tb.lo_hz for tb in tbs), min(tb.hi_hz for tb in tbs)
+    if band is not None:  # one line: the file's name when there is one file
+        notes = (tbs[0].note(str(names[0] or "") if len(tbs) == 1 else "", hint),)
+    else:
+        notes = tuple(n for n in (tb.note(str(name or ""), hint) for tb, name in zip(tbs, names)) if n)
+    if lo >= hi:
+        each = ", ".join(f"{name} {tb.lo_hz:g}–{tb.hi_hz:g} Hz" for tb, name in zip(tbs, names))
+        raise InputError(f"the trusted bands of the FRFs do not overlap ({each}): give {hint}",
+                         file=names[0], field=field)
+    told = {tb.noise_quantity for tb in tbs if tb.noise_quantity}
+    return Band(float(lo), float(hi), told.pop() if len(told) == 1 else "", notes, tuple(tbs))
 
 
 def edge_hits(chatter_hz, band: tuple[float, float], freq_hz) -> np.ndarray:

@@ -143,17 +143,3 @@ def parse_band(text: str | None, flag: str = "--band") -> tuple[float, float] | 
     if not sep or band is None or not (all(math.isfinite(b) for b in band) and 0 <= band[0] < band[1]):
         raise InputError(f"expected LO:HI in Hz with 0 ≤ LO < HI, got {text!r}", file="command line", field=flag)
     return band
-
-
-def trusted(frf, path, band=None, *, field: str = "--band", hint: str = "--band LO:HI", quantity=None):
-    """The FRF read from ``path`` cut to its trusted band (:func:`toolpoint.trust.trusted_band`), and the note.
-
-    ``band`` is a given band (no detection); a band outside the data is an
-    InputError naming ``path`` and ``field``. The note is ``""`` when nothing was
-    excluded; the caller prints it (on stderr) once the command has succeeded.
-    """
-    from ..trust import trusted_band
-
-    tb = trusted_band(frf, band=band, file=path, field=field, quantity_measured=quantity)
-    cut = frf if (tb.lo_hz, tb.hi_hz) == (frf.freq_hz[0], frf.freq_hz[-1]) else frf.band(tb.lo_hz, tb.hi_hz)
-    return cut, tb, tb.note(str(path), hint)

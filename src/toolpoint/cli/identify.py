@@ -24,7 +24,7 @@ from ..io.frf_files import read_frf
 from ..identification.identify import identify, make_algorithm, model_for
 from ..identification.params import PARAMS, UNITS, Bounds
 from ..identification.optim import METHODS, check_method
-from .common import check_number, out_path, parse_band, save_figure, trusted, use_agg, warnings_to_stderr
+from .common import check_number, out_path, parse_band, save_figure, use_agg, warnings_to_stderr
 
 MIN_POINTS = 10
 
@@ -217,8 +217,10 @@ def fit_band(frf, path, spec):
     """``frf`` (read from ``path``) cut to the band of ``spec`` (:func:`band_spec`), and the note for stderr."""
     band, field = (spec[1], spec[2]) if spec[0] == "given" else (None, "--band")
     hint = "--band LO:HI or [identify] band_hz"
-    cut, _, note = trusted(frf, path, band, field=field, hint=hint)
-    return cut, note
+    from ..trust import common_band
+
+    b = common_band([frf], band=band, files=[path], field=field, hint=hint)
+    return b.cut(frf), (b.notes[0] if b.notes else "")
 
 
 # --------------------------------------------------------------------------- general form

@@ -47,7 +47,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.atomic import atomic_open, atomic_path
 from ..stability.milling import MAX_RPM, MAX_RPM_POINTS
-from .common import out_path, parse_band, trusted, use_agg, warnings_to_stderr
+from .common import out_path, parse_band, use_agg, warnings_to_stderr
 
 # Flags of earlier versions → what to give instead (one line naming it, exit 2).
 REMOVED = {"--kt": "--tangential-coeff (the cutting coefficient Kt, N/m²; not the joint stiffness kt)",
@@ -194,98 +194,45 @@ def run(args) -> int:
 
     band = parse_band(args.band)
     outs = _outputs(args)
-    frf_x = _load(args.frf, "FRF")
-    frfs = {}
+    frfs = {"FRF": _load(args.frf, "FRF")}
     for flag in ("--frf-y", "--frf-xy", "--frf-yx"):
         path = getattr(args, flag[2:].replace("-", "_"))
-        frfs[flag] = None if path is None else _load(path, flag, freq_hz=frf_x.freq_hz)
-    data_hz = frf_x.freq_hz
-    frf_x, frfs, band, notes, noise = _trusted_band(frf_x, frfs, args, band)
+        frfs[flag] = None if path is None else _load(path, flag, freq_hz=frfs["FRF"].freq_hz)
+    files = {"FRF": args.frf, "--frf-y": args.frf_y, "--frf-xy": args.frf_xy, "--frf-yx": args.frf_yx}
+    from ..progress import Progress
+    from ..stability.measured import lobes_from_frf
+
     with warnings_to_stderr():
         rpm = np.linspace(lo, hi, npts)
         if cut.tangential_coeff < 1e6:
             warnings.warn(f"Kt {cut.tangential_coeff:g} N/m² is very small (typical 1e8–3e9 N/m²): "
                           "was it given in N/mm²?")
         if method == "zoa":
-            from ..stability import zoa_lobes
-
             for flag, given in (("--modes", n_modes is not None), ("--accuracy", args.accuracy != "1")):
                 if given:
                     warnings.warn(f"{flag} is used by --method sdm only; ignored")
-            try:
-                res = zoa_lobes(frf_x, frfs["--frf-y"], cut, rpm=rpm, frf_xy=frfs["--frf-xy"],
-                                frf_yx=frfs["--frf-yx"])
-            except InputError as err:  # name the file the FRF came from
-                flag = {"frf_x": "FRF", "frf_y": "--frf-y", "frf_xy": "--frf-xy", "frf_yx": "--frf-yx"}
-                path = {"FRF": args.frf, "--frf-y": args.frf_y, "--frf-xy": args.frf_xy, "--frf-yx": args.frf_yx}
-                f = flag.get(err.field)
-                if f is None:
-                    raise
-                raise InputError(err.message, file=path[f], field=f) from None
-        else:
-            paths = {"FRF": args.frf, "--frf-y": args.frf_y, "--frf-xy": args.frf_xy, "--frf-yx": args.frf_yx}
-            res = _sdm(dict(frfs, FRF=frf_x), paths, n_modes, cut, rpm, accuracy, noise)
+        with contextlib.ExitStack() as stack:
+            bar = []  # opened when the SDM starts: a refused model prints its one line only
+
+            def step(done, total):
+                if not bar:
+                    bar.append(stack.enter_context(Progress(total, "semi-discretisation", "speed")))
+                bar[0].update(done - bar[0].n)
+
+            found = lobes_from_frf(frfs["FRF"], cut, rpm, frf_y=frfs["--frf-y"], frf_xy=frfs["--frf-xy"],
+                                   frf_yx=frfs["--frf-yx"], method=method, band=band, n_modes=n_modes,
+                                   accuracy=accuracy, files=files, log=print, progress=step)
+    res = found.lobes
+    if method == "sdm":
+        ms = np.unique(res.params["m"])
+        print(f"semi-discretisation: {ms.min()}–{ms.max()} steps over the cut" if ms.size > 1 else
+              f"semi-discretisation: {ms[0]} steps over the cut")
     fig = _figure(res) if outs["plot"] else None
     _write(outs, res, fig)
-    for note in notes:
+    for note in found.notes:
         print(note, file=sys.stderr)
-    edge, min_at_edge = _edge_warning(res, band, data_hz)
-    _summary(res, outs, edge, min_at_edge)
+    _summary(res, outs, found.edge, found.min_at_edge)
     return 0
-
-
-def _trusted_band(frf_x, frfs, args, band):
-    """Every FRF cut to one band: the ``--band`` given, or the intersection of the files' trusted bands.
-
-    Returns the cut x FRF, the other FRFs, the band (Hz), the notes to print
-    once the lobes are written, and per flag the quantity each FRF's noise looks white in
-    (``TrustedBand.noise_quantity``, None when not found; the SDM's modal fit is weighted in it).
-    A given band outside an FRF's data is an InputError naming that file and ``--band``.
-    """
-    paths = {"FRF": args.frf, "--frf-y": args.frf_y, "--frf-xy": args.frf_xy, "--frf-yx": args.frf_yx}
-    given = {"FRF": frf_x, **{k: v for k, v in frfs.items() if v is not None}}
-    found = {k: trusted(g, paths[k], band) for k, g in given.items()}
-    lo = max(tb.lo_hz for _, tb, _ in found.values())
-    hi = min(tb.hi_hz for _, tb, _ in found.values())
-    notes = [note for _, _, note in found.values() if note]
-    noise = {k: tb.noise_quantity or None for k, (_, tb, _) in found.items()}
-    if band is not None:
-        notes = [found["FRF"][2].replace(f"{args.frf}: ", "")]
-    if lo >= hi:
-        each = ", ".join(f"{k} {tb.lo_hz:g}–{tb.hi_hz:g} Hz" for k, (_, tb, _) in found.items())
-        raise InputError(f"the trusted bands of the FRFs do not overlap ({each}): give --band LO:HI",
-                         file=args.frf, field="--band")
-    f = frf_x.freq_hz
-    if (lo, hi) == (f[0], f[-1]):
-        return frf_x, frfs, (lo, hi), notes, noise
-    cut = {k: (None if g is None else _covering(g, lo, hi)) for k, g in frfs.items()}
-    return frf_x.band(lo, hi), cut, (lo, hi), notes, noise
-
-
-def _covering(frf, lo, hi):
-    """``frf`` cut to the smallest run of its own points that covers [lo, hi] Hz (another grid: no extrapolation)."""
-    f = frf.freq_hz
-    a = f[f <= lo][-1] if np.any(f <= lo) else f[0]
-    b = f[f >= hi][0] if np.any(f >= hi) else f[-1]
-    return frf.band(a, b)
-
-
-def _edge_warning(res, band, data_hz):
-    """Say on stderr which limits rest on a chatter frequency at a cutting edge of the band.
-
-    Returns their mask over the speeds, and whether the absolute minimum's chatter frequency is at an edge.
-    """
-    from ..trust import edge_hits
-
-    edge = edge_hits(res.chatter_hz, band, data_hz) & np.isfinite(res.depth_m)
-    min_at_edge = bool(edge_hits([res.min_chatter_hz], band, data_hz)[0])
-    if edge.any():
-        r = res.rpm[edge]
-        print(f"warning: at {edge.sum()} of {res.rpm.size} speeds ({r.min():.0f}–{r.max():.0f} rpm) the limiting "
-              f"chatter frequency lies at the edge of the band {band[0]:g}–{band[1]:g} Hz: those limits are not "
-              "trusted (the resonance behind them may lie outside the band); check the FRF there and set "
-              "--band LO:HI", file=sys.stderr)
-    return edge, min_at_edge
 
 
 def _outputs(args) -> dict:
@@ -307,109 +254,6 @@ def _outputs(args) -> dict:
     if inputs & set(given):
         raise InputError("an output would overwrite an input FRF", field="--out")
     return outs
-
-
-# A modal fit that leaves this relative RMS error explains < 10 % of the FRF's energy: no resonance.
-_NO_RESONANCE = 0.95
-# A final fit worse than this explains < 75 % of the FRF: lobes from it would describe another structure.
-_BAD_FIT = 0.5
-
-
-def _fit_one(frf, flag, path, n_modes, noise=None):
-    """Complex modes of one direct receptance (``dynamics.modal.fit_frfs``), refused when there is nothing to fit.
-
-    ``noise``: the quantity the FRF's noise is white in (``"accelerance"`` for a receptance whose
-    noise grows as 1/ω², found by the trusted band), passed to the fit's weighting.
-
-    Refused (one line naming the file and flag): a fit that leaves ≥ 95 % of the FRF
-    unexplained (no resonance: noise only), a fit with no mode inside the band (the
-    resonance lies outside it), or one that leaves > 50 % unexplained.
-    """
-    from ..dynamics.modal import fit_frfs
-
-    try:
-        fit = fit_frfs([frf], n_modes=n_modes, noise=noise)
-    except InputError as err:
-        raise InputError(err.message, file=path, field=flag) from None
-    if np.max(fit.fit_error) >= _NO_RESONANCE:
-        raise InputError(f"no resonance found for --method sdm: the modal fit ({fit.n_modes} modes) leaves "
-                         f"{100 * np.max(fit.fit_error):.0f} % (relative RMS) of the FRF unexplained (noise only?)",
-                         file=path, field=flag)
-    if fit.n_modes == 0:
-        lo, hi = fit.band_hz
-        raise InputError(f"no mode inside the FRF's band {lo:g}–{hi:g} Hz for --method sdm (the resonance lies "
-                         "outside the measured band)", file=path, field=flag)
-    _check_fit(fit.fit_error, flag, path)
-    return fit
-
-
-def _check_fit(error, flag, path):
-    """Refuse a modal fit that does not describe the FRF (relative RMS error above ``_BAD_FIT``)."""
-    if np.max(error) > _BAD_FIT:
-        raise InputError(f"the modal fit leaves {100 * np.max(error):.0f} % (relative RMS) of the FRF unexplained; "
-                         "the semi-discretisation needs a modal model (try --modes, or --method zoa)",
-                         file=path, field=flag)
-
-
-def _cross_model(frfs, paths, n_modes):
-    """A 2×2 state-space model from common-pole fits of each force's column (missing cross FRFs are 0).
-
-    Force x: Φ_xx and Φ_yx share poles; force y: Φ_yy (Φ_xx if not given) and Φ_xy.
-    """
-    from ..dynamics.modal import fit_frfs
-    from ..stability.statespace import from_modal_fit
-
-    fits = []
-    for direct, cross in (("FRF", "--frf-yx"), ("--frf-y" if frfs["--frf-y"] is not None else "FRF", "--frf-xy")):
-        flags = [direct] + ([cross] if frfs[cross] is not None else [])
-        try:
-            fit = fit_frfs([frfs[f] for f in flags], n_modes=n_modes)
-        except InputError as err:
-            raise InputError(f"common-pole fit of {' and '.join(flags)}: {err.message}", file=paths[flags[-1]],
-                             field=flags[-1]) from None
-        print(f"common-pole fit, force {'xy'[len(fits)]} ({', '.join(flags)}):\n{fit.table()}")
-        if fit.n_modes == 0:
-            raise InputError(f"no mode inside the FRF's band {fit.band_hz[0]:g}–{fit.band_hz[1]:g} Hz for "
-                             "--method sdm", file=paths[direct], field=direct)
-        _check_fit(fit.fit_error, direct, paths[direct])
-        fits.append(fit)
-    return from_modal_fit(fits[0], fits[1])
-
-
-def _sdm(frfs, paths, n_modes, cut, rpm, accuracy, noise=None):
-    """Fit modes to the FRFs (printing them) and run the semi-discretisation, reporting progress on stderr.
-
-    Without cross FRFs: complex modes per direction (``dynamics.modal.fit_frfs``);
-    with ``--frf-xy``/``--frf-yx``: a common-pole fit per force direction; either way
-    the fits' state-space realisation (``stability.statespace.from_modal_fit``). ``noise``: per flag the
-    quantity the FRF's noise is white in (None: its own), for the weighting of the direct fits.
-    """
-    from ..progress import Progress
-    from ..stability import sdm_lobes
-
-    if frfs["--frf-xy"] is not None or frfs["--frf-yx"] is not None:
-        model, my = _cross_model(frfs, paths, n_modes), None
-    else:
-        from ..stability.statespace import from_modal_fit
-
-        frf_x, frf_y = frfs["FRF"], frfs["--frf-y"]
-        noise = noise or {}
-        fx = _fit_one(frf_x, "FRF", paths["FRF"], n_modes, noise.get("FRF"))
-        print(f"modal fit, x ({frf_x.label or 'FRF'}):\n{fx.table()}")
-        fy = None
-        if frf_y is None:
-            print("y: same modes as x (symmetric tool)")
-        else:
-            fy = _fit_one(frf_y, "--frf-y", paths["--frf-y"], n_modes, noise.get("--frf-y"))
-            print(f"modal fit, y ({frf_y.label or 'FRF_Y'}):\n{fy.table()}")
-        model, my = from_modal_fit(fx, fy), None
-    with Progress(rpm.size, "semi-discretisation", "speed") as bar:
-        res = sdm_lobes(model, my, cut, rpm=rpm, accuracy=accuracy,
-                        progress=lambda done, total: bar.update(done - bar.n))
-    ms = np.unique(res.params["m"])
-    print(f"semi-discretisation: {ms.min()}–{ms.max()} steps over the cut" if ms.size > 1 else
-          f"semi-discretisation: {ms[0]} steps over the cut")
-    return res
 
 
 def _figure(res):

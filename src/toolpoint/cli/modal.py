@@ -29,7 +29,8 @@ from ..errors import InputError
 from ..frf import FRF
 from ..io.atomic import atomic_open
 from ..io.frf_files import read_frf
-from .common import out_path, parse_band, save_figure, trusted, use_agg, warnings_to_stderr
+from ..trust import common_band
+from .common import out_path, parse_band, save_figure, use_agg, warnings_to_stderr
 
 QUANTITIES = ("receptance", "mobility", "accelerance")
 
@@ -80,10 +81,13 @@ def run(args) -> int:
     n_modes = parse_modes(args.modes)
     with warnings_to_stderr():
         frfs = [read_frf(path, quantity=args.quantity) for path in args.frf]
-        band, notes = _trusted(frfs, args.frf, band)
+        b = common_band(frfs, band=band, files=args.frf)
+        notes = list(b.notes)
+        f = frfs[0].freq_hz
+        band = None if (b.lo_hz, b.hi_hz) == (f[0], f[-1]) else (b.lo_hz, b.hi_hz)
         _check(frfs, args.frf, band)
         try:
-            fit = fit_frfs(frfs, band=band, n_modes=n_modes)
+            fit = fit_frfs(frfs, band=band, n_modes=n_modes, noise=b.noise_quantity or None)
         except InputError as e:
             flag = {"band": "--band", "n_modes": "--modes"}.get(e.field)
             if flag is None:
@@ -99,24 +103,6 @@ def run(args) -> int:
     for note in notes:
         print(note, file=sys.stderr)
     return 0
-
-
-def _trusted(frfs, paths, band):
-    """The band to fit: given (checked against every file), or the trusted band of every file (intersection).
-
-    Returns the band (None: all of it) and the notes to print once the fit has succeeded.
-    """
-    tbs = [trusted(g, path, band)[1:] for g, path in zip(frfs, paths)]
-    if band is not None:
-        return band, [tbs[0][1].replace(f"{paths[0]}: ", "")]
-    notes = [note for _, note in tbs if note]
-    if not notes:
-        return None, []
-    lo, hi = max(tb.lo_hz for tb, _ in tbs), min(tb.hi_hz for tb, _ in tbs)
-    if lo >= hi:
-        return None, notes + ["note: the trusted bands of the files do not overlap: all of the band fitted"]
-    f = frfs[0].freq_hz
-    return (None if (lo, hi) == (f[0], f[-1]) else (lo, hi)), notes
 
 
 def _check(frfs, paths, band) -> None:

@@ -1,0 +1,95 @@
+"""Lobes from a measured-like FRF with the artefacts of a real lab tap test (issue: a confident wrong answer).
+
+The FRF (``tests/lab_like.py``) rises smoothly towards 0 Hz below ~70 Hz (an accelerometer offset/drift ÷ −ω²) and
+carries noise white in accelerance. The reference is the structure alone from 200 Hz — the band a careful engineer
+gives. Library and CLI must agree: same band, notes and limits.
+"""
+
+import numpy as np
+import pytest
+
+from lab_like import DOMINANT_HZ, NOISE_ACCELERANCE, lab_like_frf, reference_frf, write_tsv
+from toolpoint.cli.main import main
+from toolpoint.errors import InputError
+from toolpoint.frf import FRF
+from toolpoint.stability import CuttingConditions
+from toolpoint.stability.measured import lobes_from_frf
+from toolpoint.trust import trusted_band
+
+CUT = CuttingConditions(teeth=4, tangential_coeff=796e6, radial_ratio=0.212, radial_immersion=0.5)
+RPM = np.linspace(500.0, 20000.0, 400)
+ARGS = ["--teeth", "4", "--tangential-coeff", "796e6", "--radial-ratio", "0.212", "--immersion", "0.5",
+        "--rpm", "500:20000", "--rpm-points", "400"]
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return lobes_from_frf(reference_frf(), CUT, RPM).lobes
+
+
+@pytest.mark.parametrize("seed, noise", [(0, 1.0), (1, 1.0), (2, 10.0), (3, 30.0)])
+def test_rise_towards_0_hz_is_cut_and_the_limit_is_the_structures(reference, seed, noise):
+    frf = lab_like_frf(seed, noise=NOISE_ACCELERANCE * noise)
+    tb = trusted_band(frf)
+    assert 100 <= tb.lo_hz <= 300 and "rises towards 0 Hz" in tb.reason
+    res = lobes_from_frf(frf, CUT, RPM)
+    assert res.lobes.min_chatter_hz > 500
+    assert res.lobes.min_depth_m == pytest.approx(reference.min_depth_m, rel=0.15)
+    # every speed: nothing below the band's edge limits the depth
+    assert np.nanmin(res.lobes.chatter_hz) >= tb.lo_hz
+
+
+def test_the_whole_band_gives_the_confident_wrong_answer_that_the_rule_prevents(reference):
+    """The failure the rule fixes, kept as a check that the fixture has the lab's artefact."""
+    res = lobes_from_frf(lab_like_frf(0), CUT, RPM, band=(1.0, 5000.0))
+    assert res.lobes.min_chatter_hz < 100 and res.lobes.min_depth_m < 0.6 * reference.min_depth_m
+
+
+def test_sdm_on_the_lab_like_frf_agrees_with_the_zero_order_or_refuses(reference):
+    res = lobes_from_frf(lab_like_frf(1, noise=NOISE_ACCELERANCE * 10), CUT, RPM[::8], method="sdm")
+    fn = res.modal[0].fn_hz
+    for f0 in DOMINANT_HZ:
+        assert np.min(np.abs(fn - f0)) < 0.02 * f0
+    assert res.lobes.min_chatter_hz > 500
+    assert res.lobes.min_depth_m == pytest.approx(reference.min_depth_m, rel=0.15)
+
+
+def test_sdm_refuses_a_model_that_misses_a_dominant_peak():
+    from types import SimpleNamespace
+
+    from toolpoint.stability.measured import _check_model, dominant_peaks
+
+    f = np.arange(200.0, 3000.0)
+    h = sum(1 / (k * (1 - (f / fn) ** 2 + 2j * 0.03 * f / fn)) for fn, k in ((900.0, 2e7), (1700.0, 2.2e7)))
+    frf = FRF(f, h)
+    peaks = dominant_peaks(frf)
+    assert peaks.size == 2 and np.allclose(peaks, [900, 1700], rtol=0.01)
+    one = SimpleNamespace(fn_hz=np.array([900.0]), fit_error=np.array([0.3]), n_modes=1, band_hz=(200.0, 2999.0))
+    with pytest.raises(InputError, match="dominant peak 1699|dominant peak 1700|dominant peak 1701"):
+        _check_model(one, frf, "FRF", "x.csv")
+    both = SimpleNamespace(fn_hz=np.array([900.0, 1700.0]), fit_error=np.array([0.01]), n_modes=2,
+                           band_hz=(200.0, 2999.0))
+    _check_model(both, frf, "FRF", "x.csv")
+    with pytest.raises(InputError):  # and the pipeline refuses the one-mode model one way or the other
+        lobes_from_frf(frf, CUT, RPM[::40], method="sdm", n_modes=1)
+
+
+def test_library_and_cli_give_the_same_band_notes_and_limits(tmp_path, capsys):
+    path = tmp_path / "lab.txt"
+    write_tsv(lab_like_frf(0), path)
+    out = tmp_path / "lobes.csv"
+    assert main(["lobes", str(path), *ARGS, "--out", str(out)]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    from toolpoint.io.frf_files import read_frf
+
+    lib = lobes_from_frf(read_frf(path), CUT, RPM, files={"FRF": str(path)})
+    assert err == list(lib.notes)
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert np.allclose(data[:, 1], lib.lobes.depth_m * 1e3, rtol=1e-9)
+
+
+def test_a_rise_that_never_levels_off_is_refused_pointing_to_band():
+    f = np.arange(1.0, 2000.0)
+    h = 0.5 / (2j * np.pi * f) ** 2 + 1e-8  # a free mass all the way: not a grounded tool
+    with pytest.raises(InputError, match="--band"):
+        lobes_from_frf(FRF(f, h), CUT, RPM)
