@@ -227,3 +227,288 @@ def test_cli_bad_input_exit_2_no_output(tmp_path, capsys):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert "--threshold: must be in (0, 1)" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- the realistic virtual impact test (issue 20)
+from dataclasses import replace  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from scipy.optimize import brentq  # noqa: E402
+
+from toolpoint.io import virtual_tap as V  # noqa: E402
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "tap_record.csv"
+LAB_HZ, LAB_ZETA = (1071.0, 1981.0, 2607.0), (0.037, 0.041, 0.021)
+
+
+def tap_of(rec, **kw):
+    return impact_frf(Record(rec.time_s, rec.force_n, rec.acceleration_ms2, source="virtual"), **kw)
+
+
+def at(f, hz):
+    return [int(np.argmin(abs(f - x))) for x in hz]
+
+
+def test_virtual_record_clean_gives_the_exact_receptance():
+    # no artefacts: what is left is the estimator and the sampling. Independent: the record is made from the
+    # hammer's and structure's continuous spectra, the FRF by DFTs of hit blocks of the time record
+    rec = V.lab_like_tap(seed=1, hits=3, spacing_s=0.07, chain=V.Chain().clean())
+    res = tap_of(rec)
+    f = res.frf.freq_hz
+    err = np.abs(res.frf.values / rec.receptance(f) - 1)
+    assert err[f >= 100].max() < 1e-3  # measured 3.4e-4 (the force window cuts the anti-aliasing filter's ringing)
+    assert err[at(f, LAB_HZ)].max() < 5e-4  # measured 1.8e-4
+    assert err[f >= 20].max() < 5e-3
+
+
+@pytest.mark.parametrize("tip", ["steel", "plastic", "rubber"])
+@pytest.mark.parametrize("drop_db", [10.0, 15.0, 20.0])
+def test_band_ends_where_the_half_sine_force_spectrum_has_dropped(tip, drop_db):
+    # closed form of a half-sine of contact time T: |F(f)/F(0)| = |cos(π f T)| / |1 − (2 f T)²|
+    tc = V.TIPS[tip]
+    x = brentq(lambda x: abs(np.cos(np.pi * x / 2) / (1 - x * x)) - 10 ** (-drop_db / 20), 1.01, 2.99)
+    f_drop = x / (2 * tc)
+    rec = V.lab_like_tap(seed=0, hits=2, spacing_s=0.1, tip=tip)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # rubber: leakage of nothing; the band is what is checked
+        res = tap_of(rec, force_drop_db=drop_db)
+    df = res.frf.freq_hz[1] - res.frf.freq_hz[0]
+    # the level is the median over 0–0.1/T_pulse, a hair below F(0): the band may end one line later
+    assert abs(res.band_hz[1] - f_drop) <= 2 * df + 0.01 * f_drop
+    assert f"{drop_db:g} dB below" in res.notes[0] and "band ends at" in res.notes[0]
+    assert f_drop < 1.5 / tc  # before the first zero of the spectrum
+
+
+def test_realistic_chain_within_the_band():
+    rec = V.lab_like_tap(seed=3, hits=3, spacing_s=0.07)  # every artefact of Chain(), close x/y modes
+    res = tap_of(rec)
+    f = res.frf.freq_hz
+    assert res.band_hz[1] == pytest.approx(1.19 / V.TIPS["steel"], rel=0.01)  # 15 dB of the steel tip's spectrum
+    df = f[1] - f[0]
+    hum = np.any([abs(f - h * 50.0) <= 2 * df for h in (1, 3, 5)], axis=0)
+    exact = rec.receptance(f)
+    err = np.abs(res.frf.values / exact - 1)
+    assert err[(f >= 500) & ~hum].max() < 0.01  # measured 1.7e-3–3.3e-3 over seeds 0–5
+    assert err[(f >= 200) & ~hum].max() < 0.05  # 1.2e-2–2.8e-2 (noise × 1/ω² grows towards 0 Hz)
+    k = at(f, LAB_HZ)
+    assert err[k].max() < 2e-3 and res.coherence[k].min() > 0.999
+    # at the modes what is left is the accelerometer's high-pass, |1 − iω/(iω + ω_c)| ≈ f_c/f
+    chain = np.abs(res.frf.values / V.chain_receptance(rec.modes, f, rec.chain) - 1)
+    assert chain[k].max() < 5e-4  # measured 1.8e-4–2.1e-4 (noise)
+
+
+def test_detrend_removes_the_drift_artefact():
+    # offset and linear drift only (the other artefacts off), one hit in 0.5 s as the lab's record
+    chain = replace(V.Chain().clean(), offset_ms2=0.2, drift_ms2_per_s=0.1)
+    rec = V.lab_like_tap(seed=0, hits=1, spacing_s=0.5, chain=chain)
+    with pytest.warns(UserWarning, match="one hit"):
+        raw = tap_of(rec, detrend="none")
+    with pytest.warns(UserWarning, match="one hit"):
+        fixed = tap_of(rec)
+    f = raw.frf.freq_hz
+    exact = rec.receptance(f)
+    e_raw, e_fix = (np.abs(r.frf.values / exact - 1) for r in (raw, fixed))
+    low = (f >= 5) & (f <= 40)
+    slope = np.polyfit(np.log(f[low]), np.log(np.abs(raw.frf.values - exact)[low]), 1)[0]
+    assert -3.2 < slope < -2.8  # drift b·t: b T/(iω) in acceleration, ÷ ω² F: f⁻³ in the receptance
+    assert e_raw[at(f, [10.0])][0] > 50 and e_fix[low].max() < 0.05  # measured 97 → 0.016 at 10 Hz
+    assert any("drift of the acceleration removed" in n for n in fixed.notes)
+    assert not any("drift" in n for n in raw.notes)
+
+
+def test_single_hit_has_no_coherence(tmp_path, capsys):
+    rec = V.lab_like_tap(seed=0, hits=1, spacing_s=0.3)
+    with pytest.warns(UserWarning, match=r"virtual: one hit: its coherence is 1 by construction"):
+        res = tap_of(rec)
+    assert res.single_hit and "coherence" not in res.frf.meta
+    p = tmp_path / "one.csv"
+    V.write_record(p, rec)
+    out = tmp_path / "h.csv"
+    assert main(["tap", str(p), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "one hit: its coherence is 1 by construction" in err and "one hit: no coherence" in err
+    assert out.read_text().splitlines()[0] == "freq_hz,real,imag"
+
+
+def test_example_record_is_the_virtual_test():
+    # the shipped example is what examples/make_tap_record.py writes (to the 6 digits of the file)
+    rec = V.lab_like_tap(seed=2026, hits=3, spacing_s=0.07)
+    got = read_record(EXAMPLE)
+    np.testing.assert_allclose(got.time_s, rec.time_s, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(got.force_n, rec.force_n, rtol=1e-5, atol=1e-3)
+    np.testing.assert_allclose(got.response, rec.acceleration_ms2, rtol=1e-5, atol=1e-3)
+    assert EXAMPLE.stat().st_size < 400_000
+    assert EXAMPLE.read_text().startswith("# SYNTHETIC impact record")
+
+
+def test_tap_output_gives_sane_lobes_and_modes(tmp_path, capsys):
+    # tap → lobes and tap → modal with defaults on the example record, against the same commands on the exact
+    # receptance of the virtual structure (issue 20: chatter above 500 Hz, the three modes within 2 %)
+    from toolpoint.frf import FRF
+    from toolpoint.io.frf_files import write_frf
+
+    h = tmp_path / "tap.csv"
+    assert main(["tap", str(EXAMPLE), "--out", str(h)]) == 0
+    capsys.readouterr()
+    f = read_frf(h).freq_hz
+    ref = tmp_path / "exact.csv"
+    write_frf(ref, FRF(f, V.receptance(V.close_xy_modes(V.LAB_MODES), f)))
+    lobes = ["--teeth", "4", "--tangential-coeff", "7.96e8", "--radial-ratio", "0.212", "--immersion", "0.5",
+             "--rpm", "2000:20000", "--rpm-points", "400"]
+    got = {}
+    for name, src in (("tap", h), ("exact", ref)):
+        out = tmp_path / f"lobes_{name}.csv"
+        assert main(["lobes", str(src), *lobes, "--out", str(out)]) == 0
+        got[name] = np.genfromtxt(out, delimiter=",", names=True)
+    capsys.readouterr()
+    k = int(np.argmin(got["tap"]["depth_mm"]))
+    assert got["tap"]["chatter_hz"][k] > 500
+    assert got["tap"]["depth_mm"].min() == pytest.approx(got["exact"]["depth_mm"].min(), rel=0.02)
+    np.testing.assert_allclose(got["tap"]["depth_mm"], got["exact"]["depth_mm"], rtol=0.05)
+    modes = tmp_path / "modes.csv"
+    assert main(["modal", str(h), "--out", str(modes)]) == 0
+    m = np.genfromtxt(modes, delimiter=",", names=True)
+    for fn, z in zip(LAB_HZ, LAB_ZETA):
+        j = int(np.argmin(abs(m["freq_hz"] - fn)))
+        assert m["freq_hz"][j] == pytest.approx(fn, rel=0.02)
+        assert 0.015 < m["damping_ratio"][j] < 0.07 and m["damping_ratio"][j] == pytest.approx(z, rel=0.1)
+
+
+# ---------------------------------------------------------------- bad input (issue 22)
+def small_record(path, t, f, a):
+    np.savetxt(path, np.column_stack([t, f, a]), delimiter=",", fmt="%.17g")
+    return path
+
+
+def one_pulse(n=2000, fs=1e4, at=100):
+    t = np.arange(n) / fs
+    f = np.zeros(n)
+    f[at:at + 5] = [1, 3, 5, 3, 1]
+    a = np.random.default_rng(0).standard_normal(n)
+    return t, f, a
+
+
+def cli_error(capsys, argv):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    lines = err.splitlines()
+    assert "Traceback" not in err and [x for x in lines if "error" in x] == lines[-1:]  # warnings may precede
+    return lines[-1]
+
+
+def test_subnormal_time_step_refused(tmp_path, capsys):
+    t, f, a = one_pulse()
+    with pytest.raises(InputError, match=r"r\.csv: time_s: time step 4\.94e-324 s is outside"):
+        Record(t * 0 + np.arange(t.size) * 5e-324, f, a, source="r.csv")
+    p = small_record(tmp_path / "tiny.csv", np.arange(t.size) * 5e-324, f, a)
+    assert "tiny.csv: time_s: time step" in cli_error(capsys, ["tap", str(p), "--out", str(tmp_path / "o.csv")])
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["tiny.csv"]
+
+
+def test_huge_pretrigger_refused(tmp_path, capsys):
+    p = small_record(tmp_path / "r.csv", *one_pulse())
+    err = cli_error(capsys, ["tap", str(p), "--out", str(tmp_path / "o.csv"), "--pretrigger", "1e9"])
+    assert "--pretrigger: must be shorter than --min-gap" in err
+    with pytest.raises(InputError, match=r"r\.csv: pretrigger_s: pretrigger 1e\+09 s must be"):
+        find_hits(read_record(p), pretrigger_s=1e9)
+    with pytest.raises(InputError, match=r"min_gap_s: min_gap_s must be a finite time"):
+        find_hits(read_record(p), min_gap_s=float("inf"))
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["r.csv"]
+
+
+def test_hit_at_the_last_sample_refused(tmp_path, capsys):
+    t, f, a = one_pulse()
+    f = np.zeros_like(f)
+    f[-1] = 5.0
+    p = small_record(tmp_path / "last.csv", t, f, a)
+    err = cli_error(capsys, ["tap", str(p), "--out", str(tmp_path / "o.csv")])
+    assert "last.csv: hits: hit 1 at 0.1999 s: cut off by the end of the record" in err
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["last.csv"]
+
+
+def test_hit_cut_off_at_the_end_is_dropped_from_the_others(synth):
+    t, f, a = synth
+    n = int(2.47 * FS)  # the record ends 20 ms into hit 5 (at 2.45 s)
+    with pytest.warns(UserWarning) as got:
+        res = impact_frf(Record(t[:n], f[:n], a[:n], source="r"), drop_bad=True)
+    assert res.used == [1, 2, 3] and res.hits[4].cut_s == pytest.approx(0.02, abs=2 / FS)
+    assert any("hit 5" in str(w.message) and "cut off" in str(w.message) for w in got)
+    # blocks keep their full length (0.6 s, not the 20 ms left of hit 5)
+    assert res.frf.freq_hz[1] - res.frf.freq_hz[0] == pytest.approx(1 / 0.6, rel=0.01)
+
+
+def test_zero_response_names_the_file_and_column(tmp_path, capsys):
+    t, f, a = one_pulse()
+    p = small_record(tmp_path / "z.csv", t, f, 0 * a)
+    err = cli_error(capsys, ["tap", str(p), "--out", str(tmp_path / "o.csv")])
+    assert "z.csv: response: the response is 0 at every sample" in err and "force" not in err
+
+
+@pytest.mark.parametrize("where", ["inside", "before", "after", "last cell"])
+def test_nul_bytes_in_numbers_refused(tmp_path, capsys, where):
+    p = small_record(tmp_path / "r.csv", *one_pulse())
+    lines = p.read_text().splitlines()
+    s = lines[50]
+    lines[50] = {"inside": s[:3] + "\x00" + s[3:], "before": "\x00" + s, "after": s + "\x00",
+                 "last cell": s[:-2] + "\x00" + s[-2:]}[where]
+    p.write_text("\n".join(lines) + "\n")
+    err = cli_error(capsys, ["tap", str(p), "--out", str(tmp_path / "o.csv")])
+    assert "r.csv: " in err and "line 51: " in err and "is not a number" in err
+    with pytest.raises(InputError, match="line 51"):
+        read_record(p)
+
+
+def test_full_disk_for_the_figure_writes_nothing(synth_file, tmp_path, capsys, monkeypatch):
+    import errno
+
+    import toolpoint.cli.tap as tap_cli
+
+    def full(fig, path):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(tap_cli, "save_figure", full)
+    out, png = tmp_path / "frf.csv", tmp_path / "frf.png"
+    err = cli_error(capsys, ["tap", str(synth_file), "--out", str(out), "--plot", str(png), "--drop-bad"])
+    assert "frf.png: --plot: cannot write (No space left on device); nothing written" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_full_disk_for_the_frf_removes_the_figure(synth_file, tmp_path, capsys, monkeypatch):
+    import errno
+
+    import toolpoint.io.frf_files as frf_files
+
+    def full(*args, **kw):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(frf_files, "write_frf", full)
+    out, png = tmp_path / "frf.csv", tmp_path / "frf.png"
+    err = cli_error(capsys, ["tap", str(synth_file), "--out", str(out), "--plot", str(png), "--drop-bad"])
+    assert "frf.csv: --out: cannot write (No space left on device)" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_phase_panel_greys_out_low_coherence_and_stays_in_the_band():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from toolpoint.io.impact import plot_tap
+    from toolpoint.trust import COHERENCE_MIN
+
+    rec = V.lab_like_tap(seed=0, hits=3, spacing_s=0.07)
+    res = tap_of(rec)
+    low = res.coherence < COHERENCE_MIN
+    assert low.any() and not low.all()  # the hum lines and the noise near 0 Hz
+    fig = plot_tap(res)
+    for ax in fig.axes[1:3]:
+        grey, blue = ax.get_lines()[:2]
+        for line in (grey, blue):
+            x = np.asarray(line.get_xdata())
+            assert x.min() >= res.band_hz[0] and x.max() <= res.band_hz[1]  # nothing outside the band
+        g, b = np.asarray(grey.get_ydata(), float), np.asarray(blue.get_ydata(), float)
+        np.testing.assert_array_equal(np.isfinite(g), low)
+        np.testing.assert_array_equal(np.isfinite(b), ~low)
+        assert ax.get_xlim() == pytest.approx(res.band_hz)
+    plt.close(fig)

@@ -28,10 +28,42 @@ Windows (all start at the block start, ``pretrigger_s`` before the trigger):
   (:meth:`TapResult.added_damping`) and :func:`corrected_damping` removes it
   from modal parameters fitted downstream.
 
+Offsets and drift (``detrend="auto"``, the default) are removed per block
+before any window. The force: its baseline (median of the block outside the
+force window) is subtracted. The acceleration: the least-squares straight line
+over the block is subtracted. This removes a DC offset and a linear drift of
+the channel and nothing of a grounded structure's response, whose acceleration
+has zero 0th and 1st moments once it is at rest again before the block ends:
+∫ẍ dt = ẋ(T) − ẋ(0) = 0 and ∫t ẍ dt = T ẋ(T) − (x(T) − x(0)) = 0. Divided by
+−ω² a drift b·t becomes an artefact b T/(iω · ω² F(ω)) ∝ f⁻³ in the receptance,
+which is what a real record shows below ≈ 60 Hz (issue 20). A velocity
+response loses only its mean (∫ẋ dt = 0; its 1st moment is −∫x dt ≠ 0), a
+displacement only its pre-trigger mean (its mean is the static response).
+What is left below a few tens of Hz (the conditioner's high-pass settling,
+sensor noise × 1/ω²) is cut downstream by :func:`toolpoint.trust.trusted_band`.
+
+Band. The FRF is kept only where the hammer excited the structure: up to the
+first line where the force auto-spectrum S_ff has dropped by ``force_drop_db``
+(default :data:`FORCE_DROP_DB` = 15 dB, the middle of the 10–20 dB of test
+practice) below its low-frequency level (median of S_ff from 0 Hz to
+0.1/T_pulse, T_pulse the force pulse width). A half-sine pulse of contact time
+T_c drops by 15 dB at ≈ 1.17/T_c (steel tip, 0.15 ms: 7.8 kHz; plastic, 0.4 ms:
+2.9 kHz; rubber, 1.5 ms: 0.78 kHz); its first zero is at 1.5/T_c. Above the
+band the FRF is noise over a vanishing force and is not written; the note
+(:attr:`TapResult.notes`) says where and why the band ends.
+
+One hit: the coherence of a single average is 1 at every frequency by
+construction (|S_xf|² = S_ff S_xx for one block), so it says nothing about the
+quality of the FRF. It is then not reported (no ``meta["coherence"]``, no
+coherence column in the file) and a warning names the record as a single hit.
+
 Quality checks per hit: a *double hit* (the force rises above the threshold
 again within ``min_gap_s`` of the trigger) warns; an *overload* (three or more
 samples of a channel at its maximum magnitude: clipping) is an error. With
-``drop_bad=True`` both are dropped from the average with a warning.
+``drop_bad=True`` both are dropped from the average with a warning. A hit *cut
+off* by the end of the record (less than ``min_gap_s`` of record after its
+trigger, or its pulse still above the threshold at the last sample) is always
+dropped with a warning; a record whose only hits are cut off is refused.
 
 Bad input raises :class:`~toolpoint.errors.InputError` naming the file and field.
 """
@@ -58,6 +90,11 @@ G0 = 9.80665  # standard gravity, m/s² per g
 CLIP_SAMPLES = 3  # samples at a channel's maximum magnitude that mean clipping (pyFRF's rule)
 PRETRIGGER_SAMPLES = 20  # default pretrigger
 LEAK_TAIL, LEAK_LEVEL = 0.05, 0.02  # warn if the last 5 % of a block still reaches 2 % of its peak
+FORCE_DROP_DB = 15.0
+"""Default drop of the force auto-spectrum below its low-frequency level that ends the band, dB (10–20 dB practice)."""
+DT_RANGE_S = (1e-9, 1.0)
+"""Sampling steps accepted, s (1 GHz … 1 Hz): outside, the time column is not in seconds or not a tap record."""
+DETRENDS = ("auto", "none")
 
 
 @dataclass(frozen=True)
@@ -112,6 +149,9 @@ class Record:
             raise InputError(f"time must increase: sample {k + 2} ({t[k + 1]:.10g} s) follows {t[k]:.10g} s",
                              file=src, field="time_s")
         dt = (t[-1] - t[0]) / (t.size - 1)
+        if not DT_RANGE_S[0] <= dt <= DT_RANGE_S[1]:
+            raise InputError(f"time step {dt:.3g} s is outside {DT_RANGE_S[0]:g}–{DT_RANGE_S[1]:g} s (sampling "
+                             "1 GHz … 1 Hz): is the time column in seconds?", file=src, field="time_s")
         dev = np.abs(t - (t[0] + dt * np.arange(t.size)))
         if dev.max() > 0.5 * dt:
             k = int(np.argmax(dev))
@@ -155,6 +195,8 @@ class Hit:
         Time of a second force pulse within ``min_gap_s`` (a double hit), s.
     clipped : str
         ``""`` or the clipped channel(s), e.g. ``"force"``.
+    cut_s : float or None
+        Record left after the trigger, s, when the record's end cuts the hit off (None: not cut).
     """
 
     number: int
@@ -167,11 +209,12 @@ class Hit:
     width: int
     double_at_s: float | None = None
     clipped: str = ""
+    cut_s: float | None = None
 
     @property
     def bad(self) -> bool:
-        """True for a double hit or an overload."""
-        return self.double_at_s is not None or bool(self.clipped)
+        """True for a double hit, an overload or a hit cut off by the record's end."""
+        return self.double_at_s is not None or bool(self.clipped) or self.cut_s is not None
 
     def describe(self, source: str = "") -> str:
         """One line: which hit, where, and what is wrong with it."""
@@ -180,6 +223,8 @@ class Hit:
             what.append(f"double hit (second pulse at {self.double_at_s:.6g} s)")
         if self.clipped:
             what.append(f"overload: {self.clipped} clipped")
+        if self.cut_s is not None:
+            what.append(f"cut off by the end of the record ({self.cut_s:.3g} s after its trigger)")
         at = f"{source}: " if source else ""
         return f"{at}hit {self.number} at {self.trigger_s:.6g} s: {'; '.join(what) or 'ok'}"
 
@@ -193,7 +238,8 @@ class TapResult:
     frf : FRF
         The averaged estimate (receptance by default); ``meta["coherence"]`` holds γ² on its grid.
     coherence : numpy.ndarray
-        (F,) ordinary coherence γ² on ``frf.freq_hz``.
+        (F,) ordinary coherence γ² on ``frf.freq_hz`` (all 1 for a single hit: not a quality measure, and then
+        not in ``frf.meta``).
     hits : list of Hit
         Every hit found.
     used : list of int
@@ -202,6 +248,10 @@ class TapResult:
         Time constant of the exponential window, s (None: no window).
     records : list of Record
         The input records (for plotting).
+    band_hz : tuple of float or None
+        (first, last) frequency kept, Hz.
+    notes : tuple of str
+        One-line notes: where the band ends and why, what the detrend did.
     """
 
     frf: FRF
@@ -210,6 +260,13 @@ class TapResult:
     used: list
     tau_s: float | None
     records: list = field(default_factory=list)
+    band_hz: tuple | None = None
+    notes: tuple = ()
+
+    @property
+    def single_hit(self) -> bool:
+        """One hit averaged: the coherence is 1 by construction and says nothing."""
+        return len(self.used) == 1
 
     def added_damping(self, freq_hz) -> np.ndarray:
         """Damping ratio added by the exponential window to a mode at ``freq_hz`` (Hz): 1/(2π f τ); 0 without one."""
@@ -416,6 +473,12 @@ def find_hits(record: Record, *, threshold: float = 0.1, min_gap_s: float = 0.05
     src = record.source or None
     if not 0 < threshold < 1:
         raise InputError(f"threshold must be in (0, 1), got {threshold}", file=src, field="threshold")
+    duration = record.dt * (record.time_s.size - 1)
+    if not 0 < min_gap_s < np.inf:
+        raise InputError(f"min_gap_s must be a finite time > 0 s, got {min_gap_s}", file=src, field="min_gap_s")
+    if pretrigger_s is not None and not 0 <= pretrigger_s < min(min_gap_s, duration):
+        raise InputError(f"pretrigger {pretrigger_s:g} s must be ≥ 0 and shorter than min_gap_s ({min_gap_s:g} s) "
+                         f"and the record ({duration:.6g} s)", file=src, field="pretrigger_s")
     f, x, n = record.force_n, record.response, record.force_n.size
     sign = 1.0 if f.max() >= -f.min() else -1.0
     fs_ = sign * f
@@ -424,7 +487,10 @@ def find_hits(record: Record, *, threshold: float = 0.1, min_gap_s: float = 0.05
     if peak <= 0 or peak < 10 * noise:
         raise InputError(f"no hit: peak force {peak:.3g} N is not above the noise ({noise:.3g} N rms)",
                          file=src, field="force_n")
-    gap = max(1, int(round(min_gap_s / record.dt)))
+    if np.ptp(x) == 0:
+        raise InputError(f"the response is {x[0]:g} at every sample: no signal (sensor, cable or column?)",
+                         file=src, field="response")
+    gap = max(1, int(round(min(min_gap_s, 2 * duration) / record.dt)))
     pre = PRETRIGGER_SAMPLES if pretrigger_s is None else int(round(pretrigger_s / record.dt))
     edges = _pulses(fs_, threshold * peak)
     triggers = []
@@ -445,8 +511,11 @@ def find_hits(record: Record, *, threshold: float = 0.1, min_gap_s: float = 0.05
         double = float(record.time_s[t + own[1]]) if own.size > 1 else None
         clipped = [name for name, y in (("force", f[s:stop]), ("response", x[s:stop]))
                    if np.count_nonzero(np.abs(y) >= np.abs(y).max()) >= CLIP_SAMPLES and np.abs(y).max() > 0]
+        # cut off: the record ends within min_gap of the trigger, or while the pulse is still above the threshold
+        left = (n - 1 - t) * record.dt
+        cut = left if stop == n and (n - t < gap or t + int(above[-1]) == n - 1) else None
         hits.append(Hit(first_number + k, record_index, s, stop, float(record.time_s[t]), float(sign * pk),
-                        t + int(above[-1]), width, double, " and ".join(clipped)))
+                        t + int(above[-1]), width, double, " and ".join(clipped), cut))
     return hits
 
 
@@ -454,8 +523,8 @@ def find_hits(record: Record, *, threshold: float = 0.1, min_gap_s: float = 0.05
 def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", threshold: float = 0.1,
                min_gap_s: float = 0.05, pretrigger_s: float | None = None, force_window_s: float | None = None,
                exp_window_s: float | str | None = None, drop_bad: bool = False, fmax_hz: float | None = None,
-               label: str = "tap") -> TapResult:
-    """Average the hits of impact records into an FRF with coherence.
+               force_drop_db: float | None = FORCE_DROP_DB, detrend: str = "auto", label: str = "tap") -> TapResult:
+    """Average the hits of impact records into an FRF with coherence, over the band the hammer excited.
 
     Parameters
     ----------
@@ -478,7 +547,13 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
         Drop double hits and overloads (with a warning) instead of averaging a
         double hit (warning) or refusing an overload (error).
     fmax_hz : float, optional
-        Highest frequency kept, Hz (default: Nyquist).
+        Highest frequency kept, Hz (default: the end of the force band, at most Nyquist).
+    force_drop_db : float or None
+        The band ends where the force auto-spectrum has dropped this much below its
+        low-frequency level, dB (default :data:`FORCE_DROP_DB`; None: no force band).
+    detrend : str
+        ``"auto"`` (default: force baseline; acceleration line, velocity mean,
+        displacement pre-trigger mean removed per block — see the module notes) or ``"none"``.
     label : str
         Label of the FRF.
 
@@ -504,8 +579,8 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
     >>> f = np.zeros(t.size); f[[100, 2100]] = [fs * 1.0, fs * 0.5]  # 1 N s and 0.5 N s impulses
     >>> x = np.convolve(f, h)[: t.size] / fs
     >>> res = impact_frf(Record(t, f, x, "displacement"), min_gap_s=0.1)
-    >>> len(res.used), float(res.coherence.min()) > 0.999
-    (2, True)
+    >>> len(res.used), float(res.coherence.min()) > 0.999, [round(f, 6) for f in res.band_hz]
+    (2, True, [0.0, 1000.0])
     """
     recs = [records] if isinstance(records, Record) else list(records)
     if not recs:
@@ -514,6 +589,10 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
         raise InputError(f"estimator must be H1 or H2, not {estimator!r}", field="estimator")
     if output not in ("receptance", "measured"):
         raise InputError(f"output must be 'receptance' or 'measured', not {output!r}", field="output")
+    if detrend not in DETRENDS:
+        raise InputError(f"detrend must be one of {', '.join(DETRENDS)}, not {detrend!r}", field="detrend")
+    if force_drop_db is not None and not 0 < force_drop_db < np.inf:
+        raise InputError(f"force_drop_db must be a finite number > 0 dB, got {force_drop_db}", field="force_drop_db")
     dt, kind = recs[0].dt, recs[0].response_kind
     for r in recs[1:]:
         if abs(r.dt - dt) > 1e-6 * dt:
@@ -531,6 +610,12 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
     used = []
     for h in hits:
         src = recs[h.record].source
+        if h.cut_s is not None:  # always: its short block would shorten every other block to its length
+            if all(g.cut_s is not None for g in hits):
+                raise InputError(f"{h.describe()}: no complete hit to average (min_gap_s = {min_gap_s:g} s of "
+                                 "record is needed after a trigger)", file=src or None, field="hits")
+            warnings.warn(f"{h.describe(src)}: dropped", stacklevel=2)
+            continue
         if h.bad and drop_bad:
             warnings.warn(f"{h.describe(src)}: dropped", stacklevel=2)
             continue
@@ -556,11 +641,19 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
     we = np.ones(n) if tau is None else np.exp(-t / tau)
     fblk = np.stack([recs[h.record].force_n[h.start:h.start + n] for h in used])
     xblk = np.stack([recs[h.record].response[h.start:h.start + n] for h in used])
+    for h, x in zip(used, xblk):
+        if np.ptp(x) == 0:
+            raise InputError(f"hit {h.number}: the response is {x[0]:g} throughout its block: no signal",
+                             file=recs[h.record].source or None, field="response")
     if force_window_s is None:
         ends = np.array([h.pulse_end - h.start + h.width for h in used])
     else:
-        ends = np.full(len(used), int(round(force_window_s / dt)))
-    wf = (np.arange(n)[None, :] <= ends[:, None]).astype(float)
+        ends = np.full(len(used), int(round(min(force_window_s / dt, n))))
+    inside = np.arange(n)[None, :] <= ends[:, None]
+    wf = inside.astype(float)
+    pre = np.array([int(round((h.trigger_s - recs[h.record].time_s[h.start]) / dt)) for h in used])
+    if detrend == "auto":
+        fblk, xblk = _detrend(fblk, xblk, inside, pre, kind)
     for h, x in zip(used, xblk):
         tail = np.abs(x[int((1 - LEAK_TAIL) * n):]).max()
         if tail > LEAK_LEVEL * np.abs(x).max() and tau is None:
@@ -573,7 +666,19 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
     sff = np.sum(np.abs(F) ** 2, axis=0)
     sxx = np.sum(np.abs(X) ** 2, axis=0)
     sxf = np.sum(X * np.conj(F), axis=0)
+    notes = []
     keep = np.ones(freq.size, bool) if fmax_hz is None else freq <= fmax_hz
+    if force_drop_db is not None:
+        pulse_s = float(np.median([h.width for h in used])) * dt
+        f_end, level_note = _force_band(freq, sff, pulse_s, force_drop_db)
+        if f_end is not None:
+            if not np.any(keep & (freq < f_end)):
+                raise InputError(f"{level_note}; no frequency line is left below it (fmax {fmax_hz} Hz)",
+                                 file=recs[0].source or None, field="force_n")
+            if fmax_hz is None or f_end <= fmax_hz:
+                notes.append(f"band ends at {freq[freq < f_end][-1]:.6g} Hz: {level_note}; nothing written above "
+                             "(force_drop_db / --force-drop)")
+            keep &= freq < f_end
     quantity = RESPONSES[kind]
     if output == "receptance" and quantity != "receptance":
         keep &= freq > 0
@@ -582,16 +687,26 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
     freq, sff, sxx, sxf = freq[keep], sff[keep], sxx[keep], sxf[keep]
     zero = np.flatnonzero((sff == 0) | (np.abs(sxf) == 0))
     if zero.size:
-        raise InputError(f"force or cross spectrum is zero at {freq[zero[0]]:.6g} Hz: lower fmax",
-                         field="force_n")
+        what = "force spectrum" if sff[zero[0]] == 0 else "cross spectrum (response × force)"
+        raise InputError(f"the {what} is zero at {freq[zero[0]]:.6g} Hz: lower fmax", file=recs[0].source or None,
+                         field="force_n" if sff[zero[0]] == 0 else "response")
     with np.errstate(all="ignore"):
         h = sxf / sff if estimator == "H1" else sxx / np.conj(sxf)
         coh = np.clip(np.abs(sxf) ** 2 / (sff * sxx), 0.0, 1.0)
-    if len(used) == 1:
-        warnings.warn("one hit: the coherence is 1 by construction (average several hits to measure it)",
-                      stacklevel=2)
-    meta = {"coherence": coh, "estimator": estimator, "hits": [h.number for h in used], "tau_s": tau,
+    if detrend == "auto":
+        notes.append({"acceleration": "offset and linear drift of the acceleration removed per block "
+                                      "(least-squares line) before the FFT",
+                      "velocity": "velocity offset (block mean) removed before the FFT",
+                      "displacement": "displacement offset (pre-trigger mean) removed before the FFT"}[kind])
+    meta = {"estimator": estimator, "hits": [h.number for h in used], "tau_s": tau,
             "source": ", ".join(r.source for r in recs), "format": "tap", "file_quantity": quantity}
+    if len(used) == 1:
+        src = recs[used[0].record].source
+        warnings.warn(f"{src + ': ' if src else ''}one hit: its coherence is 1 by construction (one average) and "
+                      "says nothing about the FRF's quality, so none is reported; average 3–5 hits to measure it",
+                      stacklevel=2)
+    else:
+        meta["coherence"] = coh
     frf = FRF(freq, h, quantity, label, meta)
     if output == "receptance" and tau is not None and quantity != "receptance":
         # The windowed record is that of the system h(t) e^{-t/τ}: its accelerance (mobility) is
@@ -601,17 +716,51 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
         frf = FRF(freq, h / (2j * np.pi * freq + 1.0 / tau) ** power, "receptance", label, meta)
     elif output == "receptance":
         frf = frf.to_receptance()
-    return TapResult(frf, coh, hits, [h.number for h in used], tau, recs)
+    return TapResult(frf, coh, hits, [h.number for h in used], tau, recs, (float(freq[0]), float(freq[-1])),
+                     tuple(notes))
+
+
+def _detrend(fblk, xblk, inside, pre, kind):
+    """Blocks with the force baseline and the response's offset/drift removed (see the module notes)."""
+    fblk = fblk - np.array([np.median(f[~m]) if (~m).any() else 0.0 for f, m in zip(fblk, inside)])[:, None]
+    n = xblk.shape[1]
+    if kind == "acceleration":  # least-squares line per block, vectorised over hits
+        u = np.arange(n) - (n - 1) / 2.0
+        slope = (xblk @ u) / (u @ u)
+        return fblk, xblk - xblk.mean(axis=1, keepdims=True) - slope[:, None] * u[None, :]
+    if kind == "velocity":
+        return fblk, xblk - xblk.mean(axis=1, keepdims=True)
+    base = np.array([x[:p].mean() if p > 0 else x[0] for x, p in zip(xblk, pre)])
+    return fblk, xblk - base[:, None]
+
+
+def _force_band(freq, sff, pulse_s, drop_db):
+    """(First frequency where S_ff is ``drop_db`` below its low-frequency level or None, a note on it)."""
+    f_ref = max(0.1 / pulse_s, freq[1] if freq.size > 1 else 0.0)
+    level = float(np.median(sff[freq <= f_ref]))
+    low = np.flatnonzero((freq > f_ref) & (sff < level * 10 ** (-drop_db / 10)))
+    if not low.size:
+        return None, ""
+    f_end = float(freq[low[0]])
+    return f_end, (f"the hammer's force spectrum is {drop_db:g} dB below its level at 0–{f_ref:.3g} Hz from "
+                   f"{f_end:.6g} Hz (pulse {pulse_s * 1e3:.3g} ms)")
 
 
 def plot_tap(result: TapResult):
     """Figure of an impact test: records with hits marked, |FRF|, phase and coherence.
+
+    Only the band the FRF was computed over is drawn. Where the coherence of
+    several hits is below :data:`toolpoint.trust.COHERENCE_MIN` the magnitude and
+    phase are drawn in light grey (not trusted); a single hit has no coherence
+    to show, and its panel says so.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
     import matplotlib.pyplot as plt
+
+    from ..trust import COHERENCE_MIN
 
     fig, ax = plt.subplots(4, 1, figsize=(8, 10), constrained_layout=True)
     used = set(result.used)
@@ -625,10 +774,31 @@ def plot_tap(result: TapResult):
         ax[0].annotate(str(h.number) + ("" if h.number in used else " ✗"), (h.trigger_s, h.peak_n), color=color)
     ax[0].set_xlabel("time [s]")
     ax[0].legend(loc="upper right", fontsize="small")
-    result.frf.plot(ax[1:3])
-    ax[3].plot(result.frf.freq_hz, result.coherence)
+    frf = result.frf
+    f, v = frf.freq_hz, frf.values
+    good = np.ones(f.size, bool) if result.single_hit else result.coherence >= COHERENCE_MIN
+    mag, ph = np.abs(v), np.degrees(np.angle(v))
+    for a, y in ((ax[1], mag), (ax[2], ph)):
+        a.plot(f, np.where(good, np.nan, y), color="0.8", lw=0.8,
+               label=f"γ² < {COHERENCE_MIN:g} (not trusted)" if not good.all() else None)
+        a.plot(f, np.where(good, y, np.nan), color="tab:blue", lw=1.0, label=frf.label or None)
+        a.grid(True, alpha=0.3)
+    ax[1].set_yscale("log")
+    ax[1].set_ylabel(f"|{frf.quantity}| [{frf.unit}]")
+    ax[1].legend(loc="upper right", fontsize="small")
+    ax[1].set_title(f"band {f[0]:.6g}–{f[-1]:.6g} Hz (force spectrum; nothing computed outside)", fontsize="small")
+    ax[2].set_ylabel("phase [deg]")
+    ax[2].set_ylim(-185, 185)
+    if result.single_hit:
+        ax[3].text(0.5, 0.5, "one hit: coherence is 1 by construction — not measured", ha="center", va="center",
+                   transform=ax[3].transAxes)
+    else:
+        ax[3].plot(f, result.coherence)
+        ax[3].axhline(COHERENCE_MIN, color="0.5", ls=":", lw=0.8)
     ax[3].set_ylim(0, 1.05)
     ax[3].set_ylabel("coherence γ²")
     ax[3].set_xlabel("frequency [Hz]")
     ax[3].grid(True, alpha=0.3)
+    for a in ax[1:]:
+        a.set_xlim(f[0], f[-1])
     return fig
