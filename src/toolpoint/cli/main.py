@@ -33,6 +33,7 @@ COMMANDS = {
     "tap": "impact-test records (time, force, response) → FRF with coherence",
     "library": "safe spindle speeds and depths for every tool of a tool library, with their uncertainty",
     "report": "one self-contained HTML page of a library run (sortable overview, per-tool figures)",
+    "cut": "chatter detection from a record of a cut (audio, accelerometer, UFF58): verdict, chatter frequency",
 }
 
 
