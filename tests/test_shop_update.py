@@ -179,3 +179,19 @@ def test_virtual_campaign_converges_with_few_chatters():
     assert r.chatter_cuts <= 2
     assert r.width[-1] <= 0.2 and r.coverage[-1] >= 0.9
     assert isinstance(ModalPrior, type)
+
+
+def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
+    import soundfile as sf
+
+    from shop_synth import shop_record
+
+    x, rate, *_ = shop_record(rpm=12000, teeth=4, chatter_hz=1310.0, chatter_amp=0.5, seed=8)
+    sf.write(tmp_path / "c1.wav", x, int(rate), subtype="PCM_16")
+    p = tmp_path / "cuts.csv"
+    p.write_text("rpm,depth_mm,result,record\n12000,0.8,,c1.wav\n9000,0.3,stable,\n")
+    cuts = read_test_cuts(p, teeth=4)
+    assert not cuts[0].stable and abs(cuts[0].chatter_hz / 1310 - 1) < 0.01 and cuts[1].stable
+    p.write_text("rpm,depth_mm,result,record\n12000,0.8,stable,c1.wav\n")
+    with pytest.raises(InputError, match="line 2: the table says stable, its record c1.wav says chatter"):
+        read_test_cuts(p, teeth=4)

@@ -23,14 +23,15 @@ The detector (:func:`analyse_cut`):
    speed's wander) of a multiple of f_s is masked
    (runout included: all multiples, not only those of f_t);
 4. **the chatter test** in the averaged (Welch) power spectrum P of a segment, with the floor F the
-   median of the unmasked bins in blocks of 32 bins (corrected for the median of χ²_ν/ν):
+   median of the unmasked bins in blocks of 32 bins (corrected for the median of χ²_ν/ν) plus what the
+   Hann window leaks from the two nearest spindle harmonics (×4; strong harmonics' sidelobes are not tones):
 
    * *significant*: max_f P/F > t_α, the level that the largest of the M unmasked bins of a spectrum
      without any tone exceeds with probability α = 10⁻³ (P/F ~ χ²_ν/ν with ν ≈ 1.9 n_frames degrees of
      freedom for a Hann window at 50 % overlap): a false alarm rate fixed by statistics, not tuned;
-   * *new*: when the record holds an air cut, the peak must stand ``rise_db`` (10 dB) above the air
-     cut's spectrum at that frequency (fans and pumps are there before the cut, chatter is not);
-   * *strong*: its power ≥ ``dominance`` (default 0.1, −10 dB) of the strongest spindle harmonic in the
+   * *new*: when the record holds an air cut, only lines standing ``rise_db`` (10 dB) above the air
+     cut's spectrum are candidates (fans and pumps are there before the cut, chatter is not);
+   * *strong*: its power ≥ ``dominance`` (default 0.05, −13 dB) of the strongest spindle harmonic in the
      band — chatter is the dominant vibration, not a trace (the calibration of this ratio on simulated
      records over a speed × depth grid is in ``docs/design/shop.md``).
 
@@ -305,7 +306,7 @@ def _once_per_rev(x, rate, f_s):
 
 def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_tolerance: float = 0.03,
                 band_hz: tuple | None = None, window_s: float = 1.0, activity_db: float = 4.0,
-                rise_db: float = 10.0, dominance: float = 0.1, alpha: float = _ALPHA,
+                rise_db: float = 10.0, dominance: float = 0.05, alpha: float = _ALPHA,
                 full_scale: float | None = None, source: str | None = None) -> CutAnalysis:
     """Judge a record of a milling cut: stable or chatter, per segment, with the chatter frequency.
 
@@ -329,7 +330,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         Least level difference between air cut and cutting for the record to be split, dB.
     rise_db : float, default 10.0
         Least rise of a chatter peak above the air cut's spectrum, dB.
-    dominance : float, default 0.1
+    dominance : float, default 0.05
         Least power of a chatter peak relative to the strongest spindle harmonic.
     alpha : float, default 1e-3
         False-alarm probability of the tone test per judged segment.
@@ -445,7 +446,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
 
     def judge(ta, tb):
         sel = frames_in(ta, tb)
-        seg = _judge(P[sel], nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df)
+        seg = _judge(P[sel], nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s)
         opr = _once_per_rev(x[int(ta * rate):int(tb * rate)], rate, f_s)
         return CutSegment("cut", ta, tb, **seg, once_per_rev=opr)
 
@@ -505,15 +506,40 @@ def _welch_dof(L, hop):
     return nu
 
 
-def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df) -> dict:
+def _leakage(p, freq, harm, f_s, df):
+    """Power the Hann window leaks from the two nearest spindle harmonics into each bin, ×4 (6 dB: a harmonic
+    between two bins shows less than its true peak): P_h (sinc δ / (1 − δ²))², δ the offset in bins."""
+    k = np.round(freq / f_s)
+    out = np.zeros_like(p)
+    hp = np.where(harm, p, 0.0)
+    kmax = int(freq[-1] / f_s) + 2
+    peak = np.zeros(kmax + 2)
+    np.maximum.at(peak, np.clip(k.astype(int), 0, kmax + 1), hp)  # each harmonic's highest bin
+    for side in (0, 1):  # the harmonic below and the one above each bin
+        kk = np.floor(freq / f_s) + side
+        d = (freq - kk * f_s) / df
+        with np.errstate(divide="ignore", invalid="ignore"):
+            w = np.where(np.abs(np.abs(d) - 1) < 1e-9, 0.5, np.sinc(d) / (1 - d * d))
+        out += peak[np.clip(kk.astype(int), 0, kmax + 1)] * w * w
+    return 4 * out
+
+
+def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s) -> dict:
     """The chatter test on the mean of the frames ``Pseg`` (see the module docstring)."""
     n = Pseg.shape[0]
     p = Pseg.mean(axis=0)
     nu = float(nu1(n))
-    floor = _block_floor(p[None, :], keep)[0] / _chi2_median_ratio(nu)
+    floor = _block_floor(p[None, :], keep)[0] / _chi2_median_ratio(nu) + _leakage(p, freq, harm, f_s, df)
     z = np.where(keep, p / floor, 0.0)
     t_a = _threshold(nu, int(keep.sum()), alpha)
-    i = int(np.argmax(z))
+    rise_bins = None
+    if ref is not None:  # lines already in the air cut (fans, pumps) are not candidates
+        k3 = np.ones(3)
+        rise_bins = 10 * np.log10(np.convolve(p, k3, "same") / np.maximum(np.convolve(ref, k3, "same"), 1e-300))
+        z_new = np.where(rise_bins >= rise_db, z, 0.0)
+        i = int(np.argmax(z_new)) if z_new.max() > 0 else int(np.argmax(z))
+    else:
+        i = int(np.argmax(z))
     sig = float(z[i] / t_a)
     delta = 0.0
     if 0 < i < p.size - 1 and p[i - 1] > 0 and p[i + 1] > 0:  # parabola through the log power
@@ -527,8 +553,8 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df) -> d
     h_pow = float(hp[max(0, j - 1):j + 2].sum()) if hp[j] > 0 else 0.0
     dom = pk_pow / h_pow if h_pow > 0 else np.inf
     rise, new = None, True
-    if ref is not None:
-        rise = float(10 * np.log10(pk_pow / max(float(ref[max(0, i - 1):i + 2].sum()), 1e-300)))
+    if rise_bins is not None:
+        rise = float(rise_bins[i])
         new = rise >= rise_db
     chatter = sig > 1 and new and dom >= dominance
     return dict(verdict="chatter" if chatter else "stable", chatter_hz=f_peak if chatter else None, peak_hz=f_peak,
