@@ -81,6 +81,67 @@ def bench_cut(quick):
           f"{cpu_total / dur_total:.3f} s CPU per s of audio")
 
 
+def _sim_truth_hz(sim, rpm, teeth):
+    """Dominant non-harmonic frequency of the simulated displacement (last half), Hz."""
+    t, x, y = sim[0], sim[1], sim[2]
+    h = x.size // 2
+    sig = (x + y)[h:] - np.mean((x + y)[h:])
+    dt = t[1] - t[0]
+    f = np.fft.rfftfreq(sig.size, dt)
+    p = np.abs(np.fft.rfft(sig * np.hanning(sig.size))) ** 2
+    fs = rpm / 60
+    kk = np.round(f / fs)
+    p[(np.abs(f - kk * fs) < 3 * (f[1] - f[0]) + 0.002 * f) | (f < 100)] = 0
+    return float(f[np.argmax(p)])
+
+
+def bench_cut_sim(quick):
+    """Verdicts on simulated records (tests/milling_sim.py) over a speed × depth grid; truth from the SDM."""
+    from milling_sim import microphone, simulate
+
+    from toolpoint.stability import ModalModel, sdm_lobes, sdm_spectral_radius
+
+    pr = cornelius_2024()
+    c = pr.cutting
+    fn, k, z = np.array(pr.freq_hz), np.array(pr.stiffness_n_m), np.array(pr.damping)
+    mm = ModalModel(fn, z, k / (2 * np.pi * fn) ** 2)
+    speeds = np.linspace(8000, 23000, 4 if quick else 6)
+    depths = np.linspace(0.2e-3, 1.4e-3, 4 if quick else 7)
+    lim = sdm_lobes(mm, mm, c, rpm=speeds).depth_m
+    rho = sdm_spectral_radius(mm, mm, c, rpm=speeds[None, :], depth=depths[:, None])
+    phi_st, phi_ex = c.immersion_angles
+    right = n = skipped = 0
+    ferr, cpu_sim, cpu_cut, audio_s = [], 0.0, 0.0, 0.0
+    rng = np.random.default_rng(1)
+    for gi, rpm in enumerate(speeds):
+        for di, a in enumerate(depths):
+            if abs(a / lim[gi] - 1) < 0.05:
+                skipped += 1
+                continue
+            t = time.process_time()
+            sim = simulate(fn, k, z, teeth=4, kt=c.tangential_coeff, kr=c.radial_ratio, phi_st=phi_st,
+                           phi_ex=phi_ex, rpm=[rpm], depth_m=[a], revolutions=60, seed=int(rng.integers(1 << 30)))[0]
+            cpu_sim += time.process_time() - t
+            x, rate, *_ = microphone(sim, rpm=rpm, teeth=4, seed=int(rng.integers(1 << 30)))
+            t = time.process_time()
+            r = analyse_cut(x, rate, rpm=rpm, teeth=4, full_scale=1.0)
+            cpu_cut += time.process_time() - t
+            audio_s += x.size / rate
+            truth = "chatter" if rho[di, gi] > 1 else "stable"
+            n += 1
+            right += r.verdict == truth
+            if truth == "chatter" and r.chatter_hz:
+                ft = _sim_truth_hz(sim, rpm, 4)
+                alias = ft + 4 * rpm / 60 * np.arange(-3, 4)
+                ferr.append(float(np.min(np.abs(r.chatter_hz - alias)) / ft))
+    ferr = np.array(ferr)
+    print(f"simulated records (tests/milling_sim.py, Cornelius case, {len(speeds)} speeds x {len(depths)} depths, "
+          f"{skipped} within ±5 % of the SDM limit left out): {right}/{n} verdicts right vs the SDM; chatter "
+          f"frequency (modulo tooth-passing aliases) vs the simulated displacement's: median {np.median(ferr):.2%}, "
+          f"{np.mean(ferr < 0.01):.0%} within 1 %; cut {cpu_cut / audio_s:.3f} s CPU per s of audio "
+          f"(simulation {cpu_sim:.0f} s CPU)")
+
+
 def noisy_shop(prior, rng_blur=0.03, f_noise=0.005):
     def shop(theta, rpm, depth, rng):
         a, fc = limit_at_speeds(prior, theta[None, :], [rpm])
@@ -139,6 +200,7 @@ def main():
     header()
     if a.only in (None, "cut"):
         bench_cut(a.quick)
+        bench_cut_sim(a.quick)
     if a.only in (None, "sampler"):
         bench_sampler()
     if a.only in (None, "update"):
