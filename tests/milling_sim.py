@@ -1,11 +1,13 @@
 """A small time-domain milling simulation for the tests and the benchmark of ``cut`` (not toolpoint's simulation).
 
 Symmetric tool, real modes (f_m, k_m, ζ_m) in x and y; teeth at φ_j = Ω t + 2πj/N measured clockwise from +y
-(toolpoint.stability.milling's conventions); chip h = max(0, f_z sin φ + sin φ (x(t−T) − x) + cos φ (y(t−T) − y))
-while φ_st ≤ φ ≤ φ_ex (zero when the tooth leaves the cut: the nonlinearity that bounds chatter); forces
+(toolpoint.stability.milling's conventions); chip h = f_z sin φ + s_prev − (x sin φ + y cos φ) while
+φ_st ≤ φ ≤ φ_ex, s_prev the surface the previous tooth left at this angle (projected on the tooth's normal);
+where h < 0 the tooth is out of the cut, h = 0 and the surface it leaves is the previous one plus the feed (the
+nonlinearity that bounds chatter; Tlusty's surface-history simulation, Schmitz & Smith 2019 ch. 4); forces
 F_x = a h (K_t cos φ + K_n sin φ), F_y = a h (−K_t sin φ + K_n cos φ). Each mode is stepped exactly for a force
-held over the step (zero-order hold), ``steps`` steps per tooth period (the delay is a whole number of steps);
-vectorised over a batch of (speed, depth) points of one speed? No — of any speeds: each point has its own step.
+held over the step (zero-order hold), ``steps`` steps per tooth period (the delay is a whole number of steps).
+Points are simulated one after another with a Python loop over time: a test helper, not a fast simulator.
 
 ``microphone`` turns a simulated cut into a shop record: the tool's velocity (x' + y') plus 0.3 × the force's
 derivative, resampled to 44.1 kHz, between air cuts, with the room noise, fan tones and spindle lines of
@@ -48,19 +50,24 @@ def simulate(fn, k, zeta, *, teeth, kt, kr, phi_st, phi_ex, rpm, depth_m, feed_m
         v = np.zeros((2, fn.size))
         q += 1e-9 * rng.standard_normal(q.shape)  # a seed of noise: chatter needs something to grow from
         hist = np.zeros((nsteps + 1, 2))
+        surf = np.zeros((nsteps, teeth))  # surface left by tooth j at step i, along its normal, m
         force = np.zeros((nsteps, 2))
         omega = 2 * np.pi * n / 60
         jphase = 2 * np.pi * np.arange(teeth) / teeth
+        nxt = (np.arange(teeth) + 1) % teeth  # the tooth that passed this angle one tooth period ago
         for i in range(nsteps):
             t = i * dt
             r = q.sum(axis=1)
             hist[i] = r
-            prev = hist[i - delay] if i >= delay else np.zeros(2)  # before the first tooth period: fresh surface
             phi = np.mod(omega * t + jphase, 2 * np.pi)
-            inside = (phi >= phi_st) & (phi <= phi_ex)
             s, c = np.sin(phi), np.cos(phi)
-            h = np.where(inside, feed_m * s + s * (prev[0] - r[0]) + c * (prev[1] - r[1]), 0.0)
-            h = np.maximum(h, 0.0)
+            prev = surf[i - delay, nxt] if i >= delay else np.zeros(teeth)  # fresh material before the first pass
+            inside = (phi >= phi_st) & (phi <= phi_ex)
+            nrm = s * r[0] + c * r[1]
+            h = feed_m * s + prev - nrm
+            cutting = inside & (h > 0)
+            surf[i] = np.where(cutting, nrm, prev + feed_m * s)
+            h = np.where(cutting, h, 0.0)
             fx = a * np.sum(h * (kt * c + kr * kt * s))
             fy = a * np.sum(h * (-kt * s + kr * kt * c))
             force[i] = fx, fy
@@ -93,3 +100,24 @@ def microphone(sim, *, rpm, teeth, rate=44100.0, air_s=0.7, noise=0.02, fans=(61
     seg = out[n0:n0 + sig.size]
     seg += 0.5 * sig[:seg.size] / np.max(np.abs(sig))
     return out / (1.2 * np.max(np.abs(out))), rate, t0, t1
+
+
+def sim_shop(prior, *, record_seed=0):
+    """A shop for :func:`toolpoint.shop.campaign.virtual_campaign`: the true tool cut in the simulation, heard by
+    the microphone above, judged by :func:`toolpoint.shop.analyse_cut` (its verdict and chatter frequency)."""
+    from toolpoint.shop import analyse_cut
+    from toolpoint.shop.update import TestCut
+
+    c = prior.cutting
+    m = prior.modes
+    phi_st, phi_ex = c.immersion_angles
+
+    def shop(theta, rpm, depth_m, rng):
+        fn, k, z = theta[:m], theta[m:2 * m], theta[2 * m:3 * m]
+        kt, kr = theta[3 * m], theta[3 * m + 1]
+        sim = simulate(fn, k, z, teeth=c.teeth, kt=kt, kr=kr, phi_st=phi_st, phi_ex=phi_ex, rpm=[rpm],
+                       depth_m=[depth_m], revolutions=max(60, int(rpm / 100)), seed=int(rng.integers(1 << 30)))[0]
+        x, rate, *_ = microphone(sim, rpm=rpm, teeth=c.teeth, seed=int(rng.integers(1 << 30)))
+        r = analyse_cut(x, rate, rpm=rpm, teeth=c.teeth, full_scale=1.0)
+        return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz)
+    return shop

@@ -30,10 +30,15 @@ The detector (:func:`analyse_cut`):
      without any tone exceeds with probability α = 10⁻³ (P/F ~ χ²_ν/ν with ν ≈ 1.9 n_frames degrees of
      freedom for a Hann window at 50 % overlap): a false alarm rate fixed by statistics, not tuned;
    * *new*: when the record holds an air cut, only lines standing ``rise_db`` (10 dB) above the air
-     cut's spectrum are candidates (fans and pumps are there before the cut, chatter is not);
+     cut's spectrum are candidates (fans and pumps are there before the cut, chatter is not); of the
+     significant new lines the strongest in power is the one judged (a chatter cluster raises its own
+     local floor, so the most significant line can be a weak isolated one);
    * *strong*: its power ≥ ``dominance`` (default 0.05, −13 dB) of the strongest spindle harmonic in the
      band — chatter is the dominant vibration, not a trace (the calibration of this ratio on simulated
      records over a speed × depth grid is in ``docs/design/shop.md``).
+
+   * *sustained*: over the segment's second half the line keeps ≥ ¼ of its first half's power (a free
+     vibration left by the entry decays; chatter holds or grows).
 
    The chatter frequency is the peak's frequency, refined by a parabola through the log power of the
    three bins around it.
@@ -533,13 +538,18 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s)
     z = np.where(keep, p / floor, 0.0)
     t_a = _threshold(nu, int(keep.sum()), alpha)
     rise_bins = None
+    new = np.ones(p.size, bool)
     if ref is not None:  # lines already in the air cut (fans, pumps) are not candidates
         k3 = np.ones(3)
         rise_bins = 10 * np.log10(np.convolve(p, k3, "same") / np.maximum(np.convolve(ref, k3, "same"), 1e-300))
-        z_new = np.where(rise_bins >= rise_db, z, 0.0)
-        i = int(np.argmax(z_new)) if z_new.max() > 0 else int(np.argmax(z))
+        new = rise_bins >= rise_db
+    # the strongest (in power) of the significant new lines; else the most significant new line, for the record
+    good = keep & new & (z > t_a)
+    if good.any():
+        i = int(np.argmax(np.where(good, p, -1.0)))
     else:
-        i = int(np.argmax(z))
+        zn = np.where(new, z, 0.0)
+        i = int(np.argmax(zn)) if zn.max() > 0 else int(np.argmax(z))
     sig = float(z[i] / t_a)
     delta = 0.0
     if 0 < i < p.size - 1 and p[i - 1] > 0 and p[i + 1] > 0:  # parabola through the log power
@@ -552,11 +562,14 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s)
     j = int(np.argmax(hp))
     h_pow = float(hp[max(0, j - 1):j + 2].sum()) if hp[j] > 0 else 0.0
     dom = pk_pow / h_pow if h_pow > 0 else np.inf
-    rise, new = None, True
-    if rise_bins is not None:
-        rise = float(rise_bins[i])
-        new = rise >= rise_db
-    chatter = sig > 1 and new and dom >= dominance
+    rise = None if rise_bins is None else float(rise_bins[i])
+    sustained = True
+    if n >= 4:  # a free vibration left by the entry decays; chatter holds or grows
+        h = n // 2
+        first = float(Pseg[:h, max(0, i - 1):i + 2].sum(axis=1).mean())
+        last = float(Pseg[h:, max(0, i - 1):i + 2].sum(axis=1).mean())
+        sustained = last >= 0.25 * first
+    chatter = sig > 1 and bool(new[i]) and dom >= dominance and sustained
     return dict(verdict="chatter" if chatter else "stable", chatter_hz=f_peak if chatter else None, peak_hz=f_peak,
                 significance=sig, rise_db=rise, dominance=float(min(dom, 1e6)))
 
