@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from milling_sim import sim_shop  # noqa: E402
+from milling_sim import sdm_truth, sim_shop  # noqa: E402
 from shop_synth import shop_record  # noqa: E402
 
 from toolpoint.io.records import read_cut_record  # noqa: E402
@@ -165,17 +165,18 @@ def noisy_shop(prior, rng_blur=0.03, f_noise=0.005):
     return shop
 
 
-def bench_update(seeds, quick):
+def bench_update(seeds, quick, shops=("zoa", "noisy", "sim")):
     print("\n## update: virtual campaigns (info rule, risk 0.3, SMC 1000 samples)")
     cases = (cornelius_2024(0.1), example_tool(0.15))
     for prior in cases:
-        for shop_name in ("zoa", "noisy", "sim"):
+        for shop_name in shops:
             if shop_name == "sim" and prior is not cases[0]:
                 continue  # the simulated shop on the Cornelius case only (its cuts cost ~1 s each)
             conv, chat, cpu_max, fails = [], [], 0.0, 0
             for seed in range(seeds):
                 shop = {"zoa": None, "noisy": noisy_shop(prior), "sim": sim_shop(prior)}[shop_name]
-                r = virtual_campaign(prior, rng=np.random.default_rng(seed), shop=shop, max_cuts=10,
+                truth = sdm_truth(prior) if shop_name == "sim" else None
+                r = virtual_campaign(prior, rng=np.random.default_rng(seed), shop=shop, max_cuts=10, true_limit=truth,
                                      n_samples=600 if quick else 1000, lobe_samples=300 if quick else 400)
                 conv.append(r.converged_after if r.converged_after is not None else np.inf)
                 made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
@@ -213,6 +214,7 @@ def main():
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", choices=("cut", "update", "sampler"))
+    ap.add_argument("--shops", default="zoa,noisy,sim", help="comma-separated shops of the update benchmark")
     a = ap.parse_args()
     header()
     if a.only in (None, "cut"):
@@ -221,7 +223,7 @@ def main():
     if a.only in (None, "sampler"):
         bench_sampler()
     if a.only in (None, "update"):
-        bench_update(a.seeds, a.quick)
+        bench_update(a.seeds, a.quick, a.shops.split(","))
 
 
 if __name__ == "__main__":

@@ -121,3 +121,18 @@ def sim_shop(prior, *, record_seed=0):
         r = analyse_cut(x, rate, rpm=rpm, teeth=c.teeth, full_scale=1.0)
         return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz)
     return shop
+
+
+def sdm_truth(prior):
+    """``true_limit`` for :func:`toolpoint.shop.campaign.virtual_campaign` with :func:`sim_shop`: the SDM limit."""
+    from toolpoint.stability import ModalModel, sdm_lobes
+
+    m = prior.modes
+
+    def limit(theta, rpm):
+        fn, k, z = theta[:m], theta[m:2 * m], theta[2 * m:3 * m]
+        mm = ModalModel(np.asarray(fn), np.asarray(z), np.asarray(k) / (2 * np.pi * np.asarray(fn)) ** 2)
+        from dataclasses import replace
+        cut = replace(prior.cutting, tangential_coeff=float(theta[3 * m]), radial_ratio=float(theta[3 * m + 1]))
+        return sdm_lobes(mm, mm, cut, rpm=rpm).depth_m
+    return limit

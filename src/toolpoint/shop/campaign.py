@@ -65,8 +65,13 @@ def zoa_shop(prior: ModalPrior):
 
 
 def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, max_cuts: int = 10,
-                     coverage: float = 0.9, width: float = 0.2, theta_true=None, **update_kw) -> CampaignResult:
-    """Run one virtual campaign (see the module docstring); ``update_kw`` go to :func:`update`."""
+                     coverage: float = 0.9, width: float = 0.2, theta_true=None, true_limit=None,
+                     **update_kw) -> CampaignResult:
+    """Run one virtual campaign (see the module docstring); ``update_kw`` go to :func:`update`.
+
+    ``true_limit(theta_true, rpm_grid) -> limit_m`` is the truth the coverage is judged against (default: the
+    zero-order limit of θ*, the update's own model; a time-domain shop's truth is the SDM's).
+    """
     shop = zoa_shop(prior) if shop is None else shop
     if theta_true is None:
         theta_true = prior.theta((rng.standard_normal(prior.sigma.size) * (prior.sigma > 0))[None, :])[0]
@@ -76,7 +81,8 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
     for n in range(max_cuts + 1):
         post = update(prior, cuts, rng=rng, **update_kw)
         if true_lim is None:
-            true_lim = _limits(prior, theta_true[None, :], prior.freq_grid(), post.rpm)[0]
+            true_lim = (_limits(prior, theta_true[None, :], prior.freq_grid(), post.rpm)[0] if true_limit is None
+                        else np.asarray(true_limit(theta_true, post.rpm), float))
         q = post.limit_q_m
         inside = (q[0] <= true_lim * 1.0000001) & (true_lim <= q[2] * 1.0000001)
         cov = float(inside.mean())
