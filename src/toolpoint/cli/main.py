@@ -34,6 +34,8 @@ COMMANDS = {
     "tap": "impact-test records (time, force, response) → FRF with coherence",
     "library": "safe spindle speeds and depths for every tool of a tool library, with their uncertainty",
     "report": "one self-contained HTML page of a library run (sortable overview, per-tool figures)",
+    "cut": "chatter detection from a record of a cut (audio, accelerometer, UFF58): verdict, chatter frequency",
+    "update": "test cuts → posterior lobes (5/50/95 %%), P(stable) map, parameters, the next test cut",
 }
 
 

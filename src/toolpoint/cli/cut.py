@@ -1,0 +1,89 @@
+"""``toolpoint cut RECORD --rpm N --teeth Z [--rate HZ] [--channel K] [--out cut.json] [--plot cut.png]``.
+
+Chatter detection from a record of a cut: microphone audio (WAV, FLAC, OGG, MP3), accelerometer or
+displacement time histories (CSV/text columns, time first; one column with ``--rate``; UFF58). Spindle
+and tooth-passing harmonics (all multiples of the spindle frequency: runout included) are removed, the
+strongest remaining peak is tested (:func:`toolpoint.shop.analyse_cut` documents the criterion), per
+segment (air cut, entry, cut windows, exit).
+
+``cut.json``: ``verdict`` (stable|chatter), ``chatter_hz`` (null when stable), ``segments`` (kind,
+start_s, end_s, verdict, chatter_hz, …), ``rpm_measured`` (from the spindle harmonics),
+``recommended_rpm`` (a tooth-passing harmonic on the chatter frequency) and the criterion used.
+A one-line summary goes to stdout. Bad input: one line naming file and field, exit 2.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from ..errors import InputError
+from .common import check_number, out_path, save_figure, use_agg
+
+
+def register(sub) -> None:
+    """Add the ``cut`` sub-command to the CLI's sub-parsers."""
+    p = sub.add_parser("cut", help="chatter detection from a record of a cut (audio, accelerometer, UFF58)",
+                       description="Judge a test cut from its record: stable or chatter per segment, chatter "
+                       "frequency, measured spindle speed and a Harmonizer-style speed.")
+    p.add_argument("record", metavar="RECORD", help="audio (.wav/.flac/.ogg/.mp3), text/CSV columns or UFF58")
+    p.add_argument("--rpm", required=True, help="nominal spindle speed, rpm (refined from the record)")
+    p.add_argument("--teeth", required=True, help="number of teeth")
+    p.add_argument("--rate", help="sampling rate, Hz (needed for a one-column table)")
+    p.add_argument("--channel", help="0-based channel / column (default: mean of audio channels)")
+    p.add_argument("--rpm-tolerance", default="0.03",
+                   help="relative search range around --rpm for the spindle harmonics (default 0.03; 0 = exact)")
+    p.add_argument("--window", default="1.0", help="length of the windows the cut is judged in, s (default 1)")
+    p.add_argument("--out", help="result JSON (default: print it)")
+    p.add_argument("--plot", help="spectrogram with the harmonics marked (.png/.pdf/.svg)")
+    p.set_defaults(func=run)
+
+
+def _int(value, flag):
+    try:
+        v = int(value)
+    except (TypeError, ValueError):
+        raise InputError(f"must be a whole number, got {value!r}", file="command line", field=flag) from None
+    return v
+
+
+def run(args) -> int:
+    """Run ``toolpoint cut``; returns the exit code."""
+    rec_path = Path(args.record)
+    out = out_path(args.out, "--out", inputs=[rec_path]) if args.out else None
+    plot = out_path(args.plot, "--plot", inputs=[rec_path]) if args.plot else None
+    rpm = check_number(args.rpm, "--rpm", above=0, unit="rpm")
+    teeth = _int(args.teeth, "--teeth")
+    rate = check_number(args.rate, "--rate", above=0, unit="Hz") if args.rate is not None else None
+    channel = _int(args.channel, "--channel") if args.channel is not None else None
+    tol = check_number(args.rpm_tolerance, "--rpm-tolerance", minimum=0)
+    if tol >= 0.5:
+        raise InputError(f"must be < 0.5, got {args.rpm_tolerance}", file="command line", field="--rpm-tolerance")
+    window = check_number(args.window, "--window", above=0, unit="s")
+    from ..io.atomic import atomic_open
+    from ..io.records import read_cut_record
+    from ..shop import analyse_cut
+
+    rec = read_cut_record(rec_path, rate_hz=rate, channel=channel)
+    res = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=teeth, rpm_tolerance=tol, window_s=window,
+                      full_scale=rec.full_scale, source=str(rec_path))
+    doc = {"record": str(rec_path), "channel": rec.channel, "rate_hz": rec.rate_hz, **res.to_dict()}
+    fig = None
+    if plot is not None:
+        use_agg()
+        from ..shop.detect import plot_cut
+        fig = plot_cut(res, title=f"{rec_path.name}: {res.verdict}")
+    text = json.dumps(doc, indent=2)
+    if out is not None:
+        with atomic_open(out) as fh:
+            fh.write(text + "\n")
+    if fig is not None:
+        save_figure(fig, plot)
+    if out is None:
+        print(text)
+    msg = (f"{rec_path.name}: {res.verdict}"
+           + (f" at {res.chatter_hz:.1f} Hz; Harmonizer speed {res.recommended_rpm:.0f} rpm" if res.chatter_hz else "")
+           + f"; spindle {res.rpm:.1f} rpm" + ("" if res.spindle_found else " (nominal: harmonics not found)"))
+    print(msg, file=sys.stderr if out is None else sys.stdout)
+    return 0

@@ -1,0 +1,67 @@
+"""``toolpoint update (--prior PRIOR.toml | --library OUT --tool ID) --cuts CUTS.csv --out DIR [--seed N]``.
+
+Bayesian update of the stability lobes from test cuts (:func:`toolpoint.shop.update`): the prior is a
+modal-prior TOML file (:mod:`toolpoint.shop.prior`) or a tool of a ``library`` output; the test cuts a CSV
+``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz`` and ``record`` (a record of the cut,
+analysed as ``toolpoint cut`` does). Writes ``lobes.csv``, ``p_stable.csv``, ``parameters.csv``,
+``update.json`` (recommended point, the next test cut and its rule), ``lobes.png`` and ``report.html`` in
+``--out``; prints the recommendation and the next cut. Contradictory labels are refused (exit 2), not averaged.
+"""
+
+from __future__ import annotations
+
+from ..errors import InputError
+from .common import check_number, out_folder, use_agg
+
+
+def register(sub) -> None:
+    """Add the ``update`` sub-command to the CLI's sub-parsers."""
+    p = sub.add_parser("update", help="test cuts → posterior lobes (5/50/95 %%), P(stable) map, parameters, next cut",
+                       description="Update the stability lobes of a tool from test cuts (sequential Monte Carlo "
+                       "over modal parameters and K_t) and propose the next test cut.")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--prior", help="modal-prior TOML (modes with σ, cut with K_t in N/mm²)")
+    src.add_argument("--library", help="a library output folder (with --tool)")
+    p.add_argument("--tool", help="tool id in the library output")
+    p.add_argument("--cuts", help="test-cut table CSV (rpm, depth_mm, result[, chatter_hz][, record]); "
+                   "without it: the prior's lobes and the first cut")
+    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--seed", default="0", help="random seed (default 0)")
+    p.add_argument("--samples", default="1000", help="posterior samples (default 1000)")
+    p.add_argument("--method", choices=("smc", "sir"), default="smc", help="sampler (default smc)")
+    p.add_argument("--rule", choices=("info", "risk"), default="info",
+                   help="next-cut rule: info = most reduction of the limit's band at the recommended speed with "
+                   "P(chatter) ≤ risk (default); risk = most productive cut with P(chatter) ≤ risk")
+    p.add_argument("--risk", help="largest P(chatter) of the next cut (default 0.3 for info, 0.1 for risk)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    """Run ``toolpoint update``; returns the exit code."""
+    out = out_folder(args.out, "--out")
+    seed = check_number(args.seed, "--seed", minimum=0)
+    if seed != int(seed):
+        raise InputError(f"must be a whole number, got {args.seed!r}", file="command line", field="--seed")
+    n = check_number(args.samples, "--samples", minimum=50)
+    risk = None if args.risk is None else check_number(args.risk, "--risk", above=0)
+    if risk is not None and risk > 0.5:
+        raise InputError(f"must be ≤ 0.5, got {args.risk}", file="command line", field="--risk")
+    if args.library and not args.tool:
+        raise InputError("--library needs --tool ID", file="command line", field="--tool")
+    import numpy as np
+
+    from ..shop.prior import prior_from_library, read_modal_prior
+    from ..shop.report import write_update
+    from ..shop.update import read_test_cuts, update
+
+    prior = read_modal_prior(args.prior) if args.prior else prior_from_library(args.library, args.tool)
+    cuts = read_test_cuts(args.cuts, teeth=prior.cutting.teeth) if args.cuts else []
+    use_agg()
+    post = update(prior, cuts, rng=np.random.default_rng(int(seed)), n_samples=int(n), method=args.method,
+                  rule=args.rule, risk=risk)
+    write_update(post, out)
+    rc, nc = post.recommended, post.next_cut
+    print(f"{len(cuts)} test cuts; recommended {rc['rpm']:.0f} rpm at {1e3 * rc['depth_m']:.3f} mm "
+          f"(P(stable) {rc['p_stable']:.2f}); next test cut ({nc['rule']}) {nc['rpm']:.0f} rpm at "
+          f"{1e3 * nc['depth_m']:.3f} mm, P(chatter) {nc['p_chatter']:.2f}; wrote {out}/report.html")
+    return 0

@@ -1,0 +1,211 @@
+"""Records of a cut: microphone audio, accelerometer or displacement time histories → one channel of samples.
+
+Formats (by extension):
+
+* audio ``.wav .flac .ogg .mp3`` (and whatever else libsndfile reads: ``.aiff``, ``.au``) through the
+  ``soundfile`` package (libsndfile ≥ 1.1 for MP3; the wheels of soundfile ≥ 0.12.1 bundle 1.2);
+* ``.uff .unv .uf``: universal files, datasets 58 of function type 1 (time response); the sampling
+  step is the abscissa increment;
+* anything else: a text table (comma, tab or space separated, optional header, ``#``/``%`` comments).
+  Several columns: the first is time in s when it increases evenly (the rate follows from it), the
+  others are channels; one column: samples, and the rate must be given.
+
+The channel is chosen by ``channel`` (0-based among the signal columns / audio channels); without it
+a multichannel audio file is averaged (a stereo microphone's two channels hear the same cut) and a
+table must have one signal column.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["CutRecord", "read_cut_record", "AUDIO_SUFFIXES"]
+
+AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".oga", ".mp3", ".aif", ".aiff", ".au")
+_UFF_SUFFIXES = (".uff", ".unv", ".uf")
+
+
+@dataclass(frozen=True)
+class CutRecord:
+    """One channel of a record of a cut.
+
+    Attributes
+    ----------
+    samples : ndarray, shape (T,)
+        The signal (audio: full scale ±1; tables and UFF: their unit, e.g. m/s² or m).
+    rate_hz : float
+        Sampling rate, Hz.
+    source : str
+        The file it came from.
+    channel : str
+        Which channel: ``"mean of 2"``, ``"0"``, …
+    full_scale : float or None
+        The clipping level of the recording (1.0 for audio read as float), None when unknown.
+    """
+
+    samples: np.ndarray
+    rate_hz: float
+    source: str
+    channel: str
+    full_scale: float | None = None
+
+    @property
+    def duration_s(self) -> float:
+        """Length of the record, s."""
+        return self.samples.size / self.rate_hz
+
+
+def read_cut_record(path: str | os.PathLike, *, rate_hz: float | None = None, channel: int | None = None) -> CutRecord:
+    """Read a record of a cut (audio, UFF58 time history or text columns).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    rate_hz : float, optional
+        Sampling rate, Hz: required for a one-column table; for other files it must agree
+        with the file's own rate (within 0.1 %) when given.
+    channel : int, optional
+        0-based channel (audio channel, table signal column, UFF time history).
+
+    Returns
+    -------
+    CutRecord
+
+    Raises
+    ------
+    InputError
+        One line naming the file and the field (``rate_hz``, ``channel``, ``time_s``, ``data``, …).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "acc.csv"
+    >>> _ = p.write_text("time_s,acc\\n0,0.1\\n0.001,0.2\\n0.002,-0.1\\n")
+    >>> r = read_cut_record(p)
+    >>> r.rate_hz, r.samples.tolist()
+    (1000.0, [0.1, 0.2, -0.1])
+    """
+    p = Path(path)
+    if p.is_dir():
+        raise InputError("is a folder, not a record", file=p)
+    if not p.exists():
+        raise InputError("file not found", file=p)
+    suffix = p.suffix.lower()
+    if suffix in AUDIO_SUFFIXES:
+        rec = _read_audio(p, channel)
+    elif suffix in _UFF_SUFFIXES:
+        rec = _read_uff(p, channel)
+    else:
+        rec = _read_table(p, channel, rate_hz)
+    if rate_hz is not None:
+        if not (np.isfinite(rate_hz) and rate_hz > 0):
+            raise InputError(f"must be a finite rate > 0 Hz, got {rate_hz!r}", file=p, field="rate_hz")
+        if abs(rec.rate_hz / rate_hz - 1) > 1e-3:
+            raise InputError(f"the file says {rec.rate_hz:.6g} Hz, the command line {rate_hz:.6g} Hz", file=p,
+                             field="rate_hz")
+    if rec.samples.size == 0:
+        raise InputError("no samples", file=p, field="data")
+    if not np.all(np.isfinite(rec.samples)):
+        k = int(np.flatnonzero(~np.isfinite(rec.samples))[0])
+        raise InputError(f"sample {k} is not finite", file=p, field="data")
+    return rec
+
+
+def _pick(data: np.ndarray, channel: int | None, p: Path, what: str) -> tuple[np.ndarray, str]:
+    """One channel of ``data`` (T, C): the given one, or the mean of all (audio) / the only one."""
+    n = data.shape[1]
+    if channel is None:
+        if n == 1:
+            return data[:, 0], "0"
+        if what == "audio":
+            return data.mean(axis=1), f"mean of {n}"
+        raise InputError(f"{n} signal columns: choose one with --channel (0..{n - 1})", file=p, field="channel")
+    if not (0 <= channel < n):
+        raise InputError(f"channel {channel} does not exist ({what} has {n}: 0..{n - 1})", file=p, field="channel")
+    return data[:, channel], str(channel)
+
+
+def _read_audio(p: Path, channel: int | None) -> CutRecord:
+    import soundfile as sf
+
+    try:
+        data, rate = sf.read(p, dtype="float32", always_2d=True)
+    except (sf.LibsndfileError, RuntimeError, TypeError, ValueError) as err:
+        raise InputError(f"cannot read audio: {' '.join(str(err).split())}", file=p, field="data") from None
+    except OSError as err:
+        raise InputError(f"cannot read audio: {err.strerror or err}", file=p, field="data") from None
+    x, ch = _pick(np.asarray(data, float), channel, p, "audio")
+    return CutRecord(x, float(rate), os.fspath(p), ch, full_scale=1.0)
+
+
+def _read_uff(p: Path, channel: int | None) -> CutRecord:
+    from .frf_files import _uff_headers
+
+    uff, sets, heads = _uff_headers(p)
+    th = [s for s, h in zip(sets, heads) if h.get("func_type") == 1]
+    if not th:
+        types = ", ".join(str(h.get("func_type")) for h in heads)
+        raise InputError(f"no time history (dataset 58 of function type 1; function types here: {types})",
+                         file=p, field="func_type")
+    k = 0 if channel is None and len(th) == 1 else channel
+    if k is None:
+        raise InputError(f"{len(th)} time histories: choose one with --channel (0..{len(th) - 1})", file=p,
+                         field="channel")
+    if not (0 <= k < len(th)):
+        raise InputError(f"channel {k} does not exist ({len(th)} time histories: 0..{len(th) - 1})", file=p,
+                         field="channel")
+    try:
+        ds = uff.read_sets(th[k])
+    except Exception as exc:  # pyuff raises bare Exception
+        raise InputError(f"dataset {th[k]} cannot be read ({exc})", file=p, field="data") from None
+    if np.iscomplexobj(ds["data"]):
+        raise InputError("time history must be real (ordinate data type 2 or 4)", file=p, field="ord_data_type")
+    t = np.asarray(ds["x"], float)
+    if t.size < 2 or not np.all(np.diff(t) > 0):
+        raise InputError("abscissa must increase", file=p, field="abscissa_inc")
+    return CutRecord(np.asarray(ds["data"], float), float(1.0 / np.mean(np.diff(t))), os.fspath(p), str(k))
+
+
+def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecord:
+    from .frf_files import _is_number, _read_text
+
+    text, _ = _read_text(p)
+    rows = []
+    width = None
+    for n, line in enumerate(text, 1):
+        s = line.strip()
+        if not s or s[0] in "#%":
+            continue
+        cells = [c.strip() for c in (s.split(",") if "," in s else s.split())]
+        if not rows and not _is_number(cells[0]):
+            continue  # a header line
+        if width is None:
+            width = len(cells)
+        if len(cells) != width:
+            raise InputError(f"line {n}: expected {width} columns, found {len(cells)}", file=p, field="columns")
+        for j, c in enumerate(cells):
+            if not _is_number(c):
+                raise InputError(f"line {n}: {c!r} is not a number", file=p, field=f"column {j}")
+        rows.append(cells)
+    if not rows:
+        raise InputError("no data rows", file=p, field="data")
+    a = np.array(rows, dtype=float)
+    if a.shape[1] == 1:
+        if rate_hz is None:
+            raise InputError("one column of samples: give the sampling rate (--rate HZ)", file=p, field="rate_hz")
+        x, ch = a[:, 0], "0"
+        return CutRecord(x, float(rate_hz), os.fspath(p), ch)
+    t = a[:, 0]
+    d = np.diff(t)
+    if t.size < 2 or not np.all(d > 0) or np.ptp(d) > 1e-3 * np.mean(d):
+        raise InputError("first column must be time in s, increasing in equal steps (one column of samples "
+                         "needs --rate instead)", file=p, field="time_s")
+    x, ch = _pick(a[:, 1:], channel, p, "the table")
+    return CutRecord(x, float((t.size - 1) / (t[-1] - t[0])), os.fspath(p), ch)

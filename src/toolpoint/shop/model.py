@@ -1,0 +1,264 @@
+r"""The uncertain forward model of test cuts: modal parameters and K_t → stability limit and chatter frequency.
+
+A symmetric tool (Φ_xx = Φ_yy = Φ, no cross terms) with M real modes,
+
+    Φ(f) = Σ_m 1 / (k_m (1 − r_m² + 2 i ζ_m r_m)),  r_m = f / f_m   (m/N),
+
+cut as :class:`~toolpoint.stability.CuttingConditions` says. Every uncertain parameter is log-normal:
+ln θ = ln θ̃ + σ z, z ~ N(0, 1) (θ̃ the median, σ the log standard deviation, about the coefficient of
+variation for σ ≲ 0.3). The parameters: f_m (Hz), k_m (N/m), ζ_m per mode, K_t (N/m²) and K_r.
+
+The zero-order limit (Altintas & Budak 1995) at *one* speed n comes from the lobe crossings: with
+μ_b(f) = λ_b Φ(f) (λ_b the eigenvalues of the average directional matrix, which holds K_t and K_r),
+a lobe k passes n where g(f) = 60 f / (N n) − ε(f)/2π equals the integer k, ε = π + 2 arg(−μ), and there
+the limit is a = 1 / (−2 Re μ). The limit at n is the smallest over all crossings (f, b, k), and the
+chatter frequency is that crossing's f. :func:`limit_at_speeds` evaluates this for many samples at a
+few speeds (the test cuts) — the same formulas as :mod:`toolpoint.stability.zoa_batch` (which gives the
+limit on a whole speed grid); the tests compare the two.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..errors import InputError
+from ..stability.cutting import CuttingConditions
+from ..stability.milling import average_directional_matrix
+
+__all__ = ["ModalPrior", "Samples", "limit_at_speeds", "receptance", "cornelius_2024", "example_tool"]
+
+
+@dataclass(frozen=True)
+class ModalPrior:
+    """Log-normal prior of a symmetric M-mode tool and its cutting coefficients.
+
+    Attributes
+    ----------
+    freq_hz, stiffness_n_m, damping : tuple of float
+        Medians per mode: natural frequency (Hz), modal stiffness (N/m), damping ratio.
+    sigma_freq, sigma_stiffness, sigma_damping : tuple of float
+        Log standard deviations per mode (≈ coefficients of variation).
+    cutting : CuttingConditions
+        The cut; its K_t and K_r are the medians.
+    sigma_kt, sigma_kr : float
+        Log standard deviations of K_t and K_r.
+    name : str
+        For reports.
+    rpm_range : (float, float) or None
+        The machine's speed range, rpm (default: lobes k = 0…5 of the modes).
+    """
+
+    freq_hz: tuple
+    stiffness_n_m: tuple
+    damping: tuple
+    sigma_freq: tuple
+    sigma_stiffness: tuple
+    sigma_damping: tuple
+    cutting: CuttingConditions
+    sigma_kt: float = 0.1
+    sigma_kr: float = 0.05
+    name: str = "tool"
+    rpm_range: tuple | None = None
+
+    def __post_init__(self):
+        m = len(self.freq_hz)
+        for nm in ("stiffness_n_m", "damping", "sigma_freq", "sigma_stiffness", "sigma_damping"):
+            if len(getattr(self, nm)) != m:
+                raise InputError(f"needs {m} values (one per mode), got {len(getattr(self, nm))}", field=nm)
+        for nm in ("freq_hz", "stiffness_n_m", "damping"):
+            v = np.asarray(getattr(self, nm), float)
+            if not np.all(np.isfinite(v) & (v > 0)):
+                raise InputError(f"must be finite and > 0, got {list(v)}", field=nm)
+        if not np.all(np.asarray(self.damping) < 1):
+            raise InputError(f"damping ratios must be < 1, got {list(self.damping)}", field="damping")
+        sig = np.r_[self.sigma_freq, self.sigma_stiffness, self.sigma_damping, self.sigma_kt, self.sigma_kr]
+        if not np.all(np.isfinite(sig) & (sig >= 0) & (sig <= 2)):
+            raise InputError("log standard deviations must be in [0, 2]", field="sigma")
+        if self.rpm_range is not None:
+            lo, hi = self.rpm_range
+            if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi <= 200_000):
+                raise InputError(f"must be 0 < min < max ≤ 200000 rpm, got {self.rpm_range}", field="rpm_range")
+
+    @property
+    def modes(self) -> int:
+        """Number of modes M."""
+        return len(self.freq_hz)
+
+    @property
+    def names(self) -> list:
+        """Parameter names in the order of :attr:`Samples.theta`'s columns."""
+        m = range(1, self.modes + 1)
+        return ([f"f{i}_hz" for i in m] + [f"k{i}_n_m" for i in m] + [f"zeta{i}" for i in m]
+                + ["kt_n_m2", "kr"])
+
+    @property
+    def log_median(self) -> np.ndarray:
+        """ln of the medians, shape (3M + 2,)."""
+        c = self.cutting
+        return np.log(np.r_[self.freq_hz, self.stiffness_n_m, self.damping, c.tangential_coeff, c.radial_ratio])
+
+    @property
+    def sigma(self) -> np.ndarray:
+        """Log standard deviations, shape (3M + 2,)."""
+        return np.r_[self.sigma_freq, self.sigma_stiffness, self.sigma_damping, self.sigma_kt, self.sigma_kr]
+
+    def theta(self, z) -> np.ndarray:
+        """Parameters (S, 3M + 2) from standard normal z (S, 3M + 2); a zero σ holds its median."""
+        return np.exp(self.log_median + np.asarray(z) * self.sigma)
+
+    def sample(self, n: int, rng: np.random.Generator) -> "Samples":
+        """``n`` prior samples."""
+        z = rng.standard_normal((n, self.sigma.size))
+        return Samples(self, z)
+
+    def with_median(self, theta) -> "ModalPrior":
+        """The same prior centred on ``theta`` (e.g. a truth drawn from it, for a virtual campaign)."""
+        m = self.modes
+        t = np.asarray(theta, float)
+        cut = replace(self.cutting, tangential_coeff=float(t[3 * m]), radial_ratio=float(t[3 * m + 1]))
+        return replace(self, freq_hz=tuple(t[:m]), stiffness_n_m=tuple(t[m:2 * m]), damping=tuple(t[2 * m:3 * m]),
+                       cutting=cut)
+
+    def freq_grid(self) -> np.ndarray:
+        """Frequencies (Hz): 400 points over the modes' ±4σ range (×0.5 … ×1.6), and around each mode ≥ 16
+        points per half-power band over its own ±4σ range (lightly damped modes need them, the rest does not)."""
+        f = np.asarray(self.freq_hz)
+        s = np.asarray(self.sigma_freq)
+        z = np.asarray(self.damping) * np.exp(-4 * np.asarray(self.sigma_damping))
+        lo, hi = float(np.min(f * np.exp(-4 * s))) * 0.5, float(np.max(f * np.exp(4 * s))) * 1.6
+        parts = [np.linspace(lo, hi, 400)]
+        for fm, sm, zm in zip(f, s, z):
+            a, b = fm * np.exp(-4 * sm) * (1 - 4 * zm), fm * np.exp(4 * sm) * (1 + 4 * zm)
+            step = max(0.05, 2 * zm * a / 16)
+            parts.append(np.arange(a, b, step))
+        return np.unique(np.round(np.concatenate(parts), 6))
+
+
+@dataclass(frozen=True)
+class Samples:
+    """Samples of a :class:`ModalPrior` in its standard-normal coordinates z (S, 3M + 2)."""
+
+    prior: ModalPrior
+    z: np.ndarray
+
+    @property
+    def theta(self) -> np.ndarray:
+        """The parameters, (S, 3M + 2), SI."""
+        return self.prior.theta(self.z)
+
+
+def receptance(prior: ModalPrior, theta, freq_hz) -> np.ndarray:
+    """Φ(f) of each parameter row: (S, F) complex, m/N."""
+    m = prior.modes
+    t = np.atleast_2d(theta)
+    f = np.asarray(freq_hz, float)
+    fn, k, zeta = t[:, :m, None], t[:, m:2 * m, None], t[:, 2 * m:3 * m, None]
+    r = f[None, None, :] / fn
+    return (1.0 / (k * (1.0 - r * r + 2j * zeta * r))).sum(axis=1)
+
+
+def _eigs(prior: ModalPrior, theta) -> np.ndarray:
+    """λ_b per sample (S, 2): eigenvalues of the average directional matrix with that sample's K_t, K_r."""
+    c = prior.cutting
+    phi_st, phi_ex = c.immersion_angles
+    m = prior.modes
+    t = np.atleast_2d(theta)
+    kt, kr = t[:, 3 * m], t[:, 3 * m + 1]
+    # H0 is linear in K_t and affine in K_r: H0 = K_t (A + K_r B)
+    a0 = average_directional_matrix(c.teeth, 1.0, 0.0, phi_st, phi_ex)
+    b0 = average_directional_matrix(c.teeth, 1.0, 1.0, phi_st, phi_ex) - a0
+    h = kt[:, None, None] * (a0[None] + kr[:, None, None] * b0[None])
+    tr = h[:, 0, 0] + h[:, 1, 1]
+    det = h[:, 0, 0] * h[:, 1, 1] - h[:, 0, 1] * h[:, 1, 0]
+    root = np.sqrt((tr * tr / 4 - det).astype(complex))
+    return np.stack([tr / 2 + root, tr / 2 - root], axis=1)
+
+
+def limit_at_speeds(prior: ModalPrior, theta, rpm, freq_hz=None) -> tuple[np.ndarray, np.ndarray]:
+    """Zero-order limit (m) and chatter frequency (Hz) of each sample at each speed.
+
+    Parameters
+    ----------
+    prior : ModalPrior
+    theta : array_like, shape (S, 3M + 2)
+    rpm : array_like, shape (R,)
+    freq_hz : array_like, optional
+        Frequency grid (default :meth:`ModalPrior.freq_grid`).
+
+    Returns
+    -------
+    limit_m, chatter_hz : ndarray, shape (S, R)
+        inf / nan where no lobe reaches the speed within the grid.
+
+    Examples
+    --------
+    One mode at the prior's median, compared with :func:`~toolpoint.stability.zoa_batch.zoa_limits` (a second
+    method: lobe pieces interpolated over the tooth period) at the same speeds:
+
+    >>> import numpy as np
+    >>> from toolpoint.stability import CuttingConditions
+    >>> from toolpoint.stability.zoa_batch import zoa_limits
+    >>> cut = CuttingConditions(teeth=3, tangential_coeff=7e8, radial_ratio=0.3, radial_immersion=0.5)
+    >>> pr = ModalPrior((900.0,), (5e6,), (0.03,), (0.0,), (0.0,), (0.0,), cut, 0.0, 0.0)
+    >>> f = pr.freq_grid()
+    >>> rpm = np.array([9000.0, 12000.0, 15000.0])
+    >>> a, fc = limit_at_speeds(pr, pr.theta(np.zeros((1, 5))), rpm, f)
+    >>> ref = zoa_limits(f, receptance(pr, pr.theta(np.zeros((1, 5))), f)[0], cut, rpm, subdivide=16)
+    >>> bool(np.all(np.abs(a[0] / ref - 1) < 2e-3))
+    True
+    """
+    t = np.atleast_2d(np.asarray(theta, float))
+    f = prior.freq_grid() if freq_hz is None else np.asarray(freq_hz, float)
+    n = np.atleast_1d(np.asarray(rpm, float))
+    H = receptance(prior, t, f)  # (S, F)
+    lam = _eigs(prior, t)  # (S, 2)
+    mu = lam[:, :, None] * H[:, None, :]  # (S, 2, F)
+    q = -2.0 * mu.real  # 1/a, valid where > 0
+    frac = (np.pi + 2 * np.arctan2(-mu.imag, -mu.real)) / (2 * np.pi)
+    N = prior.cutting.teeth
+    S, R = t.shape[0], n.size
+    best_q = np.zeros((S, R))
+    best_f = np.full((S, R), np.nan)
+    for r in range(R):  # a few test speeds; vectorised over samples, branches, frequencies
+        g = 60.0 * f / (N * n[r]) - frac  # (S, 2, F)
+        g0, g1 = g[..., :-1], g[..., 1:]
+        k0, k1 = np.floor(g0), np.floor(g1)
+        cross = (k0 != k1) & (q[..., :-1] > 0) & (q[..., 1:] > 0)  # frac wraps only where Re μ > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            kk = np.maximum(k0, k1)
+            w = np.clip((kk - g0) / (g1 - g0), 0, 1)
+        qc = np.where(cross, q[..., :-1] + w * (q[..., 1:] - q[..., :-1]), 0.0)
+        fc = f[:-1] + w * (f[1:] - f[:-1])
+        qc2 = qc.reshape(S, -1)
+        j = np.argmax(qc2, axis=1)
+        best_q[:, r] = qc2[np.arange(S), j]
+        best_f[:, r] = np.where(best_q[:, r] > 0, fc.reshape(S, -1)[np.arange(S), j], np.nan)
+    with np.errstate(divide="ignore"):
+        limit = np.where(best_q > 0, 1.0 / np.where(best_q > 0, best_q, 1.0), np.inf)
+    return limit, best_f
+
+
+def example_tool(sigma: float = 0.15) -> ModalPrior:
+    """A toolpoint tool: the three strongest modes of the tool-point FRF of ``examples/numerical_case.toml``
+    (2213 Hz, 9.02e6 N/m, ζ 0.99 %; 776 Hz, 2.84e7 N/m, ζ 0.55 %; 1908 Hz, 1.96e7 N/m, ζ 2.68 %, peak-picked by
+    :func:`toolpoint.shop.prior.modes_from_frf`), 3 teeth, K_t 700 N/mm², K_r 0.3, 50 % immersion, climb, speeds
+    5000–30000 rpm; log standard deviations: ``sigma`` on stiffness, damping and K_t, 0.03 on frequency."""
+    cut = CuttingConditions(teeth=3, tangential_coeff=700e6, radial_ratio=0.3, radial_immersion=0.5, milling="down")
+    return ModalPrior((2213.0, 776.0, 1908.0), (9.02e6, 2.84e7, 1.96e7), (0.0099, 0.0055, 0.0268), (0.03,) * 3,
+                      (sigma,) * 3, (sigma,) * 3, cut, sigma_kt=sigma, sigma_kr=0.05,
+                      name="toolpoint example tool (numerical_case.toml)", rpm_range=(5000.0, 30000.0))
+
+
+def cornelius_2024(sigma: float = 0.1) -> ModalPrior:
+    """The two-mode numerical case like Cornelius, Karandikar, Tyler & Schmitz 2024 (modes 1243 Hz, 2.92e6 N/m,
+    ζ 6.19 % and 1747 Hz, 1.2e7 N/m, ζ 2.88 %; K_t 2003 N/mm², K_r/K_t 0.404; 4 teeth, 50 % immersion, climb),
+    with log standard deviations ``sigma`` on stiffness and damping, sigma/4 on frequency, sigma on K_t; speeds
+    5000–25000 rpm."""
+    cut = CuttingConditions(teeth=4, tangential_coeff=2003e6, radial_ratio=0.404, radial_immersion=0.5,
+                            milling="down")
+    return ModalPrior((1243.0, 1747.0), (2.92e6, 1.2e7), (0.0619, 0.0288), (sigma / 4,) * 2, (sigma,) * 2,
+                      (sigma,) * 2, cut, sigma_kt=sigma, sigma_kr=sigma / 4, name="Cornelius 2024 two-mode case",
+                      rpm_range=(5000.0, 25000.0))

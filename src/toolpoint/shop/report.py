@@ -1,0 +1,155 @@
+"""Files of ``toolpoint update``: lobes, P(stable) map, parameters, next cut, figure and one HTML page.
+
+In the output folder (written atomically, all or none of each file):
+
+* ``lobes.csv`` — ``rpm, p05_mm, p50_mm, p95_mm, prior_p05_mm, prior_p50_mm, prior_p95_mm``;
+* ``p_stable.csv`` — first row ``depth_mm\\rpm`` and the speeds, then one row per depth (mm) of P(stable);
+* ``parameters.csv`` — ``name, unit, prior_p05, prior_p50, prior_p95, post_p05, post_p50, post_p95``
+  (K_t in N/mm²);
+* ``update.json`` — recommended point, next test cut (rule, rpm, depth_mm, P(chatter)), the test cuts,
+  sampler diagnostics (method, ESS per tempering step, acceptance, CPU s);
+* ``lobes.png`` — prior and posterior bands, the P(stable) map, the test cuts, the next cut;
+* ``report.html`` — one self-contained page (figure embedded) of all of the above.
+"""
+
+from __future__ import annotations
+
+import base64
+import csv
+import html
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..io.atomic import atomic_open, atomic_path
+from .update import Posterior
+
+__all__ = ["write_update", "plot_update"]
+
+_UNITS = {"hz": ("Hz", 1.0), "n_m": ("N/m", 1.0), "zeta": ("-", 1.0), "kt_n_m2": ("N/mm²", 1e-6), "kr": ("-", 1.0)}
+
+
+def _unit(name):
+    for suffix, (u, s) in _UNITS.items():
+        if name.endswith(suffix) or name.startswith(suffix):
+            return u, s
+    return "-", 1.0
+
+
+def plot_update(post: Posterior):
+    """Figure: P(stable) map, prior band (grey), posterior 5/50/95 % (blue), test cuts, next cut."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9, 5))
+    ax = fig.add_subplot()
+    mm = 1e3
+    mesh = ax.pcolormesh(post.rpm, post.depth_m * mm, post.p_stable, cmap="RdYlGn", vmin=0, vmax=1,
+                         shading="nearest", alpha=0.5, rasterized=True)
+    fig.colorbar(mesh, ax=ax, label="P(stable)")
+    ax.fill_between(post.rpm, post.prior_limit_q_m[0] * mm, post.prior_limit_q_m[2] * mm, color="grey", alpha=0.25,
+                    label="prior 5–95 %")
+    ax.fill_between(post.rpm, post.limit_q_m[0] * mm, post.limit_q_m[2] * mm, color="tab:blue", alpha=0.3,
+                    label="posterior 5–95 %")
+    ax.plot(post.rpm, post.limit_q_m[1] * mm, color="tab:blue", lw=1.5, label="posterior median")
+    for c in post.cuts:
+        ax.plot(c.rpm, c.depth_m * mm, "o" if c.stable else "x", color="green" if c.stable else "red", ms=7, mew=2)
+    nc, rc = post.next_cut, post.recommended
+    ax.plot(nc["rpm"], nc["depth_m"] * mm, "D", mfc="none", mec="k", ms=9, label=f"next cut ({nc['rule']})")
+    ax.plot(rc["rpm"], rc["depth_m"] * mm, "*", color="gold", mec="k", ms=13, label="recommended (P stable 0.95)")
+    ax.set_ylim(0, post.depth_m[-1] * mm)
+    ax.set_xlabel("spindle speed, rpm")
+    ax.set_ylabel("axial depth, mm")
+    ax.set_title(f"{post.prior.name}: {len(post.cuts)} test cuts ({post.method})", fontsize=10)
+    ax.legend(fontsize=7, loc="upper left")
+    return fig
+
+
+def _doc(post: Posterior) -> dict:
+    rc, nc = post.recommended, post.next_cut
+    return {
+        "prior": post.prior.name,
+        "recommended": {"rpm": round(rc["rpm"], 1), "depth_mm": round(1e3 * rc["depth_m"], 4),
+                        "p_stable": round(rc["p_stable"], 3), "limit_p50_mm": round(1e3 * rc["limit_p50_m"], 4),
+                        "limit_p95_mm": round(1e3 * rc["limit_p95_m"], 4)},
+        "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},
+        "cuts": [{"rpm": c.rpm, "depth_mm": round(1e3 * c.depth_m, 6), "result": "stable" if c.stable else "chatter",
+                  "chatter_hz": c.chatter_hz} for c in post.cuts],
+        "sampler": {"method": post.method, "samples": int(post.z.shape[0]), "ess": [round(e, 1) for e in post.ess],
+                    "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
+                    "cpu_s": round(post.cpu_s, 2)},
+    }
+
+
+def write_update(post: Posterior, out_dir) -> list:
+    """Write the files listed in the module docstring into ``out_dir``; returns their paths."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    mm = 1e3
+    paths = []
+    with atomic_open(out / "lobes.csv", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["rpm", "p05_mm", "p50_mm", "p95_mm", "prior_p05_mm", "prior_p50_mm", "prior_p95_mm"])
+        for g in range(post.rpm.size):
+            w.writerow([f"{post.rpm[g]:.6g}"] + [f"{mm * v:.6g}" for v in post.limit_q_m[:, g]]
+                       + [f"{mm * v:.6g}" for v in post.prior_limit_q_m[:, g]])
+    paths.append(out / "lobes.csv")
+    with atomic_open(out / "p_stable.csv", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["depth_mm\\rpm"] + [f"{r:.6g}" for r in post.rpm])
+        for d in range(post.depth_m.size):
+            w.writerow([f"{mm * post.depth_m[d]:.6g}"] + [f"{p:.3f}" for p in post.p_stable[d]])
+    paths.append(out / "p_stable.csv")
+    rows = []
+    with atomic_open(out / "parameters.csv", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["name", "unit", "prior_p05", "prior_p50", "prior_p95", "post_p05", "post_p50", "post_p95"])
+        for name, (pq, qq) in post.parameter_quantiles().items():
+            unit, s = _unit(name)
+            row = [name, unit] + [f"{s * v:.5g}" for v in (*pq, *qq)]
+            rows.append(row)
+            w.writerow(row)
+    paths.append(out / "parameters.csv")
+    doc = _doc(post)
+    with atomic_open(out / "update.json") as fh:
+        json.dump(doc, fh, indent=2)
+    paths.append(out / "update.json")
+    fig = plot_update(post)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    png = buf.getvalue()
+    with atomic_path(out / "lobes.png") as tmp:
+        Path(tmp).write_bytes(png)
+    paths.append(out / "lobes.png")
+    with atomic_open(out / "report.html", encoding="utf-8") as fh:
+        fh.write(_html(post, doc, rows, png))
+    paths.append(out / "report.html")
+    return paths
+
+
+def _html(post, doc, rows, png) -> str:
+    e = html.escape
+    rc, nc = doc["recommended"], doc["next_cut"]
+    cut_rows = "".join(f"<tr><td>{c['rpm']:.0f}</td><td>{c['depth_mm']:.3f}</td><td>{c['result']}</td>"
+                       f"<td>{'' if c['chatter_hz'] is None else format(c['chatter_hz'], '.1f')}</td></tr>"
+                       for c in doc["cuts"])
+    par_rows = "".join("<tr>" + "".join(f"<td>{e(str(v))}</td>" for v in r) + "</tr>" for r in rows)
+    s = doc["sampler"]
+    return (
+        "<!doctype html><html><head><meta charset='utf-8'><title>toolpoint update</title><style>"
+        "body{font-family:sans-serif;max-width:960px;margin:auto}table{border-collapse:collapse}"
+        "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}</style></head><body>"
+        f"<h1>Test cuts → lobes: {e(post.prior.name)}</h1>"
+        f"<p><b>Recommended</b>: {rc['rpm']:.0f} rpm at {rc['depth_mm']:.3f} mm (P(stable) {rc['p_stable']:.2f}; "
+        f"median limit {rc['limit_p50_mm']:.3f} mm).<br><b>Next test cut</b> ({e(nc['rule'])}: "
+        f"{e(nc['description'])}): {nc['rpm']:.0f} rpm at {nc['depth_mm']:.3f} mm, P(chatter) "
+        f"{nc['p_chatter']:.2f}.</p>"
+        f"<img alt='lobes' style='max-width:100%' src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
+        f"<h2>Test cuts</h2><table><tr><th>rpm</th><th>depth mm</th><th>result</th><th>chatter Hz</th></tr>"
+        f"{cut_rows}</table>"
+        "<h2>Parameters (5 / 50 / 95 %)</h2><table><tr><th>name</th><th>unit</th><th>prior 5</th><th>prior 50</th>"
+        f"<th>prior 95</th><th>post 5</th><th>post 50</th><th>post 95</th></tr>{par_rows}</table>"
+        f"<p>Sampler: {e(s['method'])}, {s['samples']} samples, ESS per step {e(str(s['ess']))}, acceptance "
+        f"{s['acceptance']}, {s['cpu_s']} s CPU. Files: lobes.csv, p_stable.csv, parameters.csv, update.json.</p>"
+        "</body></html>")

@@ -1,0 +1,461 @@
+r"""Bayesian update of the stability lobes from test cuts, and the next test cut.
+
+Likelihood of a test cut at speed n and depth a (Karandikar et al. 2014 and Cornelius et al. 2024 use the
+same kind of model; here with label noise and a chatter-frequency term):
+
+    P(stable | θ) = ε + (1 − 2ε) Φ( ln(a_lim(θ, n) / a) / w ),
+
+w (default 0.05) the relative width of the fuzzy boundary (a cut 5 % below the limit is stable with
+probability Φ(1) = 0.84: the limit of a real cut is not a sharp line), ε (default 0.02) the probability that
+a label is simply wrong. A chattering cut with a measured chatter frequency f adds
+
+    p(f | θ) = (1 − ε_f) N(d; 0, (σ_f f)²) + ε_f / f,   d = min_j |f − (f_c(θ, n) + j N n/60)|, j = −2…2,
+
+f_c the frequency of the limiting lobe at n (a detector may report an alias f_c + j f_t), σ_f = 2 %.
+
+The posterior is sampled by sequential Monte Carlo (Chopin 2002; Del Moral, Doucet & Jasra 2006): prior
+samples are tempered, L^β with β from 0 to 1 in steps that keep the effective sample size at half the
+samples, resampled (systematic), and moved by random-walk Metropolis steps in the prior's standard-normal
+coordinates with the particles' covariance (scale 2.38/√d, adapted to the acceptance). ``method="sir"``
+is plain sampling–importance resampling from the prior, kept to measure against: see
+``docs/design/shop.md``.
+
+Lobes: the posterior samples' zero-order limits on a speed grid (:func:`~toolpoint.stability.zoa_batch.zoa_limits`),
+their 5/50/95 % quantiles and P(stable) = share of samples whose limit exceeds a depth.
+
+Recommended point: the speed that maximises n · a₀₅(n) (removal rate at a fixed feed per tooth and width)
+at the depth a₀₅ (P(stable) = 0.95). **Next test cut**, two rules:
+
+* ``"info"`` (default): the cut that most reduces the expected relative width (a₉₅ − a₀₅)/a₅₀ of the limit at
+  the recommended speed, among cuts at the most productive speeds (the 6 best by n · a₅₀ and the
+  recommended one) and depths with P(chatter) ≤ ``risk`` (default 0.3): for each candidate the posterior after
+  "stable" and after "chatter" is the current samples reweighted by the cut's likelihood, and the expected
+  width is P(stable) W_stable + P(chatter) W_chatter;
+* ``"risk"``: the most productive cut (max n · a) whose P(chatter) ≤ ``risk`` (default 0.1) — the depth
+  a_risk(n), the ``risk`` quantile of the limit.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.special import log_ndtr
+
+from ..errors import InputError
+from ..stability.zoa_batch import zoa_limits
+from .model import ModalPrior, limit_at_speeds, receptance
+
+__all__ = ["TestCut", "Posterior", "read_test_cuts", "check_consistent", "log_likelihood", "update"]
+
+
+@dataclass(frozen=True)
+class TestCut:
+    """One test cut: speed (rpm), depth (m), stable or not, measured chatter frequency (Hz) if any."""
+
+    __test__ = False  # a shop's test cut, not a pytest test class
+
+    rpm: float
+    depth_m: float
+    stable: bool
+    chatter_hz: float | None = None
+    line: int | None = None
+    source: str | None = None
+
+
+def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
+    """Read a test-cut table: CSV ``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz`` and ``record``.
+
+    A ``record`` (path relative to the table) is analysed by :func:`toolpoint.shop.analyse_cut` (needs
+    ``teeth``): it gives ``result`` and ``chatter_hz`` where the table leaves them empty; where both are given
+    and disagree the table is refused (a contradiction is reported, not averaged).
+
+    Raises
+    ------
+    InputError
+        Naming the file, the line and the field.
+    """
+    from ..io.table import read_table
+
+    p = Path(path)
+    header, rows = read_table(p, what="the test-cut table")
+    for need in ("rpm", "depth_mm"):
+        if need not in header:
+            raise InputError(f"missing column {need!r} (columns: {', '.join(header) or 'none'})", file=p, field=need)
+    if "result" not in header and "record" not in header:
+        raise InputError("needs a column 'result' (stable|chatter) or 'record'", file=p, field="result")
+    cuts = []
+    for line, row in rows:
+        def num(name, *, required=True, lo=0.0):
+            v = (row.get(name) or "").strip()
+            if not v:
+                if required:
+                    raise InputError(f"line {line}: empty", file=p, field=name)
+                return None
+            try:
+                x = float(v)
+            except ValueError:
+                raise InputError(f"line {line}: {v!r} is not a number", file=p, field=name) from None
+            if not (math.isfinite(x) and x > lo):
+                raise InputError(f"line {line}: must be a finite number > {lo:g}, got {v}", file=p, field=name)
+            return x
+        rpm, depth = num("rpm"), num("depth_mm")
+        if rpm > 200_000:
+            raise InputError(f"line {line}: {rpm:g} rpm is not a spindle speed", file=p, field="rpm")
+        if depth > 1000:
+            raise InputError(f"line {line}: {depth:g} mm is not a depth of cut", file=p, field="depth_mm")
+        fc = num("chatter_hz", required=False)
+        res = (row.get("result") or "").strip().lower()
+        if res and res not in ("stable", "chatter"):
+            raise InputError(f"line {line}: must be 'stable' or 'chatter', got {res!r}", file=p, field="result")
+        rec = (row.get("record") or "").strip()
+        if rec:
+            if teeth is None:
+                raise InputError(f"line {line}: a record needs the number of teeth", file=p, field="record")
+            from ..io.records import read_cut_record
+            from .detect import analyse_cut
+
+            rp = (p.parent / rec) if not Path(rec).is_absolute() else Path(rec)
+            r = read_cut_record(rp)
+            a = analyse_cut(r.samples, r.rate_hz, rpm=rpm, teeth=teeth, full_scale=r.full_scale, source=str(rp),
+                            **(cut_options or {}))
+            if res and res != a.verdict:
+                raise InputError(f"line {line}: the table says {res}, its record {rec} says {a.verdict}"
+                                 + (f" at {a.chatter_hz:.1f} Hz" if a.chatter_hz else ""), file=p, field="result")
+            res = a.verdict
+            if fc is None and a.chatter_hz is not None:
+                fc = a.chatter_hz
+        if not res:
+            raise InputError(f"line {line}: empty (and no record)", file=p, field="result")
+        if res == "stable" and fc is not None:
+            raise InputError(f"line {line}: a stable cut has no chatter frequency", file=p, field="chatter_hz")
+        cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p)))
+    if not cuts:
+        raise InputError("no test cuts", file=p, field="rpm")
+    check_consistent(cuts, source=str(p))
+    return cuts
+
+
+def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, source: str | None = None) -> None:
+    """Refuse labels that contradict each other: at one speed (±``rpm_rel``), a stable cut deeper than a
+    chattering one by more than ``depth_rel`` (more than the fuzzy boundary explains), or the same cut both ways.
+
+    Raises
+    ------
+    InputError
+        Naming the two lines (field ``result``).
+    """
+    for i, a in enumerate(cuts):
+        for b in cuts[i + 1:]:
+            if abs(a.rpm / b.rpm - 1) > rpm_rel or a.stable == b.stable:
+                continue
+            s, c = (a, b) if a.stable else (b, a)
+            if s.depth_m >= c.depth_m * (1 + depth_rel) or (s.depth_m == c.depth_m):
+                raise InputError(f"lines {s.line} and {c.line} contradict each other: stable at "
+                                 f"{1e3 * s.depth_m:g} mm but chatter at {1e3 * c.depth_m:g} mm "
+                                 f"({s.rpm:g} / {c.rpm:g} rpm); check the labels", file=source, field="result")
+
+
+def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.05, label_noise: float = 0.02,
+                   freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None) -> np.ndarray:
+    """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,)."""
+    rpm = np.array([c.rpm for c in cuts])
+    depth = np.array([c.depth_m for c in cuts])
+    stable = np.array([c.stable for c in cuts])
+    a_lim, f_c = limit_at_speeds(prior, theta, rpm, freq_hz)
+    with np.errstate(divide="ignore"):
+        x = (np.log(a_lim) - np.log(depth)[None, :]) / boundary_width
+    x = np.where(np.isfinite(x), x, 50.0)  # no lobe reaches the speed: stable at any depth in the grid
+    eps = label_noise
+    ls = np.logaddexp(np.log(eps), np.log1p(-2 * eps) + log_ndtr(x))  # ln P(stable)
+    lc = np.logaddexp(np.log(eps), np.log1p(-2 * eps) + log_ndtr(-x))  # ln P(chatter)
+    ll = np.where(stable[None, :], ls, lc).sum(axis=1)
+    N = prior.cutting.teeth
+    for r, c in enumerate(cuts):
+        if c.stable or c.chatter_hz is None:
+            continue
+        ft = N * c.rpm / 60.0
+        alias = f_c[:, r, None] + ft * np.arange(-2, 3)[None, :]
+        d = np.nanmin(np.abs(c.chatter_hz - alias), axis=1) if np.any(np.isfinite(f_c[:, r])) else \
+            np.full(f_c.shape[0], np.inf)
+        d = np.where(np.isfinite(d), d, np.inf)
+        sd = freq_sigma * c.chatter_hz
+        gauss = -0.5 * (d / sd) ** 2 - math.log(sd * math.sqrt(2 * math.pi))
+        ll = ll + np.logaddexp(math.log(1 - freq_outlier) + gauss, math.log(freq_outlier / c.chatter_hz))
+    return ll
+
+
+@dataclass(frozen=True)
+class Posterior:
+    """Result of :func:`update` (SI inside: depths m, frequencies Hz, K_t N/m²).
+
+    Attributes
+    ----------
+    prior : ModalPrior
+    cuts : tuple of TestCut
+    method : str
+        ``"smc"`` or ``"sir"``.
+    z : ndarray, shape (S, P)
+        Equally weighted posterior samples in the prior's standard-normal coordinates.
+    ess : tuple of float
+        Effective sample sizes at each tempering step (SIR: the one).
+    acceptance : float
+        Mean Metropolis acceptance (SMC; nan for SIR).
+    rpm : ndarray, shape (G,)
+    limit_q_m : ndarray, shape (3, G)
+        5/50/95 % quantiles of the limit.
+    depth_m : ndarray, shape (D,)
+    p_stable : ndarray, shape (D, G)
+    prior_limit_q_m : ndarray, shape (3, G)
+        The prior's quantiles, for comparison.
+    recommended : dict
+        ``rpm``, ``depth_m`` (the 5 % limit), ``p_stable``.
+    next_cut : dict
+        ``rule``, ``risk``, ``rpm``, ``depth_m``, ``p_chatter``.
+    cpu_s : float
+        CPU time of the update.
+    """
+
+    prior: ModalPrior
+    cuts: tuple
+    method: str
+    z: np.ndarray
+    ess: tuple
+    acceptance: float
+    rpm: np.ndarray
+    limit_q_m: np.ndarray
+    depth_m: np.ndarray
+    p_stable: np.ndarray
+    prior_limit_q_m: np.ndarray
+    recommended: dict
+    next_cut: dict
+    cpu_s: float
+
+    @property
+    def theta(self) -> np.ndarray:
+        """Posterior samples of the parameters (S, P), SI."""
+        return self.prior.theta(self.z)
+
+    def parameter_quantiles(self) -> dict:
+        """name → (prior 5/50/95 %, posterior 5/50/95 %) of each parameter (SI)."""
+        zq = np.array([-1.6448536269514729, 0.0, 1.6448536269514729])
+        prior_q = np.exp(self.prior.log_median[None, :] + zq[:, None] * self.prior.sigma[None, :])
+        post_q = np.quantile(self.theta, [0.05, 0.5, 0.95], axis=0)
+        return {n: (tuple(prior_q[:, k]), tuple(post_q[:, k])) for k, n in enumerate(self.prior.names)}
+
+
+def _systematic(w, rng):
+    n = w.size
+    u = (rng.random() + np.arange(n)) / n
+    return np.minimum(np.searchsorted(np.cumsum(w), u), n - 1)
+
+
+def _ess(logw):
+    w = np.exp(logw - logw.max())
+    return float(w.sum() ** 2 / np.sum(w * w))
+
+
+def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int = 1000, method: str = "smc",
+           rpm_grid=None, n_moves: int = 3, boundary_width: float = 0.05, label_noise: float = 0.02,
+           freq_sigma: float = 0.02, rule: str = "info", risk: float | None = None, lobe_samples: int = 400,
+           n_depths: int = 60) -> Posterior:
+    """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
+
+    Parameters
+    ----------
+    prior : ModalPrior
+    cuts : sequence of TestCut
+        May be empty (then the prior's lobes and first cut).
+    rng : numpy.random.Generator
+        Seeds everything stochastic.
+    n_samples : int, default 1000
+        Particles.
+    method : {"smc", "sir"}
+    rpm_grid : array_like, optional
+        Speeds of the lobes, rpm (default: 200 speeds over the lobes k = 0…4 of the prior's modes).
+    n_moves : int, default 3
+        Metropolis moves per tempering step.
+    boundary_width, label_noise, freq_sigma
+        The likelihood's w, ε and σ_f.
+    rule : {"info", "risk"}, default "info"
+        How the next test cut is chosen (module docstring).
+    risk : float, optional
+        Largest P(chatter) of the next test cut (default 0.3 for ``"info"``, 0.1 for ``"risk"``).
+    lobe_samples : int, default 400
+        Posterior samples whose lobes are computed.
+    n_depths : int, default 60
+        Depths of the P(stable) map.
+
+    Returns
+    -------
+    Posterior
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from toolpoint.shop.model import cornelius_2024
+    >>> pr = cornelius_2024(0.1)
+    >>> post = update(pr, [TestCut(12000.0, 0.4e-3, False, 1280.0)], rng=np.random.default_rng(1), n_samples=300,
+    ...               lobe_samples=100)
+    >>> post.next_cut["rule"], 0 < post.next_cut["p_chatter"] <= 0.3
+    ('info', True)
+    """
+    import time
+
+    c0 = time.process_time()
+    if method not in ("smc", "sir"):
+        raise InputError(f"must be 'smc' or 'sir', got {method!r}", field="method")
+    if rule not in ("risk", "info"):
+        raise InputError(f"must be 'risk' or 'info', got {rule!r}", field="rule")
+    risk = (0.1 if rule == "risk" else 0.3) if risk is None else risk
+    if not 0 < risk <= 0.5:
+        raise InputError(f"must be in (0, 0.5], got {risk}", field="risk")
+    cuts = tuple(cuts)
+    f = prior.freq_grid()
+    P = prior.sigma.size
+    free = prior.sigma > 0
+    kw = dict(boundary_width=boundary_width, label_noise=label_noise, freq_sigma=freq_sigma, freq_hz=f)
+    z = rng.standard_normal((n_samples, P)) * free
+    ess_hist, acc = [], []
+    if cuts:
+        ll = log_likelihood(prior, prior.theta(z), cuts, **kw)
+        if method == "sir":
+            ess_hist.append(_ess(ll))
+            w = np.exp(ll - ll.max())
+            z = z[_systematic(w / w.sum(), rng)]
+        else:
+            beta = 0.0
+            while beta < 1.0:
+                lo, hi = 0.0, 1.0 - beta
+                if _ess(hi * ll) >= n_samples / 2:
+                    d = hi
+                else:
+                    for _ in range(30):  # bisection on the tempering step
+                        mid = 0.5 * (lo + hi)
+                        lo, hi = (mid, hi) if _ess(mid * ll) >= n_samples / 2 else (lo, mid)
+                    d = max(lo, 1e-6)
+                beta = min(1.0, beta + d)
+                ess_hist.append(_ess(d * ll))
+                w = np.exp(d * (ll - ll.max()))
+                idx = _systematic(w / w.sum(), rng)
+                z, ll = z[idx], ll[idx]
+                cov = np.cov(z[:, free].T) if free.sum() > 1 else np.var(z[:, free]).reshape(1, 1)
+                chol = np.linalg.cholesky(cov + 1e-9 * np.eye(int(free.sum())))
+                scale = 2.38 / math.sqrt(free.sum())
+                for _ in range(n_moves):
+                    prop = z.copy()
+                    prop[:, free] += scale * rng.standard_normal((n_samples, int(free.sum()))) @ chol.T
+                    llp = log_likelihood(prior, prior.theta(prop), cuts, **kw)
+                    log_a = -0.5 * (np.sum(prop ** 2, 1) - np.sum(z ** 2, 1)) + beta * (llp - ll)
+                    ok = np.log(rng.random(n_samples)) < log_a
+                    z[ok], ll[ok] = prop[ok], llp[ok]
+                    rate = float(ok.mean())
+                    acc.append(rate)
+                    scale *= 1.3 if rate > 0.3 else (0.7 if rate < 0.15 else 1.0)
+    # lobes of the posterior and of the prior
+    grid = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)
+    m = min(lobe_samples, n_samples)
+    pick = rng.choice(n_samples, m, replace=False)
+    lim = _limits(prior, prior.theta(z[pick]), f, grid)
+    zp = rng.standard_normal((m, P)) * free
+    lim_prior = _limits(prior, prior.theta(zp), f, grid)
+    q = np.quantile(lim, [0.05, 0.5, 0.95], axis=0)
+    qp = np.quantile(lim_prior, [0.05, 0.5, 0.95], axis=0)
+    top = 1.5 * float(np.max(np.where(np.isfinite(q[2]), q[2], 0.0)))
+    top = top if top > 0 else 1e-3
+    depths = np.linspace(0, top, n_depths + 1)[1:]
+    p_st = (lim[None, :, :] > depths[:, None, None]).mean(axis=1)
+    q05 = np.where(np.isfinite(q[0]), q[0], np.nan)
+    j = int(np.nanargmax(grid * q05))
+    rec = {"rpm": float(grid[j]), "depth_m": float(q05[j]), "p_stable": float(np.mean(lim[:, j] > q05[j])),
+           "limit_p50_m": float(q[1, j]), "limit_p95_m": float(q[2, j])}
+    if rule == "risk":
+        qr = np.quantile(lim, risk, axis=0)
+        qr = np.where(np.isfinite(qr), qr, np.nan)
+        k = int(np.nanargmax(grid * qr))
+        nxt = {"rule": "risk", "risk": risk, "rpm": float(grid[k]), "depth_m": float(qr[k]),
+               "p_chatter": float(np.mean(lim[:, k] <= qr[k])),
+               "description": f"most productive cut (max rpm × depth) with P(chatter) ≤ {risk:g}"}
+    else:
+        nxt = _next_info(lim, grid, j, risk, boundary_width, label_noise)
+    return Posterior(prior, cuts, method, z, tuple(ess_hist), float(np.mean(acc)) if acc else float("nan"), grid, q,
+                     depths, p_st, qp, rec, nxt, time.process_time() - c0)
+
+
+def _default_grid(prior: ModalPrior) -> np.ndarray:
+    """200 speeds over the prior's ``rpm_range``, else from the 5th to beyond the 0th lobe of its modes."""
+    if prior.rpm_range is not None:
+        return np.linspace(*prior.rpm_range, 200)
+    N = prior.cutting.teeth
+    f = np.asarray(prior.freq_hz)
+    lo = 60 * f.min() / (N * 5.5)
+    hi = 60 * f.max() / (N * 0.7)
+    return np.linspace(lo, hi, 200)
+
+
+def _limits(prior, theta, f, grid):
+    """Zero-order limits (S, G) of the samples: the limit scales as 1/K_t at fixed K_r (H scaled by K_t / K_t0),
+    and K_r (small spread) is taken per quartile bin at the bin's median."""
+    from dataclasses import replace
+
+    H = receptance(prior, theta, f)
+    out = np.empty((theta.shape[0], grid.size))
+    m = prior.modes
+    kt0 = prior.cutting.tangential_coeff
+    kt, kr = theta[:, 3 * m], theta[:, 3 * m + 1]
+    edges = np.quantile(kr, np.linspace(0, 1, 5))
+    which = np.clip(np.searchsorted(edges, kr, "right") - 1, 0, 3)
+    for b in range(4):  # four bins, not a loop over samples
+        sel = which == b
+        if sel.any():
+            cut = replace(prior.cutting, radial_ratio=float(np.median(kr[sel])))
+            out[sel] = zoa_limits(f, H[sel] * (kt[sel, None] / kt0), cut, grid)
+    return out
+
+
+def _wquantile_width(vals_sorted, w):
+    """Relative 5–95 % width of the weighted samples: rows of ``w`` (C, S) in the order of ``vals_sorted``."""
+    c = np.cumsum(w, axis=1)
+    c /= c[:, -1:]
+    lo = vals_sorted[np.minimum((c < 0.05).sum(axis=1), vals_sorted.size - 1)]
+    mid = vals_sorted[np.minimum((c < 0.5).sum(axis=1), vals_sorted.size - 1)]
+    hi = vals_sorted[np.minimum((c < 0.95).sum(axis=1), vals_sorted.size - 1)]
+    return (hi - lo) / mid
+
+
+def _next_info(lim, grid, j_rec, risk, width, eps):
+    """The ``"info"`` rule: min expected relative band width at the recommended speed, P(chatter) ≤ risk."""
+    from scipy.special import ndtr
+
+    q50 = np.quantile(lim, 0.5, axis=0)
+    score = np.where(np.isfinite(q50), grid * q50, -np.inf)
+    speeds = np.unique(np.r_[np.argsort(-score)[:6], j_rec])
+    levels = np.linspace(0.02, risk, 12)
+    target = lim[:, j_rec]
+    order = np.argsort(target)
+    ts = np.where(np.isfinite(target[order]), target[order], 1e9)
+    cand = []
+    for k in speeds:  # a few speeds; vectorised over depths and samples
+        depths = np.quantile(lim[:, k], levels)
+        ok = np.isfinite(depths) & (depths > 0)
+        if not ok.any():
+            continue
+        depths = depths[ok]
+        with np.errstate(divide="ignore"):
+            x = (np.log(lim[None, :, k]) - np.log(depths[:, None])) / width  # (C, S)
+        ps = eps + (1 - 2 * eps) * ndtr(np.where(np.isfinite(x), x, 50.0))
+        p_stable = ps.mean(axis=1)
+        ws, wc = ps[:, order], (1 - ps)[:, order]
+        exp_w = p_stable * _wquantile_width(ts, ws) + (1 - p_stable) * _wquantile_width(ts, wc)
+        for d, pst, e in zip(depths, p_stable, exp_w):
+            cand.append((float(e), -float(grid[k] * d), int(k), float(d), float(1 - pst)))
+    cand = [c for c in cand if c[4] <= risk + 1e-9] or cand
+    e, _, k, d, pc = min(cand)
+    now = float(_wquantile_width(ts, np.ones((1, ts.size)))[0])
+    return {"rule": "info", "risk": risk, "rpm": float(grid[k]), "depth_m": d, "p_chatter": pc,
+            "expected_width": e, "width_now": now,
+            "description": "the cut that most reduces the expected relative 5–95 % width of the limit at the "
+                           f"recommended speed, among productive speeds, with P(chatter) ≤ {risk:g}"}

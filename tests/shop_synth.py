@@ -1,0 +1,52 @@
+"""Synthetic shop microphone records of milling cuts, written independently of the detector.
+
+A record: air cut (spindle running, not cutting), entry, cut, exit, air cut. What a microphone in a
+shop hears, and what is modelled here:
+
+* spindle: all multiples of f_s = rpm/60 (runout), amplitude ∝ 1/k, weak in air cut;
+* cutting: the tooth-passing frequency f_t = N f_s and its harmonics, strong (forced vibration),
+  plus broadband cutting noise;
+* room: pink-ish noise (integrated white noise, high-passed) and fan/pump tones at fixed
+  frequencies that are not spindle multiples, the same in air cut and cut;
+* chatter: a tone at f_c with aliases f_c ± f_t, growing in over ``onset_s`` and wandering ±0.1 % in
+  frequency; at entry a decaying free vibration at the mode (stable cuts too).
+"""
+
+import numpy as np
+
+
+def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_amp=1.0, air_s=1.0, cut_s=2.0,
+                fans=(617.0, 1813.0), fan_amp=0.3, noise=0.05, mode_hz=None, seed=0):
+    """(samples, rate, cut start s, cut end s)."""
+    rng = np.random.default_rng(seed)
+    n = int((2 * air_s + cut_s) * rate)
+    t = np.arange(n) / rate
+    f_s = rpm / 60.0
+    t0, t1 = air_s, air_s + cut_s
+    ramp = np.clip((t - t0) / 0.05, 0, 1) * np.clip((t1 - t) / 0.05, 0, 1)  # tool in the part
+    x = np.zeros(n)
+    kmax = int(min(8000.0, 0.45 * rate) / f_s)
+    phases = rng.uniform(0, 2 * np.pi, kmax + 1)
+    for k in range(1, kmax + 1):  # loops over harmonics (tens), not samples
+        tooth = k % teeth == 0
+        a_air = 0.02 / k
+        a_cut = (1.0 if tooth else 0.1) / (k / teeth) ** 1.2
+        x += (a_air + a_cut * ramp) * np.sin(2 * np.pi * k * f_s * t + phases[k])
+    for f in fans:
+        x += fan_amp * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+    room = np.cumsum(rng.standard_normal(n))
+    room -= np.convolve(room, np.ones(441) / 441, mode="same")  # high-pass: pink-ish, no drift
+    x += noise * room / room.std()
+    x += 3 * noise * ramp * rng.standard_normal(n)  # cutting noise
+    f_t = teeth * f_s
+    if mode_hz is not None:  # entry transient: free vibration of the mode, decaying in 0.05 s
+        te = np.clip(t - t0, 0, None)
+        x += 0.5 * (t >= t0) * np.exp(-te / 0.05) * np.sin(2 * np.pi * mode_hz * te)
+    if chatter_hz is not None:
+        grow = np.clip((t - t0 - 0.1) / 0.3, 0, 1) * ramp
+        wander = 1 + 1e-3 * np.sin(2 * np.pi * 0.7 * t)
+        phase = 2 * np.pi * np.cumsum(chatter_hz * wander) / rate
+        x += chatter_amp * grow * np.sin(phase)
+        for j, a in ((-1, 0.3), (1, 0.2)):
+            x += chatter_amp * a * grow * np.sin(phase + 2 * np.pi * j * f_t * t)
+    return x / (1.5 * np.abs(x).max()), rate, t0, t1

@@ -1,0 +1,40 @@
+"""``cut`` on records of simulated cuts (tests/milling_sim.py: time-domain, nonlinear chip), truth from the SDM."""
+
+import numpy as np
+import pytest
+
+from milling_sim import microphone, simulate
+from toolpoint.shop import analyse_cut
+from toolpoint.shop.model import cornelius_2024
+from toolpoint.stability import ModalModel, sdm_lobes
+
+
+@pytest.mark.slow
+def test_verdicts_on_simulated_records_follow_the_sdm_limit():
+    pr = cornelius_2024()
+    c = pr.cutting
+    fn, k, z = np.array(pr.freq_hz), np.array(pr.stiffness_n_m), np.array(pr.damping)
+    mm = ModalModel(fn, z, k / (2 * np.pi * fn) ** 2)
+    speeds = np.array([9000.0, 20000.0])
+    lim = sdm_lobes(mm, mm, c, rpm=speeds).depth_m
+    phi_st, phi_ex = c.immersion_angles
+    for rpm, a_lim in zip(speeds, lim):
+        for rel, want in ((0.75, "stable"), (1.3, "chatter")):
+            sim = simulate(fn, k, z, teeth=4, kt=c.tangential_coeff, kr=c.radial_ratio, phi_st=phi_st,
+                           phi_ex=phi_ex, rpm=[rpm], depth_m=[rel * a_lim], revolutions=max(60, int(rpm / 100)),
+                           seed=3)[0]
+            x, rate, *_ = microphone(sim, rpm=rpm, teeth=4, seed=4)
+            r = analyse_cut(x, rate, rpm=rpm, teeth=4, full_scale=1.0)
+            assert r.verdict == want, (rpm, rel)
+            if want == "chatter":
+                # the chatter frequency, modulo tooth-passing aliases, is the simulated displacement's
+                t, xd, yd = sim[0], sim[1], sim[2]
+                h = xd.size // 2
+                sig = (xd + yd)[h:] - np.mean((xd + yd)[h:])
+                f = np.fft.rfftfreq(sig.size, t[1] - t[0])
+                p = np.abs(np.fft.rfft(sig * np.hanning(sig.size))) ** 2
+                kk = np.round(f * 60 / rpm)
+                p[(np.abs(f - kk * rpm / 60) < 3 * f[1] + 0.002 * f) | (f < 100)] = 0
+                f_true = f[np.argmax(p)]
+                alias = f_true + 4 * rpm / 60 * np.arange(-3, 4)
+                assert np.min(np.abs(r.chatter_hz - alias)) / f_true < 0.01

@@ -1,0 +1,197 @@
+"""``toolpoint update``: the forward model against zoa_limits, the sampler against quadrature, calibration of the
+bands out of sample, contradictory tables, the files, the library adapter, a virtual campaign."""
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from toolpoint.cli.main import main
+from toolpoint.errors import InputError
+from toolpoint.shop.campaign import virtual_campaign
+from toolpoint.shop.model import ModalPrior, cornelius_2024, limit_at_speeds, receptance
+from toolpoint.shop.prior import prior_from_library, read_modal_prior
+from toolpoint.shop.update import TestCut, log_likelihood, read_test_cuts, update
+from toolpoint.stability.zoa_batch import zoa_limits
+
+
+def test_limit_at_speeds_matches_zoa_limits_on_two_modes():
+    """Second method: the lobe crossings at single speeds vs zoa_limits' interpolated lobes (same K_t, K_r)."""
+    pr = replace(cornelius_2024(0.15), sigma_kt=0.0, sigma_kr=0.0)
+    th = pr.sample(40, np.random.default_rng(0)).theta
+    f = pr.freq_grid()
+    rpm = np.array([6100.0, 9000.0, 13000.0, 17500.0, 21000.0])
+    a, fc = limit_at_speeds(pr, th, rpm, f)
+    ref = zoa_limits(f, receptance(pr, th, f), pr.cutting, rpm, subdivide=16)
+    np.testing.assert_allclose(a, ref, rtol=5e-3)
+    # the chatter frequency lies near a mode, above it (the ZOA's chatter is on the rising phase side)
+    fn = th[:, :2]
+    near = np.min(np.abs(fc[:, :, None] / fn[:, None, :] - 1), axis=2)
+    assert np.all(near < 0.25)
+
+
+def _kt_only(sig=0.2):
+    return replace(cornelius_2024(0.1), sigma_freq=(0.0, 0.0), sigma_stiffness=(0.0, 0.0), sigma_damping=(0.0, 0.0),
+                   sigma_kt=sig, sigma_kr=0.0)
+
+
+def test_smc_posterior_matches_quadrature_on_one_parameter():
+    """Only K_t uncertain: the exact posterior on a fine grid of ln K_t vs the SMC samples' quantiles."""
+    pr = _kt_only()
+    cuts = [TestCut(20000.0, 0.55e-3, True), TestCut(20000.0, 0.75e-3, False, 1290.0), TestCut(9000.0, 0.5e-3, True)]
+    zg = np.linspace(-5, 5, 2001)
+    zz = np.zeros((zg.size, pr.sigma.size))
+    zz[:, -2] = zg
+    lp = -0.5 * zg ** 2 + log_likelihood(pr, pr.theta(zz), cuts)
+    w = np.exp(lp - lp.max())
+    cdf = np.cumsum(w) / w.sum()
+    exact = np.interp([0.05, 0.5, 0.95], cdf, zg)
+    post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50)
+    got = np.quantile(post.z[:, -2], [0.05, 0.5, 0.95])
+    np.testing.assert_allclose(got, exact, atol=0.08)
+    assert exact[2] - exact[0] < 0.6 * 2 * 1.645  # the cuts did narrow it
+
+
+@pytest.mark.slow
+def test_bands_are_calibrated_out_of_sample():
+    """Truths drawn from the prior, three cuts at random speeds and depths labelled by the truth: the posterior
+    5–95 % band of the limit holds the true limit at a random speed about 90 % of the time."""
+    pr = cornelius_2024(0.12)
+    rng = np.random.default_rng(11)
+    inside = []
+    for _ in range(40):
+        truth = pr.theta(rng.standard_normal((1, pr.sigma.size)))
+        rpm = rng.uniform(5000, 25000, 3)
+        a_true, fc = limit_at_speeds(pr, truth, rpm)
+        depth = a_true[0] * np.exp(rng.normal(0, 0.3, 3))
+        cuts = [TestCut(r, d, bool(d < a), None if d < a else float(f))
+                for r, d, a, f in zip(rpm, depth, a_true[0], fc[0])]
+        post = update(pr, cuts, rng=rng, n_samples=500, lobe_samples=200, rpm_grid=np.linspace(5000, 25000, 40))
+        g = rng.integers(40)
+        truth_lim = zoa_limits(pr.freq_grid(), receptance(pr, truth, pr.freq_grid()) * truth[0, 6] / 2003e6,
+                               replace(pr.cutting, radial_ratio=float(truth[0, 7])), post.rpm[g:g + 1])[0, 0]
+        inside.append(post.limit_q_m[0, g] <= truth_lim <= post.limit_q_m[2, g])
+    assert 0.78 <= np.mean(inside) <= 0.99
+
+
+def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):
+    p = tmp_path / "cuts.csv"
+    p.write_text("rpm,depth_mm,result\n12000,1.0,stable\n12000,0.5,chatter\n15000,0.4,stable\n")
+    with pytest.raises(InputError, match="lines 2 and 3 contradict"):
+        read_test_cuts(p)
+    prior = tmp_path / "prior.toml"
+    prior.write_text(PRIOR_TOML)
+    assert main(["update", "--prior", str(prior), "--cuts", str(p), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "cuts.csv" in err and "result" in err
+    assert not (tmp_path / "o" / "report.html").exists()
+    # within the fuzzy boundary (5 %) a stable cut above a chattering one is noise, not a contradiction
+    p.write_text("rpm,depth_mm,result\n12000,0.52,stable\n12000,0.5,chatter\n")
+    assert len(read_test_cuts(p)) == 2
+
+
+@pytest.mark.parametrize("text,field", [
+    ("rpm,depth_mm,result\n12000,-1,stable\n", "depth_mm"), ("rpm,depth_mm,result\n12000,1,maybe\n", "result"),
+    ("rpm,result\n12000,stable\n", "depth_mm"), ("rpm,depth_mm,result,chatter_hz\n1e9,1,chatter,900\n", "rpm")])
+def test_bad_tables_name_the_field(tmp_path, text, field):
+    p = tmp_path / "c.csv"
+    p.write_text(text)
+    with pytest.raises(InputError, match=field):
+        read_test_cuts(p)
+
+
+PRIOR_TOML = """name = "two modes"
+[cut]
+teeth = 4
+tangential_coeff_n_mm2 = 2003
+radial_ratio = 0.404
+radial_immersion = 0.5
+milling = "down"
+rpm_min = 5000
+rpm_max = 25000
+[[mode]]
+freq_hz = 1243
+stiffness_n_m = 2.92e6
+damping = 0.0619
+[[mode]]
+freq_hz = 1747
+stiffness_n_m = 1.2e7
+damping = 0.0288
+"""
+
+
+def test_cli_update_writes_files_and_report(tmp_path, capsys):
+    prior = tmp_path / "prior.toml"
+    prior.write_text(PRIOR_TOML)
+    cuts = tmp_path / "cuts.csv"
+    cuts.write_text("rpm,depth_mm,result,chatter_hz\n20000,0.5,stable,\n20000,0.9,chatter,1290\n12000,0.3,stable,\n")
+    out = tmp_path / "out"
+    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(out), "--samples", "300"]) == 0
+    assert "next test cut (info)" in capsys.readouterr().out
+    for name in ("lobes.csv", "p_stable.csv", "parameters.csv", "update.json", "lobes.png", "report.html"):
+        assert (out / name).stat().st_size > 100
+    doc = json.loads((out / "update.json").read_text())
+    assert doc["next_cut"]["rule"] == "info" and doc["next_cut"]["p_chatter"] <= 0.3
+    assert 5000 <= doc["recommended"]["rpm"] <= 25000 and len(doc["cuts"]) == 3
+    html = (out / "report.html").read_text()
+    assert "data:image/png;base64," in html and "src='http" not in html and "<script src" not in html
+    lobes = np.genfromtxt(out / "lobes.csv", delimiter=",", names=True)
+    assert np.all(lobes["p05_mm"] <= lobes["p50_mm"]) and np.all(lobes["p50_mm"] <= lobes["p95_mm"])
+    # the stable cut at 20000 rpm, 0.5 mm: the posterior 5 % limit there is near or above it
+    k = np.argmin(np.abs(lobes["rpm"] - 20000))
+    assert lobes["p05_mm"][k] > 0.45 and lobes["p95_mm"][k] < 0.95
+
+
+def test_modal_prior_file_errors_name_the_field(tmp_path):
+    p = tmp_path / "p.toml"
+    p.write_text(PRIOR_TOML.replace("damping = 0.0619", "damping = -1"))
+    with pytest.raises(InputError, match="damping"):
+        read_modal_prior(p)
+    p.write_text(PRIOR_TOML.replace("teeth = 4", "teeth = 0"))
+    with pytest.raises(InputError, match="cut.teeth"):
+        read_modal_prior(p)
+
+
+def test_library_adapter_reads_modes_and_cutting(tmp_path):
+    """A library output's tool (npz + json as recommend.run writes them) → modes of its nominal FRF."""
+    tools = tmp_path / "tools"
+    tools.mkdir()
+    f = np.arange(200.0, 4000.0, 1.0)
+    h = sum(1 / (k * (1 - (f / fn) ** 2 + 2j * z * f / fn)) for fn, k, z in ((900, 8e6, 0.03), (2100, 2e7, 0.02)))
+    hq = np.abs(h)[None, :] * np.array([0.8, 1.0, 1.25])[:, None]
+    np.savez(tools / "T1.npz", freq_hz=f, frf_nominal=h, frf_abs_q=hq)
+    (tools / "T1.json").write_text(json.dumps({"cutting": {"teeth": 3, "tangential_coeff": 7e8, "radial_ratio": 0.3,
+                                                           "radial_immersion": 0.5, "milling": "up"}}))
+    pr = prior_from_library(tmp_path, "T1")
+    assert pr.modes == 2 and pr.cutting.teeth == 3 and pr.cutting.milling == "up"
+    np.testing.assert_allclose(sorted(pr.freq_hz), [900, 2100], rtol=2e-3)
+    assert abs(pr.sigma_stiffness[0] - np.log(1.25 / 0.8) / 3.29) < 1e-9
+    with pytest.raises(InputError, match="no tool 'T9'"):
+        prior_from_library(tmp_path, "T9")
+
+
+def test_virtual_campaign_converges_with_few_chatters():
+    """The loop on the update's own forward model (zero-order shop): converges within 8 cuts, ≤ 2 chatter."""
+    pr = cornelius_2024(0.1)
+    r = virtual_campaign(pr, rng=np.random.default_rng(0), max_cuts=8, n_samples=400, lobe_samples=200)
+    assert r.converged_after is not None and r.converged_after <= 8
+    assert r.chatter_cuts <= 2
+    assert r.width[-1] <= 0.2 and r.coverage[-1] >= 0.9
+    assert isinstance(ModalPrior, type)
+
+
+def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
+    import soundfile as sf
+
+    from shop_synth import shop_record
+
+    x, rate, *_ = shop_record(rpm=12000, teeth=4, chatter_hz=1310.0, chatter_amp=0.5, seed=8)
+    sf.write(tmp_path / "c1.wav", x, int(rate), subtype="PCM_16")
+    p = tmp_path / "cuts.csv"
+    p.write_text("rpm,depth_mm,result,record\n12000,0.8,,c1.wav\n9000,0.3,stable,\n")
+    cuts = read_test_cuts(p, teeth=4)
+    assert not cuts[0].stable and abs(cuts[0].chatter_hz / 1310 - 1) < 0.01 and cuts[1].stable
+    p.write_text("rpm,depth_mm,result,record\n12000,0.8,stable,c1.wav\n")
+    with pytest.raises(InputError, match="line 2: the table says stable, its record c1.wav says chatter"):
+        read_test_cuts(p, teeth=4)
