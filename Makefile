@@ -4,7 +4,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-stamp
 OUT ?= toolpoint-out
 
-.PHONY: demo test lint browser bench docs clean
+.PHONY: demo test test-slow lint browser bench docs clean
 
 $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
@@ -15,9 +15,13 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(VENV)/bin/toolpoint reproduce --out $(OUT)
 
-# ruff (pyflakes + pycodestyle), the one-way import layers (import-linter), then the tests and doctests
+# ruff (pyflakes + pycodestyle), the one-way import layers (import-linter), then the fast tier of the tests and
+# doctests on both cores; `make test-slow` runs the slow tier (statistical and end-to-end checks; CI runs both)
 test: lint browser
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 2 -m "not slow"
+
+test-slow: $(STAMP) browser
+	$(PY) -m pytest -q -n 2 -m slow
 
 # The report's browser test needs Chromium (Debian's package); installed here when this user may.
 browser:
