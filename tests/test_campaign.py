@@ -33,6 +33,7 @@ def test_synth_writes_a_campaign_the_pipeline_can_read(small):
     assert np.allclose(truth_joint(16, 50), [2.1e7, 15.0, 1.4e6, 3.0])
 
 
+@pytest.mark.slow
 def test_run_identifies_every_tool_and_resumes(small, tmp_path):
     out = tmp_path / "res"
     r = run_campaign(small, out, workers=2, progress=False)
@@ -48,6 +49,7 @@ def test_run_identifies_every_tool_and_resumes(small, tmp_path):
     assert len(_rows(out / "identified.csv")) == 8
 
 
+@pytest.mark.slow
 def test_a_broken_item_is_recorded_and_the_rest_goes_on(small, tmp_path):
     broken = tmp_path / "c"
     shutil.copytree(small, broken)
@@ -66,13 +68,16 @@ def test_a_broken_item_is_recorded_and_the_rest_goes_on(small, tmp_path):
     assert r2["skipped"] == 6 and r2["failed"] == 2
 
 
+@pytest.mark.slow
 def test_dask_local_cluster(small, tmp_path):
-    distributed = pytest.importorskip("distributed")
+    import distributed
+
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as lc:
         r = run_campaign(small, tmp_path / "res", dask=lc.scheduler_address, progress=False)
     assert r["ok"] == 8
 
 
+@pytest.mark.slow
 def test_dask_address_that_does_not_answer(small, tmp_path, capsys):
     out = tmp_path / "res"
     assert main(["campaign", "run", str(small), "--out", str(out), "--dask", "tcp://127.0.0.1:9"]) == 2
@@ -93,6 +98,7 @@ def test_bad_campaign_inputs(small, tmp_path):
         load_campaign(bad)
 
 
+@pytest.mark.slow
 def test_band_outside_the_subassembly_is_refused_per_item(small, tmp_path):
     from toolpoint.frf import FRF
     from toolpoint.io.frf_files import read_frf, write_frf

@@ -28,6 +28,7 @@ def small(tmp_path_factory):
     return d
 
 
+@pytest.mark.slow
 def test_a_second_run_into_the_same_folder_refuses(small, tmp_path):
     out = tmp_path / "res"
     out.mkdir()
@@ -69,6 +70,7 @@ def test_a_broken_blank_file_stops_the_run_before_any_row(small, tmp_path, capsy
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_a_dask_port_that_never_answers_fails_in_bounded_time(small, tmp_path, monkeypatch, capsys):
     srv = socket.socket()
     srv.bind(("127.0.0.1", 0))
@@ -99,6 +101,7 @@ def _alive(pid: int) -> bool:
         return False
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="uses /proc and ps")
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
 def test_pool_workers_end_with_their_parent(small, tmp_path, sig):
@@ -125,6 +128,7 @@ def test_pool_workers_end_with_their_parent(small, tmp_path, sig):
             parent.kill()
 
 
+@pytest.mark.slow
 def test_progress_goes_to_a_log_when_stderr_is_not_a_terminal(small, tmp_path):
     # a log gets plain lines (not a redrawn bar, not nothing): the command runs with stderr to a pipe
     proc = subprocess.run([sys.executable, "-m", "toolpoint.cli.main", "campaign", "run", str(small), "--out",
@@ -143,7 +147,7 @@ def _free_port() -> int:
 def test_a_dask_scheduler_lost_mid_run_is_one_error_and_no_traceback(capfd):
     # a real scheduler (a process of its own) that dies while jobs are queued on it: the jobs' futures are
     # cancelled, distributed logs reconnect tracebacks; execute must stop with one InputError naming --dask
-    pytest.importorskip("distributed")
+    import distributed  # noqa: F401  (a dependency: its absence is a failure, not a skip)
     port = _free_port()
     sched = subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--port", str(port),
                               "--no-dashboard", "--host", "127.0.0.1"],

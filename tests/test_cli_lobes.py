@@ -272,6 +272,7 @@ def test_sdm_accuracy_and_progress(tmp_path, frf_files, capsys):
     assert steps["2"] >= 2 * steps["1"] - 4  # the step ladder is ≈ 2^(1/4) apart
 
 
+@pytest.mark.slow
 def test_sdm_with_cross_frfs_matches_the_exact_model(tmp_path, capsys):
     """Orthotropic tool, principal axes turned 35°: the four receptance files → common-pole fits → 2×2
     state-space model must give the lobes of the exact model (built from its poles and residue matrices,
@@ -347,6 +348,7 @@ def _fitted_fn_hz(text):
     return [float(r[1]) for r in rows if len(r) == 3 and r[0].isdigit()]
 
 
+@pytest.mark.slow
 def test_sdm_on_noisy_frf_weighs_the_fit_as_accelerance_noise(tmp_path, noisy_files, capsys):
     """The receptance's noise grows as 1/ω² (tests/test_trust.py): the trusted band says so and the SDM path's
     modal fit is weighted in accelerance. Weighted in receptance it put three ultra-light modes (177–219 Hz,

@@ -22,6 +22,7 @@ def fe_fine(example):
     return tool_point_fe(example, F, max_element_m=0.1e-3)
 
 
+@pytest.mark.slow
 def test_rcsa_equals_full_assembly_fe(rcsa, fe_fine):
     """The paper's check (ANSYS BEAM188 + COMBIN14), here with our own FE: 1e-6 relative norm."""
     err = np.linalg.norm(rcsa.values - fe_fine) / np.linalg.norm(fe_fine)
@@ -29,6 +30,7 @@ def test_rcsa_equals_full_assembly_fe(rcsa, fe_fine):
     assert np.all(np.isfinite(rcsa.values)) and rcsa.freq_hz[0] == 0
 
 
+@pytest.mark.slow
 def test_fe_converges_to_rcsa(example, rcsa):
     """FE error falls like h² towards the exact RCSA; Richardson-extrapolated it agrees to ~1e-8."""
     h1 = tool_point_fe(example, F, 1.0e-3)
@@ -40,6 +42,7 @@ def test_fe_converges_to_rcsa(example, rcsa):
     assert np.linalg.norm(rcsa.values - richardson) / np.linalg.norm(richardson) < 1e-7
 
 
+@pytest.mark.slow
 def test_static_point_is_the_assembly_compliance(rcsa, fe_fine):
     """0 Hz: the static compliance of the grounded assembly, continuous with 1 Hz."""
     assert rcsa.values[0].imag == 0

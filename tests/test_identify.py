@@ -68,6 +68,7 @@ def test_unknown_method_is_an_input_error(case):
     assert make_algorithm("GA").name == "ga"  # method names in any case, as `--method SDM` in lobes
 
 
+@pytest.mark.slow
 def test_same_seed_same_result(case):
     model, _, meas = case
     for method in ("ga", "pso", "sa", "de"):

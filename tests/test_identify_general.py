@@ -227,6 +227,7 @@ def test_front_bearing_stiffness_from_a_spindle_nose_frf(example):
     assert r.params["bearings[1].c"] == pytest.approx(2500.0, rel=1e-2)
 
 
+@pytest.mark.slow
 def test_joint_and_bearings_together_are_reported_as_trading_off(example, fe_holder_tip):
     """Exactly the pairs whose log10 estimates correlate with |ρ| > 0.95 are reported, ρ recomputed here
     from a central-difference Jacobian: the two front bearings trade off (ρ = −0.965), the joint's kt with

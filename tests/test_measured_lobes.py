@@ -45,6 +45,7 @@ def test_the_whole_band_gives_the_confident_wrong_answer_that_the_rule_prevents(
     assert res.lobes.min_chatter_hz < 100 and res.lobes.min_depth_m < 0.6 * reference.min_depth_m
 
 
+@pytest.mark.slow
 def test_sdm_on_the_lab_like_frf_agrees_with_the_zero_order_or_refuses(reference):
     res = lobes_from_frf(lab_like_frf(1, noise=NOISE_ACCELERANCE * 10), CUT, RPM[::8], method="sdm")
     fn = res.modal[0].fn_hz

@@ -104,6 +104,7 @@ def test_ga_short_run_already_beats_the_paper(case):
     assert r.nit == 120 and not r.success and r.status == 1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["ga", "sa"])
 def test_same_seed_same_run(case, method):
     model, _, meas = case
@@ -265,6 +266,7 @@ def test_options_are_keyword_only(cls):
         cls(30)
 
 
+@pytest.mark.slow
 def test_identify_options_set_the_stopping_rules(case):
     model, _, meas = case
     with warnings.catch_warnings():

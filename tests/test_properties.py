@@ -465,6 +465,7 @@ def test_cmd_campaign_learn(seeds, tmp_path, data):
     _run(argv, [ident], out)
 
 
+@pytest.mark.slow
 @_n(12)
 @given(data=st.data())
 def test_cmd_predict(seeds, tmp_path, data):
@@ -611,6 +612,7 @@ def _campaign_run_failed_rows(out: Path) -> list[str]:
     return [r["id"] for _, r in read_identified(out / "identified.csv").rows if r["status"] != "ok"]
 
 
+@pytest.mark.slow
 @_n(20)
 @given(data=st.data())
 def test_cmd_campaign_run(heavy, tmp_path, data):
@@ -647,6 +649,7 @@ def test_campaign_run_one_bad_frf(heavy, tmp_path):
         assert _campaign_run_failed_rows(out / "res") == ["T001"]
 
 
+@pytest.mark.slow
 @_n(24)
 @given(data=st.data())
 def test_cmd_library(seeds, heavy, tmp_path, data):
@@ -737,6 +740,7 @@ def test_report_of_a_damaged_tool_file(heavy, tmp_path, name, damage):
         gc.collect()
 
 
+@pytest.mark.slow
 @_n(12)
 @given(data=st.data())
 def test_cmd_reproduce(tmp_path, data):

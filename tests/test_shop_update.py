@@ -171,6 +171,7 @@ def test_library_adapter_reads_modes_and_cutting(tmp_path):
         prior_from_library(tmp_path, "T9")
 
 
+@pytest.mark.slow
 def test_virtual_campaign_converges_with_few_chatters():
     """The loop on the update's own forward model (zero-order shop): converges within 8 cuts, ≤ 2 chatter."""
     pr = cornelius_2024(0.1)

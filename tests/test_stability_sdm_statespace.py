@@ -177,7 +177,7 @@ def test_lobes_sdm_path_recovers_a_close_pair_of_complex_modes():
     1482 / 1622 Hz. A real-mode fit cannot represent it (the former ``stability.fit_modes`` put the 1482 Hz
     mode at 1495 Hz, ζ 2.66 % instead of 2.84 %); the SDM path of ``toolpoint lobes``
     (``dynamics.modal.fit_frfs`` → ``from_modal_fit``) must recover every pole within 0.1 % in f_n and 2 % in ζ."""
-    from toolpoint.cli.lobes import _fit_one
+    from toolpoint.stability.measured import _fit_one
 
     fn = np.array([650.0, 1050.0, 1482.0, 1622.0, 2350.0])
     ze = np.array([0.025, 0.02, 0.0284, 0.021, 0.015])
@@ -190,7 +190,7 @@ def test_lobes_sdm_path_recovers_a_close_pair_of_complex_modes():
     f = np.arange(0.0, 3000.5, 1.0)
     frf = FRF(f, true.frf(f)[:, 0, 0])
 
-    model = from_modal_fit(_fit_one(frf, "FRF", "x.csv", None))
+    model = from_modal_fit(_fit_one(frf, "FRF", "x.csv", None, None))
     lam = model.poles[model.poles.imag > 0]
     lam = np.unique(np.round(lam, 6))  # x and y realisations (symmetric tool) share the poles
     lam = lam[np.argsort(np.abs(lam))]

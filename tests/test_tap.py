@@ -183,6 +183,7 @@ def synth_file(synth, tmp_path_factory):
     return p
 
 
+@pytest.mark.slow
 def test_cli_csv_uff_frf_and_plot(synth_file, tmp_path, capsys):
     out, png = tmp_path / "h.csv", tmp_path / "h.png"
     assert main(["tap", str(synth_file), "--out", str(out), "--drop-bad", "--plot", str(png), "--fmax", "2000"]) == 0
@@ -473,6 +474,7 @@ def test_full_disk_for_the_figure_writes_nothing(synth_file, tmp_path, capsys, m
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_full_disk_for_the_frf_removes_the_figure(synth_file, tmp_path, capsys, monkeypatch):
     import errno
 
