@@ -113,3 +113,28 @@ def test_modal_fit_of_the_lab_like_frf_in_its_trusted_band(seed, noise):
         assert fit.zeta[r] == pytest.approx(z0, rel=0.1)
     assert fit.fn_hz.min() >= b.lo_hz and fit.n_modes <= 8
     assert np.all(fit.residues[:, 0].imag < 0)
+
+
+def test_check_screen_on_the_lab_like_file(tmp_path, capsys):
+    path = tmp_path / "lab.txt"
+    write_tsv(lab_like_frf(0), path)
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "band used: 148–5000 Hz" in out and "rises towards 0 Hz" in out
+    for f0 in DOMINANT_HZ:
+        assert f"{f0:.1f}" in out
+    assert "looks wrong: nothing found" in out
+
+
+def test_a_receptance_in_mm_per_newton_is_named(tmp_path, capsys):
+    """Issue: an FRF in mm/N was accepted silently (lobes 0.00076 mm)."""
+    f = np.arange(1.0, 3001.0)
+    h = 1e3 / (1e7 * (1 - (f / 900) ** 2 + 0.04j * f / 900))  # written in mm/N
+    path = tmp_path / "mm.csv"
+    np.savetxt(path, np.column_stack([f, h.real, h.imag]), delimiter=",", header="freq_hz,real,imag", comments="")
+    out = tmp_path / "o.csv"
+    assert main(["lobes", str(path), *ARGS, "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "mm/N" in err and "mm.csv" in err
+    assert main(["check", str(path)]) == 0
+    assert "mm/N" in capsys.readouterr().out

@@ -76,7 +76,8 @@ from .frf import FRF
 
 __all__ = ["COHERENCE_MIN", "SNR_MIN", "WINDOW", "MIN_SLOPE_POINTS", "RISE_SLOPE", "RISE_CLIMB", "RISE_MARGIN",
            "RISE_SMOOTH", "RISE_NEAR_ZERO",
-           "TrustedBand", "Band", "check_band", "trusted_band", "common_band", "edge_hits"]
+           "RECEPTANCE_RANGE", "TrustedBand", "Band", "check_band", "trusted_band", "common_band", "unit_note",
+           "edge_hits"]
 
 COHERENCE_MIN = 0.8
 """Lowest ordinary coherence γ² trusted at the band ends (γ² = 0.8: noise-to-signal power ratio 0.25)."""
@@ -89,6 +90,35 @@ WINDOW = 15
 
 MIN_SLOPE_POINTS = 5
 """Fewest points (> 0 Hz) below the edge to judge whether the noise grows towards 0 Hz."""
+
+
+RECEPTANCE_RANGE = (1e-10, 1e-4)
+"""Plausible largest |H| of a machine-tool tool-point receptance, m/N. Measured tool points peak at ≈ 1e-8–1e-5 m/N
+(Schmitz & Smith, *Machining Dynamics*, 2019; this project's examples 5.6e-6, a lab's end mill 6.8e-7); a file whose
+peak lies outside this range by orders of magnitude was most likely written in another unit (mm/N reads 1000×)."""
+
+
+def unit_note(frf: FRF, name: str = "") -> str:
+    """A one-line hint when a receptance's size is orders of magnitude from a machine tool's (``""`` otherwise).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = np.arange(1.0, 3001.0)
+    >>> h = 1 / (1e7 * (1 - (f / 900) ** 2 + 0.04j * f / 900))   # m/N: peak 2.5e-6
+    >>> unit_note(FRF(f, h)), unit_note(FRF(f, 1e3 * h), "x.csv")[:60]
+    ('', 'warning: x.csv: the largest |H| is 0.0025 m/N, orders of mag')
+    """
+    if frf.quantity != "receptance" or not len(frf):
+        return ""
+    peak = float(np.max(np.abs(frf.values)))
+    lo, hi = RECEPTANCE_RANGE
+    if lo <= peak <= hi or peak == 0:
+        return ""
+    where = f"{name}: " if name else ""
+    guess = "mm/N (×1000)" if peak > hi else "another unit or scale"
+    return (f"warning: {where}the largest |H| is {peak:.2g} m/N, orders of magnitude from a machine-tool tool "
+            f"point's ({lo:g}–{hi:g} m/N): was the file written in {guess}? Files are read in m/N")
 
 
 class TrustedBand(NamedTuple):
@@ -498,6 +528,8 @@ def common_band(frfs, *, band=None, files=None, field: str = "--band", hint: str
         raise InputError(f"the trusted bands of the FRFs do not overlap ({each}): give {hint}",
                          file=names[0], field=field)
     told = {tb.noise_quantity for tb in tbs if tb.noise_quantity}
+    notes += tuple(n for n in (unit_note(g.band(lo, hi), str(name or "")) for (g, _), name in zip(pairs, names))
+                   if n)
     return Band(float(lo), float(hi), told.pop() if len(told) == 1 else "", notes, tuple(tbs))
 
 

@@ -220,7 +220,7 @@ def fit_band(frf, path, spec):
     from ..trust import common_band
 
     b = common_band([frf], band=band, files=[path], field=field, hint=hint)
-    return b.cut(frf), (b.notes[0] if b.notes else "")
+    return b.cut(frf), "\n".join(b.notes)
 
 
 # --------------------------------------------------------------------------- general form

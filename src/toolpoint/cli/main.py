@@ -30,6 +30,7 @@ COMMANDS = {
     "predict": "tool-point FRF of an unmeasured tool from the ANFIS-predicted joint",
     "anfis": "ANFIS (MATLAB genfis + anfis hybrid learning): train a model on a CSV table, or predict with one",
     "modal": "common-pole modal fit of one or several FRFs → natural frequencies, damping, modal constants",
+    "check": "check measured FRFs before trusting them: band, modes with a confidence word, coherence, problems",
     "lobes": "stability lobe diagram from a tool-point FRF (zero-order or semi-discretisation)",
     "tap": "impact-test records (time, force, response) → FRF with coherence",
     "library": "safe spindle speeds and depths for every tool of a tool library, with their uncertainty",

@@ -751,11 +751,9 @@ def _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, labels, quan
     # optimum and be dropped: keep the model of the order selection when it is the better one.
     if final.size == poles.size or prob.bic(prob.rss(final), final.size) < prob.bic(prob.rss(poles), poles.size):
         poles = final
-    if n_modes is None:  # the automatic order reports only modes the data determine, and only physical ones
+    if n_modes is None:  # the automatic order reports only modes the data determine
         while True:
             bad = _undetermined(prob, poles, f_lo, f_hi)
-            if bad is None:
-                bad = _implausible(prob, poles, f_lo, f_hi)
             if bad is None:
                 break
             poles = _refine_clean(prob, np.delete(poles, bad), f_lo, f_hi, _FINAL_TOL)
@@ -777,30 +775,6 @@ def _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, labels, quan
                    velocity_residual=V, **kw)
     err = np.linalg.norm(fit.values(f, quantity) - Yq, axis=0) / np.linalg.norm(Yq, axis=0)
     return ModalFit(fit.poles, fit.residues, U, L, fit.band_hz, quantity, err, labels, velocity_residual=V, **kw)
-
-
-def _implausible(prob, poles, f_lo, f_hi):
-    """Index of an in-band pole that is no physical mode, if any; else None.
-
-    For a single FRF — a driving point (the tool point) — a modal constant of the wrong sign: a driving-point
-    receptance has A_r = 1/(2i m_r ω_dr) with m_r > 0, Im A_r < 0; allowing the phase of non-proportional damping up
-    to ±60°, Im A_r < −|A_r|/2. The lightest such pole goes first. (Damping alone decides nothing: a free steel
-    structure measures ζ ≈ 0.01–0.05 %, as light as the spurious poles a fit can put on noise.)
-    """
-    inband = (np.abs(poles) >= 2 * np.pi * f_lo) & (np.abs(poles) <= 2 * np.pi * f_hi)
-    if not inband.any():
-        return None
-    c, _, _ = prob.solve(poles)
-    if c.shape[0] != 1:
-        return None
-    zeta = -poles.real / np.abs(poles)
-    n = poles.size
-    a = c[0, 0:2 * n:2] + 1j * c[0, 1:2 * n:2]
-    bad = inband & ~(a.imag < -0.5 * np.abs(a))
-    if not bad.any():
-        return None
-    idx = np.flatnonzero(bad)
-    return int(idx[np.argmin(zeta[idx])])
 
 
 def _undetermined(prob, poles, f_lo, f_hi):
