@@ -118,7 +118,7 @@ def run(args) -> int:
             print(note, file=sys.stderr)
         algo = make_algorithm(args.method)
         res = _run_with_progress(model, meas, args.method, args.seed, bounds, algo)
-    _report(res, args)
+    _report(res, args, measured=[meas.to_receptance().values])
     doc = result_document(res, args.method, args.seed, assembly=args.assembly, measured=args.measured,
                           band_hz=[float(meas.freq_hz[0]), float(meas.freq_hz[-1])])
     _write(doc, out, plot, args.method, meas, res.model_frf, res.history,
@@ -184,13 +184,29 @@ def result_document(res, method, seed, *, names=PARAMS, units=None, key=None, **
     return doc
 
 
-def _report(res, args, names=PARAMS, units=UNITS) -> None:
-    """Print the identified parameters (stdout) and each identifiability warning once (stderr)."""
-    print(f"method {args.method}, seed {args.seed}: objective {res.fun:.4g} m/N, {res.nfev} evaluations, "
-          f"{res.seconds:.2f} s — {res.message}")
+def _report(res, args, names=PARAMS, units=UNITS, measured=None) -> None:
+    """Print the identified parameters in aligned columns (stdout) and each identifiability warning once (stderr).
+
+    The interval ends get the digits that tell them apart from the value; the objective is also given relative to
+    the measured FRF's norm (the m/N figure alone says little).
+    """
+    rel = ""
+    if measured is not None:
+        norm = float(np.linalg.norm(np.concatenate([np.ravel(m) for m in measured])))
+        if norm > 0:
+            rel = f" ({res.fun / norm:.2g} of the measured FRF's norm)"
+    state = "converged" if res.success else f"not converged: {res.message}"
+    print(f"method {args.method}, seed {args.seed}: {state}; objective {res.fun:.3g} m/N{rel}, "
+          f"{res.nfev:,} evaluations, {res.seconds:.2f} s")
+    width = max(len(k) for k in names)
+    uw = max(len(units[k]) for k in names)
+    print(f"  {'':{width}s}  {'value':>12s}  {'unit':{uw}s}  95 % interval")
     for k in names:
-        lo, hi = res.ci95[k]
-        print(f"  {k} = {res.params[k]:.6g} {units[k]:9s}  95 % CI [{lo:.4g}, {hi:.4g}]")
+        v, (lo, hi) = res.params[k], res.ci95[k]
+        spread = max(abs(hi - v), abs(v - lo)) / abs(v) if v else 1.0
+        digits = int(np.clip(np.ceil(-np.log10(max(spread, 1e-15))) + 2, 3, 15))
+        print(f"  {k:{width}s}  {v:12.6g}  {units[k]:{uw}s}  [{lo:.{digits}g}, {hi:.{digits}g}]"
+              f"  (−{100 * (v - lo) / v:.2g} %, +{100 * (hi - v) / v:.2g} %)" if v else "")
     for w in res.warnings:
         print(f"warning: {w}", file=sys.stderr)
 
