@@ -42,7 +42,9 @@ downstream (squares in the fits, ω⁴ in conversions, 1/H in inverse RCSA):
   number of its column (``1.2345e-08`` cut to ``1.2345e-0`` or ``1.23`` reads
   as 1.2345 or 1.23 m/N), or, in a column without exponents, with fewer digits
   than each of them: the message names the line and says to end the file with
-  a line break if it is complete. Every writer writes receptance, through :mod:`toolpoint.io.atomic`, so a
+  a line break if it is complete.
+
+Every writer writes receptance, through :mod:`toolpoint.io.atomic`, so a
 failure never leaves a half-written file.
 """
 

@@ -2,21 +2,18 @@
 
 Columns (one tool per row; lengths in mm, speeds in rpm):
 
-====================== =========================================================================
-``id``                 tool identifier (unique, non-empty)
-``diameter_mm``        tool diameter D, mm
-``overhang_mm``        overhang (gauge length out of the holder) L, mm
-``teeth``              number of teeth N
-``holder``             holder name: one of the campaign's ``[holders]``
-``tangential_coeff_n_mm2``, ``radial_ratio``
-                       cutting coefficients K_t (N/mm²) and K_r = K_n/K_t; or leave them empty and
-                       name a preset in ``material`` (:mod:`~toolpoint.recommend.materials`)
-``radial_immersion``   a_e/D in (0, 1] (1 = slotting)
-``milling``            ``down`` or ``up``
-``rpm_min``, ``rpm_max`` the spindle's usable speed range, rpm
-``flute_length_mm``    optional: flute length, mm (default: the campaign's tool family rule)
-``material``           optional: work material (a preset name when the coefficients are empty)
-====================== =========================================================================
+* ``id``: tool identifier (unique, non-empty)
+* ``diameter_mm``: tool diameter D, mm
+* ``overhang_mm``: overhang (gauge length out of the holder) L, mm
+* ``teeth``: number of teeth N
+* ``holder``: holder name: one of the campaign's ``[holders]``
+* ``tangential_coeff_n_mm2``, ``radial_ratio``: cutting coefficients K_t (N/mm²) and K_r = K_n/K_t; or leave
+  them empty and name a preset in ``material`` (:mod:`~toolpoint.recommend.materials`)
+* ``radial_immersion``: a_e/D in (0, 1] (1 = slotting)
+* ``milling``: ``down`` or ``up``
+* ``rpm_min``, ``rpm_max``: the spindle's usable speed range, rpm
+* ``flute_length_mm``: optional: flute length, mm (default: the campaign's tool family rule)
+* ``material``: optional: work material (a preset name when the coefficients are empty)
 
 A file that cannot be read, has no header or no rows, or lacks a required
 column is an :class:`~toolpoint.errors.InputError`. A bad *row* (a missing
