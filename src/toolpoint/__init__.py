@@ -1,8 +1,10 @@
 """toolpoint — tool-point FRF prediction for milling.
 
-Data flow, one sub-package per step (imports go one way, checked in CI)::
+Data flow, one sub-package per step (imports go one way, no cycle inside a sub-package; checked in CI)::
 
-    frf, errors → io → dynamics → identification → learning → campaign → stability → cli
+    frf, errors → trust → io → dynamics → identification → learning → campaign → stability → recommend → shop → cli
+
+measured FRFs enter through ``io`` and the trusted band (``trust``), test cuts through ``io`` and ``shop``.
 
 The names most used are importable from here (lazily, so that ``import
 toolpoint`` stays fast): :class:`FRF`, :func:`load_assembly`,
