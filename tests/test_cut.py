@@ -94,7 +94,10 @@ def test_real_shop_recording_air_entry_cut_chatter_exit():
     assert res.verdict == "chatter"
     dur = {v: sum(s.end_s - s.start_s for s in cut if s.verdict == v) for v in ("stable", "chatter")}
     assert dur["chatter"] > dur["stable"]
-    assert cut[-1].verdict == "chatter"  # the cut ends chattering, as the recording says
+    # stable cutting, then chatter, as the README says: once chatter starts it stays
+    verdicts = [s.verdict for s in cut]
+    first = verdicts.index("chatter")
+    assert all(v == "chatter" for v in verdicts[first:])
     # the chatter frequency is one across segments: every chattering segment reports it or its 2nd harmonic
     # (where the fundamental sits on a spindle harmonic), within 1 %
     fc = res.chatter_hz
