@@ -335,3 +335,26 @@ def test_resume_keeps_only_tools_computed_with_the_same_joint_model(tmp_path):
     assert _resume(table, tools, {"A", "B", "C"}, "gp") == {"B"}  # and the rewritten table says so
     with open(table, newline="") as fh:
         assert [r["id"] for r in csv.DictReader(fh)] == ["B"]
+
+
+def test_a_limit_at_the_depth_cap_is_shown_as_at_least_the_cap():
+    """A limit equal to the internal depth cap was not computed: CSV '>=cap', never the cap as a number."""
+    from types import SimpleNamespace
+
+    from toolpoint.recommend.engine import _point
+    from toolpoint.recommend.run import _ok_row
+
+    cap = 9.68e-3
+    rpm = np.array([1000.0, 2000.0])
+    nominal = np.array([cap, 5e-3])
+    lq = np.array([[cap, 4e-3], [cap, 5e-3], [cap, 6e-3]])
+    samples = np.full((10, 2), cap)
+    job = SimpleNamespace(rpm=rpm, margin=0.1)
+    p = _point(job, 0, "pocket", nominal, lq, lq[0], samples, cap)
+    assert p["capped"] == ["limit_nominal_mm", "limit_p05_mm", "limit_p50_mm", "limit_robust_p05_mm"]
+    assert _point(job, 1, "pocket", nominal, lq, lq[0], samples, cap)["capped"] == []
+    joint = {k: {"p05": 1.0, "p50": 1.0, "p95": 1.0} for k in ("kt", "ct", "kr", "cr")}
+    summary = {"points": [p], "joint": joint, "min_limit_mm": {"p05": 4.0}, "cap_mm": 1e3 * cap}
+    row = _ok_row(SimpleNamespace(id="EM28-80"), summary, 0.0, [])
+    assert row["limit_p05_mm"] == row["limit_p50_mm"] == row["limit_nominal_mm"] == ">=9.68"
+    assert row["rpm"] == "1000"

@@ -199,10 +199,10 @@ def evaluate_tool(job: ToolJob) -> dict:
     idx = pockets(robust)
     points = []
     for j in idx[:3]:
-        points.append(_point(job, j, "pocket", nominal, lq, robust, samples))
+        points.append(_point(job, j, "pocket", nominal, lq, robust, samples, cap))
     if not points:
         j = int(np.argmax(np.where(np.isfinite(robust), robust, -np.inf)))
-        points.append(_point(job, j, "edge", nominal, lq, robust, samples))
+        points.append(_point(job, j, "edge", nominal, lq, robust, samples, cap))
     jq = 10.0 ** (job.log10_median[None, :] + np.array([-1.6448536269514729, 0.0, 1.6448536269514729])[:, None]
                   * job.sigma_log10[None, :])
     hq = np.quantile(np.abs(H[1:]), QUANTILES, axis=0)
@@ -230,11 +230,13 @@ def evaluate_tool(job: ToolJob) -> dict:
     return {"summary": summary, "arrays": arrays}
 
 
-def _point(job, j, kind, nominal, lq, robust, samples) -> dict:
+def _point(job, j, kind, nominal, lq, robust, samples, cap) -> dict:
     depth = robust[j] * (1.0 - job.margin)
+    limits = {"limit_nominal_mm": nominal[j], "limit_p50_mm": lq[1, j], "limit_p05_mm": lq[0, j],
+              "limit_robust_p05_mm": robust[j]}
     return {
-        "kind": kind, "rpm": float(job.rpm[j]), "limit_nominal_mm": 1e3 * float(nominal[j]),
-        "limit_p50_mm": 1e3 * float(lq[1, j]), "limit_p05_mm": 1e3 * float(lq[0, j]),
-        "limit_robust_p05_mm": 1e3 * float(robust[j]), "depth_mm": 1e3 * float(depth),
-        "p_stable": float(np.mean(samples[:, j] > depth)),
+        "kind": kind, "rpm": float(job.rpm[j]), **{k: 1e3 * float(v) for k, v in limits.items()},
+        "depth_mm": 1e3 * float(depth), "p_stable": float(np.mean(samples[:, j] > depth)),
+        # a limit at the depth cap was not computed: it lies somewhere above the cap (shown as "≥ cap")
+        "capped": sorted(k for k, v in limits.items() if np.isfinite(cap) and v >= cap * (1 - 1e-9)),
     }

@@ -39,7 +39,7 @@ __all__ = ["write_report", "SHOWN", "FRF_BINS", "RPM_BINS", "MAP_SHAPE"]
 SHOWN = {"id": "tool", "status": "status", "diameter_mm": "D mm", "overhang_mm": "L mm", "teeth": "N",
          "material": "material", "rpm": "rpm", "depth_mm": "depth mm (recommended)",
          "limit_p05_mm": "5 % limit mm", "limit_p50_mm": "50 % limit mm", "min_limit_p05_mm": "stable everywhere mm",
-         "kind": "point", "outside_range": "outside range", "error": "error / notes"}
+         "kind": "point", "outside_range": "outside learned (D, L) range", "error": "error / notes"}
 
 #: Frequency bins of the FRF band in the report (max of the 95 % and median, min of the 5 % curve per bin).
 FRF_BINS = 240
@@ -104,7 +104,7 @@ function draw(d){const src=document.getElementById(d.dataset.src),figs=d.querySe
   ylabel:'|h|, m/N',title:'tool-point FRF: median and 5–95 % band',band:{x:a.f,lo:h[0],hi:h[2]},
   lines:[{x:a.f,y:h[1],color:'#1f77b4',label:'median'}]})+
  plot({x:[a.rpm[0],a.rpm[a.rpm.length-1]],y:[0,a.top],xlabel:'spindle speed, rpm',ylabel:'axial depth, mm',
-  title:'P(stable) (green 100 %, red 0 %), limits; ★ recommended',image:a.map,stars:a.pts,
+  title:'P(stable) (yellow 100 %, dark blue 0 %), limits; ★ recommended',image:a.map,stars:a.pts,
   lines:limits.map((l,k)=>({x:a.rpm,y:a.lim[k],label:l[0],dash:l[1]}))});}
 function openHash(){const t=document.getElementById(decodeURIComponent(location.hash.slice(1)));
  if(t&&t.tagName==='DETAILS'){t.open=true;draw(t);}}
@@ -132,8 +132,8 @@ def _bins(n: int, most: int) -> np.ndarray:
 
 
 def _map_png(p_stable: np.ndarray) -> str:
-    """The probability map (depths × speeds, %) as a small PNG data URL (RdYlGn, 5 % steps, lowest depth at the
-    bottom); block means over at most :data:`MAP_SHAPE`."""
+    """The probability map (depths × speeds, %) as a small PNG data URL (cividis: perceptually uniform and
+    colour-blind safe; 5 % steps, lowest depth at the bottom); block means over at most :data:`MAP_SHAPE`."""
     from matplotlib import colormaps
     from PIL import Image
 
@@ -142,7 +142,7 @@ def _map_png(p_stable: np.ndarray) -> str:
         p = np.add.reduceat(p, _bins(p.shape[axis], most), axis=axis) / np.diff(
             np.r_[_bins(p.shape[axis], most), p.shape[axis]]).reshape((-1, 1) if axis == 0 else (1, -1))
     level = np.round(p / 5).astype(np.uint8)[::-1]  # 0..20, top row = deepest
-    palette = (255 * colormaps["RdYlGn"](np.arange(21) / 20)[:, :3]).astype(np.uint8)
+    palette = (255 * colormaps["cividis"](np.arange(21) / 20)[:, :3]).astype(np.uint8)
     img = Image.fromarray(level, "P")
     img.putpalette(palette.ravel().tolist())
     buf = io.BytesIO()
@@ -186,8 +186,11 @@ def _section(d: Path, tid: str, n_data: int) -> str:
         a = {k: z[k] for k in z.files}
     s = json.loads((d / "tools" / f"{tid}.json").read_text(encoding="utf-8"))
     data = json.dumps(_plot_data(a, s), separators=(",", ":"), allow_nan=False)
+    def lim(p, k):  # a limit at the depth cap is no computed limit: it lies above the cap
+        return f"≥ {s['cap_mm']:.3g}" if k in p.get("capped", ()) else f"{p[k]:.3g}"
+
     pts = "".join(f"<tr><td class=t>{html.escape(str(p['kind']))}</td><td>{p['rpm']:.0f}</td><td>{p['depth_mm']:.3g}"
-                  f"</td><td>{p['limit_p05_mm']:.3g}</td><td>{p['limit_p50_mm']:.3g}</td><td>{p['p_stable']:.2f}</td>"
+                  f"</td><td>{lim(p, 'limit_p05_mm')}</td><td>{lim(p, 'limit_p50_mm')}</td><td>{p['p_stable']:.2f}</td>"
                   "</tr>" for p in s["points"])
     best = s["points"][0]
     notes = "".join(f"<li>{html.escape(str(n))}</li>" for n in s.get("notes", []))
@@ -251,9 +254,9 @@ def write_report(out_dir, path=None) -> Path:
                 cells.append(f'<td><a href="#tool-{html.escape(v)}">{html.escape(v)}</a></td>')
             else:
                 try:
-                    v = f"{float(v):.4g}" if k not in ("id", "teeth") else v
+                    v = v if k in ("id", "teeth") else (f"{float(v):.0f}" if k == "rpm" else f"{float(v):.4g}")
                 except ValueError:
-                    pass
+                    v = v.replace(">=", "≥ ")
                 cells.append(f'<td class="t">{html.escape(v)}</td>' if k in ("error", "material", "kind", "status")
                              else f"<td>{html.escape(v)}</td>")
         body.append(f'<tr class="{html.escape(r.get("status", ""))}">{"".join(cells)}</tr>')

@@ -94,6 +94,10 @@ def _ok_row(tool, summary, delta, notes) -> dict:
     cells = {f"{p}_{q}": summary["joint"][p][q] for p in PARAMS for q in ("p05", "p50", "p95")}
     cells.update({k: best[k] for k in ("rpm", "kind", "limit_nominal_mm", "limit_p50_mm", "limit_p05_mm",
                                        "depth_mm", "p_stable")})
+    cells["rpm"] = f"{best['rpm']:.0f}"
+    for k in best.get("capped", ()):  # not a computed limit: above the depth searched
+        if k in cells:
+            cells[k] = f">={summary['cap_mm']:.4g}"
     return _row(tool, "ok", outside_range=float(delta), min_limit_p05_mm=summary["min_limit_mm"]["p05"],
                 notes="; ".join(notes), **cells)
 
