@@ -358,3 +358,45 @@ def test_a_limit_at_the_depth_cap_is_shown_as_at_least_the_cap():
     row = _ok_row(SimpleNamespace(id="EM28-80"), summary, 0.0, [])
     assert row["limit_p05_mm"] == row["limit_p50_mm"] == row["limit_nominal_mm"] == ">=9.68"
     assert row["rpm"] == "1000"
+
+
+def test_tool_ids_from_the_file_never_become_paths_and_csv_cells_never_formulas(tmp_path):
+    """Issue: an id `../../x` wrote next to the output folder, an absolute id anywhere; `=cmd|…` went into the CSV
+    as it was (a spreadsheet runs it); report followed ids out of `tools/`."""
+    root = small_campaign()
+    work = tmp_path / "a" / "b"
+    work.mkdir(parents=True)
+    evil = ["../../x", str(tmp_path / "abs"), "=cmd|' /C calc'!A0", "CON", "a" * 300]
+    rows = [f'"{i}",16,50,3,ER40,,,al7075,0.5,down,4000,20000' if "," in i or "'" in i
+            else f"{i},16,50,3,ER40,,,al7075,0.5,down,4000,20000" for i in evil]
+    lib = _library(tmp_path / "lib.csv", rows)
+    out = work / "out"
+    before = {p for p in tmp_path.rglob("*")}
+    run_library(lib, root / "camp", root / "results" / "models", out, workers=1, n_samples=20, rpm_points=60,
+                progress=False)
+    new = {p for p in tmp_path.rglob("*")} - before
+    assert all(out in p.parents or p == out for p in new), sorted(map(str, new - {out}))
+    written = sorted(p.name for p in (out / "tools").iterdir())
+    assert all(len(n) < 80 and "/" not in n for n in written) and len(written) == 2 * len(evil)
+    with open(out / "recommendations.csv", newline="", encoding="utf-8") as fh:
+        cells = [c for r in csv.reader(fh) for c in r]
+    assert not any(c.startswith(("=", "+", "@")) for c in cells)
+    assert "'=cmd|' /C calc'!A0" in cells
+    from toolpoint.recommend.report import write_report
+
+    page = write_report(out).read_text(encoding="utf-8")
+    assert page.count("files missing or unreadable") == 0  # every section read back from the names it wrote
+    assert "=cmd|&#x27; /C calc&#x27;!A0" in page  # shown as the id it is (escaped), never as a formula cell
+
+
+def test_report_does_not_follow_an_id_out_of_the_tools_folder(tmp_path):
+    out = tmp_path / "run"
+    shutil.copytree(small_run(), out)
+    (tmp_path / "secret.json").write_text('{"id": "../../secret"}')
+    with open(out / "recommendations.csv", "a", encoding="utf-8") as fh:
+        fh.write("../../secret,ok" + "," * 33 + "\n")
+    from toolpoint.recommend.report import write_report
+
+    with pytest.warns(UserWarning, match="unreadable or incomplete"):
+        page = write_report(out).read_text(encoding="utf-8")
+    assert "files missing or unreadable" in page  # it looked only inside tools/, under the safe name

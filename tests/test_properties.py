@@ -785,3 +785,28 @@ def test_library_with_a_zero_width_membership_function(seeds, heavy, tmp_path):
     _run(["library", heavy / "lib.csv", "--campaign", seeds / "camp", "--models", inp / "results" / "models",
           "--out", out / "lib", "--workers", "1", "--samples", "8", "--rpm-points", "20"],
          [p for p in inp.rglob("*") if p.is_file()], out)
+
+
+@pytest.mark.parametrize("argv", [
+    ["modal", "{fifo}", "--out", "{out}"],
+    ["check", "{fifo}"],
+    ["lobes", "{fifo}", "--teeth", "2", "--tangential-coeff", "6e8", "--radial-ratio", "0.3", "--immersion", "1",
+     "--rpm", "1000:2000", "--out", "{out}"],
+    ["tap", "{fifo}", "--out", "{out}"],
+    ["library", "{fifo}", "--campaign", "{out}", "--models", "{out}", "--out", "{outdir}"],
+    ["cut", "{fifo}", "--rpm", "6000", "--teeth", "2"],
+])
+def test_a_fifo_where_a_file_is_expected_is_one_line_not_a_hang(tmp_path, argv):
+    """Opening a named pipe for reading blocks until a writer comes: readers refuse anything but regular files."""
+    import os
+    import subprocess
+    import sys
+
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    args = [a.format(fifo=fifo, out=tmp_path / "o.csv", outdir=tmp_path / "lib") for a in argv]
+    run = subprocess.run([sys.executable, "-m", "toolpoint.cli.main", *args], capture_output=True, text=True,
+                         timeout=60)
+    assert run.returncode == 2, run.stderr
+    err = run.stderr.strip().splitlines()
+    assert len(err) == 1 and "pipe.csv" in err[0] and "regular file" in err[0]

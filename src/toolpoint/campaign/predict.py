@@ -19,6 +19,7 @@ from ..learning.anfis import ANFIS
 from ..dynamics.assembly import Assembly, load_assembly
 from ..errors import ExtrapolationWarning, InputError
 from ..frf import FRF
+from ..io.table import check_regular_file
 from ..dynamics.model import ToolPointModel
 from ..identification.params import PARAMS
 from ..dynamics.subassembly import Subassembly
@@ -111,6 +112,7 @@ class GPModel:
     @classmethod
     def load(cls, path) -> "GPModel":
         """Read ``gp_<target>.json`` (ValueError, KeyError or OSError if it is not one)."""
+        check_regular_file(path, what="GP model file")
         return cls(json.loads(Path(path).read_text(encoding="utf-8")))
 
     def predict(self, X) -> tuple[np.ndarray, np.ndarray]:
@@ -152,6 +154,8 @@ def load_gp_models(models_dir) -> dict[str, GPModel]:
     if not d.is_dir():
         raise InputError("models folder not found", file=d, field="--models")
     path = d / MANIFEST
+    if path.exists():
+        check_regular_file(path, what="models manifest")
     try:
         names = dict(json.loads(path.read_text(encoding="utf-8")).get("gp", {}))
     except (OSError, UnicodeDecodeError, ValueError, TypeError, AttributeError) as e:
@@ -177,6 +181,7 @@ def _manifest(d: Path) -> list[str]:
     path = d / MANIFEST
     if not path.exists():
         return [p for p in PARAMS if (d / f"{p}.json").exists()]
+    check_regular_file(path, what="models manifest")
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
         names = list(doc["models"])

@@ -122,9 +122,13 @@ def _rpm_range(text: str) -> tuple[float, float]:
 
 def _load(path: str, flag: str, freq_hz=None):
     """An FRF from a file, or from an assembly TOML (``toolpoint.dynamics.model.frf_from_toml``)."""
+    from ..io.table import check_regular_file
+
     p = Path(path)
-    if not p.is_file():
-        raise InputError("no such file", file=p, field=flag)
+    try:
+        check_regular_file(p, what="FRF file")
+    except InputError as err:
+        raise InputError(err.message, file=p, field=flag) from None
     try:
         if p.suffix.lower() == ".toml":
             from ..dynamics.model import frf_from_toml

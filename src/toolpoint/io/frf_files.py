@@ -600,6 +600,10 @@ def _quantity(path, quantity) -> str:
 
 
 def _check_readable(path) -> None:
+    from .table import check_regular_file
+
+    if os.path.exists(path):
+        check_regular_file(path)  # a FIFO would block the open below for ever
     try:
         with open(path, "rb"):
             pass

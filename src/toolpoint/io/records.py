@@ -135,6 +135,9 @@ def _pick(data: np.ndarray, channel: int | None, p: Path, what: str) -> tuple[np
 def _read_audio(p: Path, channel: int | None) -> CutRecord:
     import soundfile as sf
 
+    from .table import check_regular_file
+
+    check_regular_file(p, what="record")
     try:
         data, rate = sf.read(p, dtype="float32", always_2d=True)
     except (sf.LibsndfileError, RuntimeError, TypeError, ValueError) as err:

@@ -12,11 +12,12 @@ from __future__ import annotations
 
 import csv
 import os
+import stat
 from pathlib import Path
 
 from ..errors import InputError
 
-__all__ = ["read_rows", "read_table"]
+__all__ = ["read_rows", "read_table", "csv_safe", "csv_unsafe", "check_regular_file"]
 
 
 def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, list[str]]]:
@@ -48,6 +49,8 @@ def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, 
     p = Path(path)
     if p.is_dir():
         raise InputError(f"cannot read {what}: is a folder, not a file", file=p)
+    if p.exists():
+        check_regular_file(p, what=what)
     try:
         with open(p, newline="", encoding="utf-8-sig") as fh:
             reader = csv.reader(fh)
@@ -85,3 +88,62 @@ def read_table(path: str | os.PathLike, *, what: str = "CSV") -> tuple[list[str]
             d[None] = row[len(header):]
         out.append((line, d))
     return header, out
+
+
+_FORMULA = ("=", "+", "-", "@", "\t", "\r")
+
+
+def csv_safe(value) -> str:
+    """A CSV cell a spreadsheet will not run as a formula (OWASP's "CSV injection" rule).
+
+    Text starting with ``= + - @``, a tab or a carriage return gets the standard quote prefix ``'``; numbers
+    (``-1.5``, ``+3e-7``) stay numbers. :func:`csv_unsafe` undoes it when toolpoint reads its own files back.
+
+    Examples
+    --------
+    >>> csv_safe("=cmd|' /C calc'!A0"), csv_safe("-1.5"), csv_safe("EM10-45"), csv_safe(2.5)
+    ("'=cmd|' /C calc'!A0", '-1.5', 'EM10-45', '2.5')
+    """
+    text = str(value)
+    if text.startswith(_FORMULA):
+        try:
+            float(text)
+            return text
+        except ValueError:
+            return "'" + text
+    return text
+
+
+def csv_unsafe(text: str) -> str:
+    """The cell as written before :func:`csv_safe` (a leading ``'`` before a formula character removed)."""
+    return text[1:] if text.startswith("'") and text[1:].startswith(_FORMULA) else text
+
+
+def check_regular_file(path, *, what: str = "file") -> Path:
+    """``path`` as a Path if it is a regular file; else one line naming it (missing, a folder, a FIFO, a device).
+
+    Every reader calls this before opening: opening a FIFO (named pipe) for reading blocks until something writes
+    to it, i.e. for ever, and a device can stream without end.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> d = tempfile.mkdtemp(); fifo = os.path.join(d, "p"); os.mkfifo(fifo)
+    >>> check_regular_file(fifo, what="FRF file")
+    Traceback (most recent call last):
+    ...
+    toolpoint.errors.InputError: ...p: cannot read FRF file: not a regular file (a FIFO/named pipe)
+    """
+    p = Path(path)
+    try:
+        st = os.stat(p)
+    except FileNotFoundError:
+        raise InputError(f"cannot read {what}: file not found", file=p) from None
+    except OSError as exc:
+        raise InputError(f"cannot read {what} ({exc.strerror or exc})", file=p) from None
+    if stat.S_ISREG(st.st_mode):
+        return p
+    kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO/named pipe" if stat.S_ISFIFO(st.st_mode)
+            else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode)
+            else "a socket" if stat.S_ISSOCK(st.st_mode) else "not a file")
+    raise InputError(f"cannot read {what}: not a regular file ({kind})", file=p)

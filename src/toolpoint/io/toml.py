@@ -80,6 +80,10 @@ class TomlReader:
 def load_toml(path: str | Path) -> dict:
     """Read a TOML file; unreadable, undecodable or malformed files raise InputError."""
     path = Path(path)
+    if path.exists() and not path.is_dir():
+        from .table import check_regular_file
+
+        check_regular_file(path, what="TOML file")
     try:
         with open(path, "rb") as fh:
             return tomllib.load(fh)

@@ -813,6 +813,10 @@ class ANFIS(RegressorMixin, BaseEstimator):
         OSError
             The file cannot be opened.
         """
+        from ..io.table import check_regular_file
+
+        if os.path.exists(path):
+            check_regular_file(path, what="model file")  # a FIFO would block the open for ever
         with open(path, encoding="utf-8") as fh:
             try:
                 doc = json.load(fh)

@@ -38,8 +38,10 @@ Examples
 
 from __future__ import annotations
 
+import hashlib
 import math
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -209,3 +211,32 @@ def read_library(path: str | os.PathLike) -> tuple[list[LibraryTool], list[BadRo
         except ValueError as e:
             bad.append(BadRow(tid, f"{tid}: {' '.join(str(e).split())}", line))
     return tools, bad
+
+
+_SAFE_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
+_RESERVED = {"con", "prn", "aux", "nul", *(f"com{i}" for i in range(10)), *(f"lpt{i}" for i in range(10))}
+
+
+def tool_file_stem(tool_id: str) -> str:
+    """The file name stem of a tool's result files: a tool id from a library never becomes a path as it is.
+
+    An id of at most 64 letters, digits, ``.``, ``_``, ``-`` (starting with a letter or digit, not a reserved device
+    name such as ``CON`` or ``NUL``) is its own stem, so ``EM10-45`` gives ``tools/EM10-45.json``. Any other id — path
+    separators, ``..``, NUL, newlines, 300 characters, a leading ``=`` — gives its safe characters (at most 40) and a
+    hash of the whole id: unique, bounded, inside the folder. The tool's JSON records the id itself.
+
+    Examples
+    --------
+    >>> tool_file_stem("EM10-45")
+    'EM10-45'
+    >>> tool_file_stem("../../x")
+    'x-9bdbf20b56'
+    >>> len(tool_file_stem("a" * 300)), tool_file_stem("CON").startswith("CON-")
+    (51, True)
+    """
+    tool_id = str(tool_id)
+    if _SAFE_ID.fullmatch(tool_id) and tool_id.split(".")[0].lower() not in _RESERVED and not tool_id.endswith("."):
+        return tool_id
+    slug = re.sub(r"[^A-Za-z0-9._-]+", "_", tool_id).strip("._-")[:40]
+    digest = hashlib.sha1(tool_id.encode("utf-8", "surrogatepass")).hexdigest()[:10]
+    return f"{slug}-{digest}" if slug else f"tool-{digest}"

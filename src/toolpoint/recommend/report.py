@@ -28,9 +28,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from .library import tool_file_stem
 from ..identification.params import PARAMS, UNITS
 from ..io.atomic import atomic_open
-from ..io.table import read_table
+from ..io.table import check_regular_file, csv_unsafe, read_table
 from .run import FILE_NAME
 
 __all__ = ["write_report", "SHOWN", "FRF_BINS", "RPM_BINS", "MAP_SHAPE"]
@@ -181,10 +182,16 @@ _DAMAGED = (OSError, ValueError, KeyError, IndexError, TypeError, AttributeError
 
 
 def _section(d: Path, tid: str, n_data: int) -> str:
-    """One tool's collapsible section (its data read from ``d/tools/<tid>.npz`` and ``.json``)."""
-    with np.load(d / "tools" / f"{tid}.npz") as z:
+    """One tool's collapsible section (its data read from ``d/tools/<stem>.npz`` and ``.json``: only the names
+    ``library`` writes, :func:`~toolpoint.recommend.library.tool_file_stem`, inside ``d/tools``)."""
+    stem = d / "tools" / tool_file_stem(tid)
+    for ext in (".npz", ".json"):  # a FIFO in place of a tool file would block the page for ever
+        check_regular_file(f"{stem}{ext}", what="tool file")
+    with np.load(f"{stem}.npz", allow_pickle=False) as z:
         a = {k: z[k] for k in z.files}
-    s = json.loads((d / "tools" / f"{tid}.json").read_text(encoding="utf-8"))
+    s = json.loads(Path(f"{stem}.json").read_text(encoding="utf-8"))
+    if s.get("id") != tid:
+        raise ValueError(f"the files hold tool {s.get('id')!r}, not {tid!r}")
     data = json.dumps(_plot_data(a, s), separators=(",", ":"), allow_nan=False)
     def lim(p, k):  # a limit at the depth cap is no computed limit: it lies above the cap
         return f"≥ {s['cap_mm']:.3g}" if k in p.get("capped", ()) else f"{p[k]:.3g}"
@@ -235,6 +242,7 @@ def write_report(out_dir, path=None) -> Path:
     if not table.is_file():
         raise InputError("not found: run 'toolpoint library' first", file=table)
     header, rows = read_table(table, what="the library's results")
+    rows = [(n, {k: csv_unsafe(v) if isinstance(v, str) else v for k, v in r.items()}) for n, r in rows]
     for name in ("id", "status"):
         if name not in header:
             raise InputError(f"no column {name!r}: not a 'toolpoint library' results table", file=table, field=name)
@@ -267,7 +275,7 @@ def write_report(out_dir, path=None) -> Path:
             sections.append(_section(d, tid, n_data + 1))
             n_data += 1
         except _DAMAGED as e:  # a damaged tool is named on the page and on stderr; the others go on
-            where = d / "tools" / tid
+            where = d / "tools" / tool_file_stem(tid)
             warnings.warn(f"{where}.json/.npz: unreadable or incomplete ({type(e).__name__}: {e}); "
                           "its section of the report says so (run 'toolpoint library' again to redo it)")
             sections.append(f'<details id="tool-{html.escape(tid)}"><summary>{html.escape(tid)}</summary>'

@@ -1,8 +1,9 @@
 """``library``: recommend speeds and depths for every tool of a library, resumably.
 
 Rows go to ``OUT/recommendations.csv`` as tools finish (flushed and synced),
-each after the tool's files ``OUT/tools/<id>.npz`` (arrays) and
-``OUT/tools/<id>.json`` (summary) were written atomically; a killed run loses at
+each after the tool's files ``OUT/tools/<stem>.npz`` (arrays) and
+``OUT/tools/<stem>.json`` (summary, with the id) were written atomically — ``<stem>`` is
+:func:`~toolpoint.recommend.library.tool_file_stem` of the id, never the id as it is; a killed run loses at
 most the tools being computed. A re-run keeps the ``ok`` rows whose files
 exist, and computes the rest (bad rows are checked again). Tools run in a local
 process pool or on an existing Dask cluster, like ``campaign run``.
@@ -34,9 +35,9 @@ from ..campaign.run import execute
 from ..errors import ExtrapolationWarning, InputError
 from ..identification.params import PARAMS
 from ..io.atomic import atomic_open, atomic_path
-from ..io.table import read_table
+from ..io.table import csv_safe, csv_unsafe, read_table
 from .engine import ToolJob, evaluate_tool
-from .library import read_library
+from .library import read_library, tool_file_stem
 from .uncertainty import WIDEN_PER_RANGE, JointPredictor
 
 __all__ = ["COLUMNS", "FILE_NAME", "run_library"]
@@ -53,9 +54,11 @@ def _resume(path: Path, tools_dir: Path, ids: set, model: str) -> set:
     ``model`` (a run with the other joint model starts those tools again); their ids."""
     keep = []
     if path.exists():
-        rows = [r for _, r in read_table(path, what="the results to resume")[1]]
+        rows = [{k: csv_unsafe(v) if isinstance(v, str) else v for k, v in r.items()}
+                for _, r in read_table(path, what="the results to resume")[1]]
         keep = [r for r in rows if r.get("status") == "ok" and r.get("id") in ids and r.get("error") is not None
-                and (tools_dir / f"{r['id']}.npz").exists() and _tool_model(tools_dir / f"{r['id']}.json") == model]
+                and (tools_dir / f"{tool_file_stem(r['id'])}.npz").exists()
+                and _tool_model(tools_dir / f"{tool_file_stem(r['id'])}.json") == model]
     with atomic_open(path, "w", newline="", encoding="utf-8") as fh:
         w = csv.DictWriter(fh, COLUMNS, extrasaction="ignore")
         w.writeheader()
@@ -86,7 +89,7 @@ def _row(tool, status, **cells) -> dict:
         row.update(holder=tool.holder, diameter_mm=_fmt(tool.diameter_mm), overhang_mm=_fmt(tool.overhang_mm),
                    teeth=tool.cutting.teeth, material=tool.material, cutting_source=tool.cutting_source)
     row.update({k: _fmt(v) for k, v in cells.items()})
-    return row
+    return {k: csv_safe(v) for k, v in row.items()}  # the file is opened in spreadsheets: no formula cells
 
 
 def _ok_row(tool, summary, delta, notes) -> dict:
@@ -105,9 +108,10 @@ def _ok_row(tool, summary, delta, notes) -> dict:
 def _write_tool(tools_dir: Path, tool_id: str, result: dict, extra: dict) -> None:
     buf = io.BytesIO()
     np.savez_compressed(buf, **result["arrays"])
-    with atomic_path(tools_dir / f"{tool_id}.npz") as tmp:
+    stem = tool_file_stem(tool_id)  # never the id as it is: ids come from a file anyone may have written
+    with atomic_path(tools_dir / f"{stem}.npz") as tmp:
         Path(tmp).write_bytes(buf.getvalue())
-    with atomic_open(tools_dir / f"{tool_id}.json", "w", encoding="utf-8") as fh:
+    with atomic_open(tools_dir / f"{stem}.json", "w", encoding="utf-8") as fh:
         json.dump({**result["summary"], **extra}, fh, indent=1, allow_nan=True)
 
 

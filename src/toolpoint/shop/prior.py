@@ -161,8 +161,11 @@ def prior_from_library(out_dir: str | os.PathLike, tool_id: str, *, sigma_freq: 
     InputError
         A missing tool, or a FRF without a resonance.
     """
+    from ..recommend.library import tool_file_stem
+
     tools = Path(out_dir) / "tools"
-    npz, js = tools / f"{tool_id}.npz", tools / f"{tool_id}.json"
+    stem = tool_file_stem(tool_id)  # the names library writes, never the id as a path
+    npz, js = tools / f"{stem}.npz", tools / f"{stem}.json"
     if not npz.exists() or not js.exists():
         have = sorted(q.stem for q in tools.glob("*.json")) if tools.is_dir() else []
         raise InputError(f"no tool {tool_id!r} in this library output (tools: {', '.join(have[:10]) or 'none'})",
