@@ -32,7 +32,7 @@ def small(tmp_path_factory):
 def test_a_second_run_into_the_same_folder_refuses(small, tmp_path):
     out = tmp_path / "res"
     out.mkdir()
-    with run_mod._folder_lock(out):  # a run in progress
+    with run_mod.folder_lock(out):  # a run in progress
         with pytest.raises(InputError, match="another campaign run .pid"):
             run_campaign(small, out, workers=1, progress=False)
     assert not (out / "identified.csv").exists()

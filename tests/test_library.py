@@ -310,7 +310,8 @@ def test_cli_bad_rows_on_stderr_others_go_on(tmp_path, capsys):
     code = main(["library", str(lib), "--campaign", str(root / "camp"), "--models", str(root / "results" / "models"),
                  "--out", str(tmp_path / "o"), "--workers", "1", "--samples", "10", "--rpm-points", "50"])
     cap = capsys.readouterr()
-    assert code == 0 and "1 tools ok, 2 failed" in cap.out
+    assert code == 1 and "1 tools ok, 2 failed" in cap.out  # finished with failed items: exit 1, not 0
+    assert "finished, 2 tools failed" in cap.err
     errs = [ln for ln in cap.err.splitlines() if ln.startswith("error: ")]
     assert [ln.split(":")[1].strip() for ln in errs] == ["C1", "D1"]
     assert math.isfinite(float(_rows(tmp_path / "o")["A16"]["depth_mm"]))
@@ -400,3 +401,24 @@ def test_report_does_not_follow_an_id_out_of_the_tools_folder(tmp_path):
     with pytest.warns(UserWarning, match="unreadable or incomplete"):
         page = write_report(out).read_text(encoding="utf-8")
     assert "files missing or unreadable" in page  # it looked only inside tools/, under the safe name
+
+
+def test_a_second_library_run_into_the_same_folder_is_refused_and_stale_temporaries_go(tmp_path):
+    from toolpoint.campaign.run import folder_lock
+    from toolpoint.errors import InputError
+
+    root = small_campaign()
+    lib = _library(tmp_path / "lib.csv", GOOD[:1])
+    out = tmp_path / "o"
+    (out / "tools").mkdir(parents=True)
+    stale = out / "tools" / ".A16.npz.x1y2.tmp.npz"  # what a SIGTERM during an atomic write leaves
+    stale.write_bytes(b"half")
+    args = (lib, root / "camp", root / "results" / "models", out)
+    with folder_lock(out, "library run"):  # a run in progress
+        with pytest.raises(InputError, match="another library run"):
+            run_library(*args, workers=1, n_samples=10, rpm_points=30, progress=False)
+    assert stale.exists()  # the refused run touched nothing
+    run_library(*args, workers=1, n_samples=10, rpm_points=30, progress=False)
+    assert not stale.exists()
+    with open(out / "recommendations.csv") as fh:
+        assert sum(1 for line in fh if line.startswith("A16,")) == 1

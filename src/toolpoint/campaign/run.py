@@ -294,7 +294,7 @@ def run_campaign(folder, out_dir, *, method: str | None = None, workers: int | N
             out.mkdir(parents=True, exist_ok=True)
         except OSError as e:
             raise InputError(f"cannot make the results folder ({e.strerror})", file=out, field="--out") from None
-        with _folder_lock(out):
+        with folder_lock(out):
             return _run_locked(c, out, method, seed, workers, client, progress, t0, native)
     finally:
         if client is not None:
@@ -332,7 +332,7 @@ LOCK_NAME = ".toolpoint-run.lock"
 
 
 @contextmanager
-def _folder_lock(out: Path):
+def folder_lock(out: Path, what: str = "campaign run"):
     """One run per results folder: a second concurrent run refuses instead of interleaving rows.
 
     An advisory ``flock`` on a file in the folder; the kernel drops it when the
@@ -351,7 +351,7 @@ def _folder_lock(out: Path):
         except OSError:
             fh.seek(0)
             who = fh.read().strip() or "another process"
-            raise InputError(f"another campaign run ({who}) is writing to this folder; wait for it or choose "
+            raise InputError(f"another {what} ({who}) is writing to this folder; wait for it or choose "
                              "another --out", file=out, field="--out") from None
         fh.seek(0)
         fh.truncate()

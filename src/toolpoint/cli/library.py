@@ -78,4 +78,7 @@ def run(args) -> int:
             print(f"report → {write_report(args.out)}")
         except OSError as e:
             raise InputError(f"cannot write the report: {e}", file=args.out) from None
+    if counts["failed"]:  # a script can trust the code: 0 only when every tool succeeded (as make -k, rsync)
+        print(f"finished, {counts['failed']} tools failed (their rows say why)", file=sys.stderr)
+        return 1
     return 0

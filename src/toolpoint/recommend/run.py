@@ -178,12 +178,23 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
     tools, bad = read_library(library)
     c = load_campaign(campaign)
     predictor = JointPredictor(models, model)
-    from ..campaign.run import dask_client
+    from ..campaign.run import dask_client, folder_lock
 
     client = dask_client(dask) if dask else None
     out = Path(out_dir)
     tools_dir = out / "tools"
     tools_dir.mkdir(parents=True, exist_ok=True)
+    with folder_lock(out, "library run"):  # a second run into this folder refuses instead of doubling rows
+        return _run_locked(tools, bad, c, predictor, client, out, tools_dir, workers=workers, n_samples=n_samples,
+                           rpm_points=rpm_points, seed=seed, margin=margin, rpm_tolerance=rpm_tolerance,
+                           outside=outside, model=model, progress=progress, on_bad=on_bad)
+
+
+def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_samples, rpm_points, seed, margin,
+                rpm_tolerance, outside, model, progress, on_bad) -> dict:
+    """The locked part of :func:`run_library`: stale temporary files cleared, resume, compute, write rows."""
+    for stale in tools_dir.glob(".*.tmp*"):  # left by a run killed while writing (atomic writes' temporaries)
+        stale.unlink(missing_ok=True)
     path = out / FILE_NAME
     done = _resume(path, tools_dir, {t.id for t in tools}, model)
     todo = [t for t in tools if t.id not in done]
