@@ -188,3 +188,28 @@ def test_removed_fmin_fmax_name_band(tmp_path, example_path, noisy_csv, capsys, 
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and flag in err[0] and "--band LO:HI" in err[0]
     assert not out.exists()
+
+
+@pytest.mark.parametrize("extra, field", [
+    (["--bounds", "kt=1e300:1e308"], "--bounds.kt"),
+    (["--joint", ""], "--joint"),
+    (["--params", ""], "--params"),
+    (["--params", ","], "--params"),
+])
+def test_absurd_bounds_and_empty_names_are_one_line(tmp_path, example_path, noisy_csv, capsys, extra, field):
+    out = tmp_path / "r.json"
+    assert main(["identify", str(example_path), str(noisy_csv), *extra, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and field in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_an_all_zero_frf_is_refused_not_identified(tmp_path, example_path, capsys):
+    f = np.arange(1.0, 3001.0)
+    zero = tmp_path / "zero.csv"
+    np.savetxt(zero, np.column_stack([f, 0 * f, 0 * f]), delimiter=",", header="freq_hz,real,imag", comments="")
+    out = tmp_path / "r.json"
+    assert main(["identify", str(example_path), str(zero), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "zero.csv" in err and "zero at every frequency" in err
+    assert not out.exists()

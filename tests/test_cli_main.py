@@ -150,3 +150,25 @@ def test_every_command_has_a_description():
                     walk(sp, path + [name])
 
     walk(build_parser(None), [])
+
+
+def test_an_os_error_is_one_line_exit_2(monkeypatch, capsys, tmp_path):
+    """A full disk (ENOSPC) anywhere in a command: one line naming the file and the reason, no traceback."""
+    import errno
+
+    from toolpoint.cli import frf as frf_cmd
+
+    def full(args):
+        raise OSError(errno.ENOSPC, "No space left on device", str(tmp_path / "frf.csv"))
+
+    monkeypatch.setattr(frf_cmd, "run", full)
+    assert main(["frf", "examples/numerical_case.toml", "--out", str(tmp_path / "frf.csv")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "frf.csv: No space left on device" in err[0]
+
+
+def test_a_file_name_with_a_newline_keeps_the_error_on_one_line(tmp_path, capsys):
+    bad = tmp_path / "a\nb.csv"
+    assert main(["modal", str(bad), "--out", str(tmp_path / "o.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "a\\nb.csv" in err

@@ -34,7 +34,9 @@ class InputError(ValueError):
         self.message = " ".join(str(message).split())  # keep it to one line
         self.file = None if file is None else str(file)
         self.field = field
-        parts = [p for p in (self.file, self.field) if p]
+        # a file name may hold a newline or other control characters: escaped, the error stays one line
+        parts = [p.encode("unicode_escape").decode("ascii", "replace") if any(ord(c) < 32 for c in p) else p
+                 for p in (self.file, self.field) if p]
         super().__init__(": ".join(parts + [self.message]))
 
 

@@ -90,6 +90,10 @@ def run(args) -> int:
     """Run ``toolpoint identify``; returns the exit code (0)."""
     args.method = check_method(args.method)
     check_number(args.seed, "--seed", minimum=0)  # NumPy's generator refuses a negative seed with a ValueError
+    for flag in ("joint", "params"):  # given but empty is a mistake, not "absent"
+        if getattr(args, flag, None) is not None and not str(getattr(args, flag)).strip(" ,"):
+            raise InputError("is empty: name the joint (e.g. spindle_holder) or the parameters",
+                             file="command line", field=f"--{flag}")
     if general_requested(args):
         return run_general(args)
     if len(args.measured) != 1:
@@ -108,6 +112,9 @@ def run(args) -> int:
         if meas.freq_hz[0] == 0:  # free–free components are singular there; the band note names what is fitted
             meas = meas.band(fmin=np.nextafter(0.0, 1.0))
         meas, note = fit_band(meas, args.measured, band_spec(args))
+        if not np.any(meas.values):  # a joint fitted to zeros would be "identified" at the bounds
+            raise InputError("the FRF is zero at every frequency of the band: nothing to identify", file=args.measured,
+                             field="values")
         if len(meas) < MIN_POINTS:
             raise InputError(f"only {len(meas)} points in the fitted band, need at least {MIN_POINTS}",
                              file=args.measured, field="freq_hz")
@@ -332,6 +339,9 @@ def _general_setup(args):
         if frf.freq_hz[0] == 0:  # free–free components are singular there; the band note names what is fitted
             frf = frf.band(fmin=np.nextafter(0.0, 1.0))
         frf, note = fit_band(frf, path, spec)
+        if not np.any(frf.values):  # a joint fitted to zeros would be "identified" at the bounds
+            raise InputError("the FRF is zero at every frequency of the band: nothing to identify", file=path,
+                             field="values")
         if note:
             args.band_notes.append(note)
         if len(frf) < MIN_POINTS:

@@ -148,6 +148,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"toolpoint {args.command}: interrupted", file=sys.stderr)
         return 130
+    except OSError as err:  # the operating system's refusals (full disk, permission, name too long): one line
+        name = InputError("", file=err.filename).file if err.filename else "file system"
+        print(f"toolpoint {args.command}: error: {name}: {err.strerror or err}", file=sys.stderr)
+        return 2
     return int(code or 0)
 
 

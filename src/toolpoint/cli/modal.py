@@ -92,6 +92,9 @@ def run(args) -> int:
             flag = {"band": "--band", "n_modes": "--modes"}.get(e.field)
             if flag is None:
                 raise
+            if flag == "--band" and args.band is None:  # the data are short, not a band the user gave
+                raise InputError(e.message.replace(" in the band 0–inf Hz", ""), file=args.frf[0],
+                                 field="freq_hz") from None
             raise InputError(e.message, file="command line", field=flag) from None
     if plot:  # render first: a plotting failure must not leave a CSV without its figure
         fig = _figure(frfs, fit, args.frf)

@@ -33,6 +33,18 @@ UNITS = {"kt": "N/m", "ct": "N s/m", "kr": "N m/rad", "cr": "N m s/rad"}
 PAPER_BOUNDS = {"kt": (1e6, 1e9), "ct": (1.0, 300.0), "kr": (1e5, 1e7), "cr": (1.0, 300.0)}
 
 
+BOUND_RANGE = (1e-12, 1e15)
+"""Search bounds of joint and bearing parameters outside this range (SI) are refused: joints measure k ≈ 1e4–1e10
+(N/m, N m/rad) and c ≈ 1e-3–1e4 (N s/m, N m s/rad); a bound of 1e300 is a typo, and would overflow the model."""
+
+
+def check_bound_range(lo: float, hi: float, *, file=None, field=None) -> None:
+    """One line naming ``field`` when a bound lies outside :data:`BOUND_RANGE`."""
+    if lo < BOUND_RANGE[0] or hi > BOUND_RANGE[1]:
+        raise InputError(f"bounds [{lo:g}, {hi:g}] lie outside any joint's range ({BOUND_RANGE[0]:g}–"
+                         f"{BOUND_RANGE[1]:g} in SI units): a typo?", file=file, field=field)
+
+
 @dataclass(frozen=True)
 class Bounds:
     """Box bounds of the search, SI units, one (lo, hi) per parameter of :data:`PARAMS`.
@@ -89,6 +101,7 @@ class Bounds:
                 raise InputError(f"must be [lo, hi], got {val!r}", file=source, field=field) from None
             if not (np.isfinite(lo) and np.isfinite(hi)) or lo <= 0 or hi <= 0:
                 raise InputError(f"bounds must be finite and > 0, got [{lo:g}, {hi:g}]", file=source, field=field)
+            check_bound_range(lo, hi, file=source, field=field)
             if lo >= hi:
                 raise InputError(f"lo must be < hi, got [{lo:g}, {hi:g}]", file=source, field=field)
             merged[key] = (lo, hi)

@@ -29,7 +29,7 @@ from ..errors import InputError
 from ..frf import FRF
 from .identify import INTERVALS_DEFAULT, IdentificationResult, solve
 from .objective import JointProblem
-from .params import DEFAULT_BOUNDS, ELEMENT_PARAMS, ELEMENT_UNITS, Bounds
+from .params import DEFAULT_BOUNDS, ELEMENT_PARAMS, ELEMENT_UNITS, Bounds, check_bound_range
 
 __all__ = ["Measured", "parse_params", "param_bounds", "FRFProblem", "identify_frfs"]
 
@@ -145,6 +145,7 @@ def param_bounds(params, overrides: dict | None = None, *, file=None, field: str
             raise InputError(f"must be [lo, hi], got {val!r}", file=file, field=f"{field}.{key}") from None
         if not (np.isfinite(lo) and np.isfinite(hi)) or lo <= 0 or hi <= 0:
             raise InputError(f"bounds must be finite and > 0, got [{lo:g}, {hi:g}]", file=file, field=f"{field}.{key}")
+        check_bound_range(lo, hi, file=file, field=f"{field}.{key}")
         if lo >= hi:
             raise InputError(f"lo must be < hi, got [{lo:g}, {hi:g}]", file=file, field=f"{field}.{key}")
         over[name] = (lo, hi)
