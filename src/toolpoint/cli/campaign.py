@@ -29,9 +29,9 @@ def register(sub) -> None:
     cs = p.add_subparsers(dest="campaign_command", required=True, metavar="STEP")
 
     s = cs.add_parser("synth", help="write a realistic synthetic campaign (truth law documented, kept in truth/)")
-    s.add_argument("out_dir")
+    s.add_argument("out_dir", help="new campaign folder to write (campaign.toml, FRFs, measurements.csv, truth/)")
     s.add_argument("--n", type=int, default=178, help="number of tool assemblies (default 178)")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=int, default=0, help="seed of the tools, joints and noise drawn (default 0)")
     s.add_argument("--noise", type=float, default=0.01,
                    help="tool-point FRF noise, fraction of the peak (default 0.01)")
     s.add_argument("--blank-noise", type=float, default=5e-5,
@@ -40,16 +40,16 @@ def register(sub) -> None:
     s.set_defaults(func=_synth)
 
     r = cs.add_parser("run", help="identify the joint of every measurement (resumable)")
-    r.add_argument("campaign_dir")
+    r.add_argument("campaign_dir", help="campaign folder (campaign.toml, measurements.csv, FRF files)")
     r.add_argument("--out", required=True, help="results folder (identified.csv)")
     r.add_argument("--method", help="hybrid, ga, sa, pso or de (default: campaign.toml, else hybrid)")
     r.add_argument("--workers", type=int, help="local processes (default: all cores)")
     r.add_argument("--dask", metavar="ADDRESS", help="run on an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
-    r.add_argument("--seed", type=int, default=0)
+    r.add_argument("--seed", type=int, default=0, help="seed of every identification (default 0)")
     r.set_defaults(func=_run)
 
     lp = cs.add_parser("learn", help="ANFIS per target on (diameter_mm, overhang_mm), with baselines")
-    lp.add_argument("results_dir")
+    lp.add_argument("results_dir", help="results folder of `campaign run` (identified.csv); models/ go beside it")
     add_arguments(lp)
     lp.set_defaults(func=run_cli)
 
@@ -179,7 +179,7 @@ def report_lines(result) -> list[str]:
         if res["anfis"]["overfit"]:
             ratio = overfit_ratio(res["anfis"]["test"]["nrmse"], res["anfis"]["train"]["nrmse"])
             lines.append(f"warning: ANFIS test NRMSE is {ratio:.3g}× its training NRMSE — {rules} rules over-fit "
-                         f"{result.n_train} samples; try fewer MFs (e.g. --mfs 3,3), fewer --epochs, "
+                         f"{res['anfis']['train']['n']} training rows; try fewer MFs (e.g. --mfs 3,3), fewer --epochs, "
                          "and compare the baselines")
         scored = {k: v["test"]["mape"] for k, v in res.items() if math.isfinite(v["test"]["mape"])}
         best = result.best_test_model.get(t)

@@ -43,7 +43,7 @@ def register(sub) -> None:
                    help=f"assembly TOML with the exact [joints.holder_tool] (default {DEFAULT_ASSEMBLY})")
     p.add_argument("--out", default="toolpoint-out", help="output folder (default toolpoint-out)")
     p.add_argument("--methods", default="ga,sa,pso,hybrid", help="comma-separated (default ga,sa,pso,hybrid)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="seed of every search and of the noise (default 0)")
     p.add_argument("--noise", type=float, default=0.0,
                    help="complex Gaussian noise, fraction of the peak |h| (default 0: the paper's noise-free case)")
     p.set_defaults(func=run)
