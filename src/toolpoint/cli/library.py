@@ -42,7 +42,8 @@ def register(sub) -> None:
     p.add_argument("--model", choices=("anfis", "gp"), default="anfis",
                    help="joint distribution from the ANFIS models (σ from training residuals and identification "
                    "intervals; default) or from the GP baselines 'campaign learn' saved (their own predictive σ)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the joint samples (each tool its own from it; default 0)")
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed of the joint samples (each tool its own from it; default 0)")
     p.add_argument("--report", action="store_true", help="also write DIR/report.html")
     p.set_defaults(func=run)
 
