@@ -139,7 +139,7 @@ def test_an_option_with_no_close_match_is_named_alone(capsys):
     assert "unknown option --zzzzzz" in err and "did you mean" not in err
 
 
-def test_every_command_has_a_description():
+def test_every_command_has_a_description_and_every_option_a_help_text():
     import argparse
 
     def walk(parser, path):
@@ -148,6 +148,8 @@ def test_every_command_has_a_description():
                 for name, sp in a.choices.items():
                     assert sp.description, f"toolpoint {' '.join(path + [name])} has no description"
                     walk(sp, path + [name])
+            elif not isinstance(a, argparse._HelpAction):
+                assert a.help, f"toolpoint {' '.join(path)}: {a.option_strings or a.dest} has no help text"
 
     walk(build_parser(None), [])
 
