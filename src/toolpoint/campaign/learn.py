@@ -509,7 +509,8 @@ def _write_plots(t: str, fit: _Fit, plots_dir: Path) -> list[str]:
     figures = {
         test: per_sample_figure(fit.y_test, fit.p_test, label, f"{t}: experimental vs ANFIS, test data"),
         regression: regression_figure(fit.y_test, fit.p_test, label, f"{t}, test data"),
-        membership: membership_figure(fit.model),
+        membership: membership_figure(fit.model, title=f"{t}: ANFIS membership functions",
+                                      input_names=["tool diameter D [mm]", "overhang L [mm]"]),
     }
     try:
         for path, fig in figures.items():

@@ -77,13 +77,17 @@ def plot_membership(model: ANFIS, ax=None, input_names=None, n_points: int = 400
     return fig
 
 
-def membership_figure(model: ANFIS):
+def membership_figure(model: ANFIS, *, title: str | None = None, input_names=None):
     """A new (pyplot-free) figure of the model's membership functions, one panel per input.
 
     Parameters
     ----------
     model : ANFIS
         A fitted model.
+    title : str, optional
+        Figure title (e.g. the target the model predicts).
+    input_names : list of str, optional
+        Axis labels of the inputs with units (default: the model's input names).
 
     Returns
     -------
@@ -92,8 +96,11 @@ def membership_figure(model: ANFIS):
     from matplotlib.figure import Figure
 
     d = model.n_features_in_
-    fig = Figure(figsize=(6.0, 2.2 * d))
-    plot_membership(model, ax=fig.subplots(d, 1, squeeze=False)[:, 0])
+    fig = Figure(figsize=(6.0, 2.2 * d + (0.4 if title else 0.0)))
+    plot_membership(model, ax=fig.subplots(d, 1, squeeze=False)[:, 0], input_names=input_names)
+    if title:
+        fig.suptitle(title)
+        fig.tight_layout()
     return fig
 
 
@@ -162,6 +169,9 @@ def regression_figure(y_true, y_pred, label: str, title: str):
         sign = "+" if b >= 0 else "−"
         ax.plot([lo, hi], [m * lo + b, m * hi + b], "-", label=f"fit: output = {m:.3g}·target {sign} {abs(b):.3g}")
         title = f"{title}: R = {r:.4f}"
+    if lo > 0 and hi / lo > 20:  # targets over decades (kr, dampings): one outlier would squash the rest
+        ax.set_xscale("log")
+        ax.set_yscale("log")
     ax.set_xlabel(f"target {label}")
     ax.set_ylabel(f"output {label}")
     ax.set_title(title)
