@@ -4,7 +4,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-stamp
 OUT ?= toolpoint-out
 
-.PHONY: demo test test-slow lint browser bench docs clean
+.PHONY: demo test test-slow lint browser bench docs readme-check clean
 
 $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
@@ -44,6 +44,10 @@ docs: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[test,docs]"
 	$(VENV)/bin/sphinx-build -W --keep-going -q -b html docs docs/_build/html
 	@echo "documentation: docs/_build/html/index.html"
+
+# Rerun the README's campaign figures and fail when one drifts (Table 1: tests/test_readme.py, slow tier)
+readme-check: $(STAMP)
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(PY) benchmarks/readme_check.py
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache docs/_build docs/api/generated docs/gallery

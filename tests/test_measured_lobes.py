@@ -138,3 +138,19 @@ def test_a_receptance_in_mm_per_newton_is_named(tmp_path, capsys):
     assert "mm/N" in err and "mm.csv" in err
     assert main(["check", str(path)]) == 0
     assert "mm/N" in capsys.readouterr().out
+
+
+def test_modal_plot_shows_the_stabilisation_diagram(tmp_path):
+    from toolpoint.dynamics.modal import fit_frfs
+
+    path, png, out = tmp_path / "lab.txt", tmp_path / "m.png", tmp_path / "m.csv"
+    write_tsv(lab_like_frf(0), path)
+    assert main(["modal", str(path), "--out", str(out), "--plot", str(png)]) == 0
+    assert png.stat().st_size > 20_000
+    fit = fit_frfs([reference_frf()])
+    orders = [o for o, _ in fit.diagram]
+    assert len(orders) > 5 and orders == sorted(orders)
+    # every mode kept is a pole at (almost) every order of the diagram: stable
+    for f0 in DOMINANT_HZ:
+        hits = sum(np.any(np.abs(np.abs(lam) / (2 * np.pi) - f0) < 0.01 * f0) for _, lam in fit.diagram)
+        assert hits >= 0.8 * len(orders)

@@ -3,7 +3,7 @@
 ::
 
     toolpoint anfis train DATA.csv --inputs diameter_mm,overhang_mm --target kt \\
-        --mfs 3,7 --mf gauss --order 1 --epochs 100 [--step-size 0.01] \\
+        --mfs 3,7 --mf gauss --order 1 --epochs 200 [--step-size 0.01] \\
         [--test-fraction 0.2 | --test TEST.csv] [--seed 0] [--log-target] \\
         --out MODEL.json [--plots DIR]
     toolpoint anfis predict MODEL.json DATA.csv --out PRED.csv
@@ -60,7 +60,7 @@ def register(subparsers) -> None:
     t.add_argument("--mf", default="gauss", choices=tuple(MF_PARAMS), help="membership function type (default gauss)")
     t.add_argument("--order", type=int, default=1, choices=(0, 1),
                    help="consequent order: 0 constant, 1 linear (default 1)")
-    t.add_argument("--epochs", type=int, default=100, help="training epochs (default 100)")
+    t.add_argument("--epochs", type=int, default=200, help="training epochs (default 200, as `campaign learn`)")
     t.add_argument("--step-size", type=float, default=0.01, help="initial step size, in input units (default 0.01)")
     split = t.add_mutually_exclusive_group()
     split.add_argument("--test-fraction", type=float, help="hold out this random fraction of DATA as test data")

@@ -135,9 +135,28 @@ def _describe(parser: argparse.ArgumentParser) -> None:
                 _describe(sp)
 
 
+def _terminate_cleanly() -> None:
+    """SIGTERM (a kill, a scheduler's time-out) unwinds like Ctrl-C: atomic writes remove their temporary files
+    and finished work stays; the exit code is 143 (128 + 15). Only in the main thread (signal's rule)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+
+    def stop(signum, frame):
+        raise SystemExit(143)
+
+    try:
+        signal.signal(signal.SIGTERM, stop)
+    except (ValueError, OSError):  # not settable here (embedded interpreter): the default action stays
+        pass
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run ``toolpoint`` with ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
     argv = sys.argv[1:] if argv is None else list(argv)
+    _terminate_cleanly()
     parser = build_parser(argv)
     args = parser.parse_args(argv)
     try:

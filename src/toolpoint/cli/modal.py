@@ -138,7 +138,9 @@ def _figure(frfs, fit, paths):
     import matplotlib.pyplot as plt
 
     m = len(frfs)
-    fig, ax = plt.subplots(2, m, sharex=True, squeeze=False, figsize=(4.5 * m + 1, 5.5), constrained_layout=True)
+    rows = 3 if fit.diagram else 2
+    fig, ax = plt.subplots(rows, m, sharex=True, squeeze=False, figsize=(4.5 * m + 1, 2.75 * rows),
+                           constrained_layout=True)
     lo, hi = fit.band_hz
     for k, (g, path) in enumerate(zip(frfs, paths)):
         q = g.meta.get("file_quantity", g.quantity)
@@ -146,10 +148,37 @@ def _figure(frfs, fit, paths):
         measured = g.band(lo, hi)
         factor = (2j * np.pi * f) ** {"receptance": 0, "mobility": 1, "accelerance": 2}[q]
         measured = FRF(f, measured.values * factor, q, measured.label)
-        measured.plot(ax=ax[:, k], label="measured", color="0.55", lw=1.0)
-        fit.frf(f, k, q).plot(ax=ax[:, k], label=f"modal fit ({fit.n_modes} modes)", color="C3", lw=1.2)
-        for a in ax[:, k]:
+        measured.plot(ax=ax[:2, k], label="measured", color="0.55", lw=1.0)
+        fit.frf(f, k, q).plot(ax=ax[:2, k], label=f"modal fit ({fit.n_modes} modes)", color="C3", lw=1.2)
+        for a in ax[:2, k]:
             for fn in fit.fn_hz:
                 a.axvline(fn, color="C0", lw=0.5, alpha=0.4)
         ax[0, k].set_title(f"{Path(str(path)).name} (fit error {100 * fit.fit_error[k]:.3g} %)", fontsize="medium")
+        if fit.diagram:  # the stabilisation diagram the order was chosen from, under each FRF
+            _stabilisation(ax[2, k], fit, lo, hi)
     return fig
+
+
+def _stabilisation(a, fit, lo, hi):
+    """Poles of every LSCF order (f_n against order): a pole that recurs within 1 % in f_n and 20 % in ζ at the
+    next order (the top order: the one below) is stable (filled); the fit's modes are the vertical lines."""
+    orders = list(fit.diagram)
+    # the top order has no next one: it is judged against the one below
+    neighbours = [d for _, d in orders[1:]] + ([orders[-2][1]] if len(orders) > 1 else [np.empty(0, complex)])
+    for (order, lam), nxt in zip(orders, neighbours):
+        fn = np.abs(lam) / (2 * np.pi)
+        ze = -lam.real / np.maximum(np.abs(lam), 1e-300)
+        inside = (fn >= lo) & (fn <= hi)
+        if nxt.size:
+            fk, zk = np.abs(nxt) / (2 * np.pi), -nxt.real / np.maximum(np.abs(nxt), 1e-300)
+            stable = np.array([np.any((abs(fk - f) < 0.01 * f) & (abs(zk - z) < 0.2 * max(z, 1e-9)))
+                               for f, z in zip(fn, ze)], bool) if fn.size else np.zeros(0, bool)
+        else:
+            stable = np.zeros(fn.size, bool)
+        a.plot(fn[inside & stable], np.full((inside & stable).sum(), order), "o", ms=3, color="C0")
+        a.plot(fn[inside & ~stable], np.full((inside & ~stable).sum(), order), "x", ms=3, color="0.6")
+    for f in fit.fn_hz:
+        a.axvline(f, color="C3", lw=0.8, alpha=0.6)
+    a.set_ylabel("model order")
+    a.set_xlabel("frequency [Hz]")
+    a.set_title("stabilisation diagram (● stable, × not; red: modes kept)", fontsize="small")

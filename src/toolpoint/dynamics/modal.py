@@ -108,6 +108,9 @@ class ModalFit:
         modal constants: residual terms of out-of-band modes, not reported as modes.
     velocity_residual : numpy.ndarray, optional
         (m,) V_e in a further residual term iω V_e, s·m/N (damping of out-of-band modes); None = 0.
+    diagram : tuple
+        The stabilisation diagram the automatic order started from: ``(order, poles)`` per LSCF model order
+        (poles in rad/s, Im > 0); () when not computed.
     """
 
     poles: np.ndarray
@@ -121,6 +124,7 @@ class ModalFit:
     residual_poles: np.ndarray = field(default_factory=lambda: np.empty(0, complex))
     residual_residues: np.ndarray | None = None
     velocity_residual: np.ndarray | None = None
+    diagram: tuple = ()
 
     @property
     def n_modes(self) -> int:
@@ -730,7 +734,9 @@ def _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, labels, quan
         max_order = int(np.clip(4 * want + 16, 24, 80))
     dt = 1.0 / (2.0 * f_hi)
     max_order = int(max_order)  # the upper half of the orders makes the stabilisation diagram
-    poles = _stable_poles(_lscf(w, Yq, Wt, max_order, dt, first=max_order // 2 + 1), f_lo, f_hi)
+    first = max_order // 2 + 1
+    diagram = _lscf(w, Yq, Wt, max_order, dt, first=first)
+    poles = _stable_poles(diagram, f_lo, f_hi)
     if poles.size == 0:
         # Nothing stable: start from the most prominent peaks, as many as the modes asked for (automatic
         # order: _PEAK_STARTS; the forward step adds more where the criterion wants them). Not from every
@@ -770,7 +776,8 @@ def _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, labels, quan
     res = res.T.copy()
     fn = np.abs(poles) / (2 * np.pi)
     mode = (fn >= f_lo) & (fn <= f_hi)
-    kw = dict(residual_poles=poles[~mode], residual_residues=res[~mode])
+    kw = dict(residual_poles=poles[~mode], residual_residues=res[~mode],
+              diagram=tuple((first + i, np.asarray(d)) for i, d in enumerate(diagram)))
     fit = ModalFit(poles[mode], res[mode], U, L, (f_lo, f_hi), quantity, np.zeros(c.shape[0]), labels,
                    velocity_residual=V, **kw)
     err = np.linalg.norm(fit.values(f, quantity) - Yq, axis=0) / np.linalg.norm(Yq, axis=0)
