@@ -4,7 +4,7 @@
 
 CPU time (time.process_time), not wall time: the machine is shared.
 
-1. ``cut``: CPU per second of 44.1 kHz audio on the real shop recording (tests/data/cuts) and on synthetic shop
+1. ``cut``: CPU per second of 44.1 kHz audio on the real shop recording (examples/cuts) and on synthetic shop
    records (tests/shop_synth.py); verdicts over a (speed, chatter amplitude) grid of synthetic records.
 2. ``update``: virtual campaigns (truth drawn from the prior, the next cut from the ``info`` rule) on the
    Cornelius et al. 2024 two-mode case and on the toolpoint example tool, over ``--seeds`` seeds, with two shops:
@@ -37,7 +37,7 @@ from toolpoint.shop.campaign import virtual_campaign  # noqa: E402
 from toolpoint.shop.model import cornelius_2024, example_tool, limit_at_speeds  # noqa: E402
 from toolpoint.shop.update import TestCut, update  # noqa: E402
 
-REAL = Path(__file__).resolve().parents[1] / "tests" / "data" / "cuts" / "combined_chatter6567.mp3"
+REAL = Path(__file__).resolve().parents[1] / "examples" / "cuts" / "combined_chatter6567.mp3"
 
 
 def header():

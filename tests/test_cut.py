@@ -12,7 +12,7 @@ from toolpoint.errors import InputError
 from toolpoint.io.records import read_cut_record
 from toolpoint.shop import analyse_cut, harmonizer_rpm
 
-REAL = Path(__file__).parent / "data" / "cuts" / "combined_chatter6567.mp3"
+REAL = Path(__file__).resolve().parents[1] / "examples" / "cuts" / "combined_chatter6567.mp3"
 
 
 def _cut_segments(res):
@@ -77,7 +77,7 @@ def test_harmonizer_rule():
 
 
 def test_real_shop_recording_air_entry_cut_chatter_exit():
-    """A real shop microphone (UBC, MIT; tests/data/cuts/README.md): air cut, entry, cutting that chatters, exit.
+    """A real shop microphone (UBC, MIT; examples/cuts/README.md): air cut, entry, cutting that chatters, exit.
 
     Speed and teeth are not documented: the audio's tooth-passing comb is at 215.3 Hz; a nominal
     6500 rpm and 2 teeth are given with a 5 % search range and the spindle is found in the record.
