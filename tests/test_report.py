@@ -89,4 +89,11 @@ def test_screenshot(report, tmp_path):
     shot = tmp_path / "shot.png"
     run = subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--window-size=1200,900",
                           f"--screenshot={shot}", report.as_uri()], capture_output=True, text=True, timeout=60)
-    assert run.returncode == 0 and shot.stat().st_size > 20_000  # a rendered page, not a blank one
+    assert run.returncode == 0, run.stderr[-300:]
+    from matplotlib.image import imread
+
+    img = imread(shot)[..., :3]
+    # a rendered page, not a blank one: dark text on white and the colour figures (cividis yellow and blue)
+    assert img.std() > 0.1 and (img.mean(axis=2) < 0.3).mean() > 0.01
+    yellow = (img[..., 0] > 0.8) & (img[..., 1] > 0.75) & (img[..., 2] < 0.4)
+    assert yellow.sum() > 500  # the open tool's probability map is drawn
