@@ -68,8 +68,14 @@ def plot_lobes(result, ax=None, *, show_lobes: bool | None = None, ymax_mm: floa
     if show_lobes is None:
         show_lobes = result.method == "zoa"
     if show_lobes:
+        span = rpm[-1] - rpm[0]
         for i, lobe in enumerate(result.lobes):
-            ax.plot(lobe.rpm, 1e3 * lobe.depth_m, color="0.55", lw=0.7, label="lobes" if i == 0 else None)
+            r, dd = np.asarray(lobe.rpm, float), 1e3 * np.asarray(lobe.depth_m, float)
+            # lobe points come one per FRF frequency; where they are further apart than 2 % of the axis a
+            # straight chord would draw a lobe the data do not give: leave a gap instead
+            gap = np.flatnonzero(np.abs(np.diff(r)) > 0.02 * span) + 1
+            r, dd = np.insert(r, gap, np.nan), np.insert(dd, gap, np.nan)
+            ax.plot(r, dd, color="0.55", lw=0.7, label="lobes" if i == 0 else None)
     ax.plot(rpm, d, color="tab:blue", lw=1.6, label=f"stability limit ({result.method.upper()})")
     if annotate:
         # Markers only where they fall inside the axes (a given ymax_mm can be lower).
