@@ -1,6 +1,11 @@
+import sys
 from pathlib import Path
 
 import pytest
+
+# The suite mirrors the sub-packages (tests/<sub-package>/); the shared test helpers (virtual measurements,
+# synthetic systems) stay in tests/ and are imported by name from every folder.
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from toolpoint.dynamics.assembly import load_assembly
 

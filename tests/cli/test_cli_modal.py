@@ -13,7 +13,7 @@ from scipy.signal import find_peaks
 from modal_systems import FOUR
 from toolpoint.cli.main import main
 
-DATA = __import__("pathlib").Path(__file__).parent / "data" / "pyuff"
+DATA = __import__("pathlib").Path(__file__).parents[1] / "data" / "pyuff"
 F = np.arange(1.0, 3001.0)
 
 

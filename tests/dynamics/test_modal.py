@@ -171,7 +171,7 @@ def test_chain_noise_removed_peaks_kept():
         fit_modal(F3[::-1], Y)
 
 
-EXAMPLE = __import__("pathlib").Path(__file__).resolve().parents[1] / "examples" / "numerical_case.toml"
+EXAMPLE = __import__("pathlib").Path(__file__).resolve().parents[2] / "examples" / "numerical_case.toml"
 
 
 def test_assembly_frf_automatic_order_finds_the_fe_modes():

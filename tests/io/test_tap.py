@@ -238,7 +238,7 @@ from scipy.optimize import brentq  # noqa: E402
 
 from toolpoint.io import virtual_tap as V  # noqa: E402
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "tap_record.csv"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "tap_record.csv"
 LAB_HZ, LAB_ZETA = (1071.0, 1981.0, 2607.0), (0.037, 0.041, 0.021)
 
 

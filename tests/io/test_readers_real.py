@@ -10,7 +10,7 @@ from toolpoint.errors import InputError
 from toolpoint.io.frf_files import read_frf
 from toolpoint.io.impact import read_record
 
-DATA = Path(__file__).parent / "data" / "pyuff"
+DATA = Path(__file__).parents[1] / "data" / "pyuff"
 
 
 def measured(k):

@@ -12,7 +12,7 @@ from toolpoint.errors import InputError
 from toolpoint.io.records import read_cut_record
 from toolpoint.shop import analyse_cut, harmonizer_rpm
 
-REAL = Path(__file__).resolve().parents[1] / "examples" / "cuts" / "combined_chatter6567.mp3"
+REAL = Path(__file__).resolve().parents[2] / "examples" / "cuts" / "combined_chatter6567.mp3"
 
 
 def _cut_segments(res):

@@ -97,7 +97,7 @@ def test_bounds_in_the_assembly_file(tmp_path, example_path, measured_csv, capsy
 def test_reproduce_quick(tmp_path):
     from pathlib import Path
 
-    example = Path(__file__).resolve().parents[1] / "examples" / "numerical_case.toml"
+    example = Path(__file__).resolve().parents[2] / "examples" / "numerical_case.toml"
     assert main(["reproduce", str(example), "--out", str(tmp_path), "--methods", "hybrid,pso"]) == 0
     assert (tmp_path / "fig4.png").exists() and (tmp_path / "table1.csv").exists()
     doc = json.loads((tmp_path / "result_hybrid.json").read_text())

@@ -101,7 +101,7 @@ def test_outputs_get_the_users_umask(tmp_path):
 def test_bad_numbers_are_one_line_exit_2_and_write_nothing(argv, field, tmp_path, capsys, monkeypatch):
     from pathlib import Path
 
-    monkeypatch.chdir(Path(__file__).resolve().parents[1])
+    monkeypatch.chdir(Path(__file__).resolve().parents[2])
     before = sorted(tmp_path.rglob("*"))
     assert main([a.replace("{tmp}", str(tmp_path)) for a in argv]) == 2
     err = capsys.readouterr().err.strip().splitlines()

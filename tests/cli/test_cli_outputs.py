@@ -7,7 +7,7 @@ import pytest
 
 from toolpoint.cli.main import main
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "numerical_case.toml"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "numerical_case.toml"
 
 
 @pytest.fixture

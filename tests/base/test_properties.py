@@ -38,7 +38,7 @@ from toolpoint.cli.main import main
 from toolpoint.errors import InputError
 from toolpoint.frf import FRF
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PYUFF = ROOT / "tests" / "data" / "pyuff"
 # TOOLPOINT_PROPERTY_SCALE=k runs k times the examples, randomised (exploration); the default is derandomised
 SCALE = int(os.environ.get("TOOLPOINT_PROPERTY_SCALE", "1"))
