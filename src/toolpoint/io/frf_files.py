@@ -786,3 +786,19 @@ def _write_table(path, frf, header: str | None, sep: str, as_measured: bool = Fa
 _READERS = {".csv": read_csv_frf, ".uff": read_uff58, ".unv": read_uff58, ".uf": read_uff58, ".frf": read_cutpro,
             ".txt": read_cutpro, ".tsv": read_cutpro, ".dat": read_cutpro}
 _WRITERS = {".csv": write_csv_frf, ".uff": write_uff58, ".unv": write_uff58, ".uf": write_uff58, ".frf": write_cutpro}
+
+
+def numeric_lines(text: list[str]):
+    """(line number, cells) of a text table's data lines: comments (``#``, ``%``) and blank lines skipped, cells split
+    at commas (else at white space), header lines before the first number skipped. The one line splitter of the
+    column readers (impact records, cut records)."""
+    started = False
+    for n, line in enumerate(text, 1):
+        s = line.strip()
+        if not s or s[0] in "#%":
+            continue
+        cells = [c.strip() for c in (s.split(",") if "," in s else s.split())]
+        if not started and not _is_number(cells[0]):
+            continue  # a header line
+        started = True
+        yield n, cells

@@ -343,17 +343,11 @@ def read_record(path, *, response: str = "acceleration") -> Record:
     """
     if Path(path).suffix.lower() in (".uff", ".unv", ".uf"):
         return _read_uff_record(path)
-    from .frf_files import _check_not_cut, _is_number, _read_text
+    from .frf_files import _check_not_cut, _is_number, _read_text, numeric_lines
 
     rows = []
     text, open_end = _read_text(path)
-    for n, line in enumerate(text, 1):
-        s = line.strip()
-        if not s or s[0] in "#%":
-            continue
-        cells = [c.strip() for c in (s.split(",") if "," in s else s.split())]
-        if not rows and not _is_number(cells[0]):
-            continue  # a header line
+    for n, cells in numeric_lines(text):
         if len(cells) != 3:
             raise InputError(f"line {n}: expected 3 columns (time s, force N, response), found {len(cells)}",
                              file=path, field="columns")

@@ -177,18 +177,12 @@ def _read_uff(p: Path, channel: int | None) -> CutRecord:
 
 
 def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecord:
-    from .frf_files import _is_number, _read_text
+    from .frf_files import _is_number, _read_text, numeric_lines
 
     text, _ = _read_text(p)
     rows = []
     width = None
-    for n, line in enumerate(text, 1):
-        s = line.strip()
-        if not s or s[0] in "#%":
-            continue
-        cells = [c.strip() for c in (s.split(",") if "," in s else s.split())]
-        if not rows and not _is_number(cells[0]):
-            continue  # a header line
+    for n, cells in numeric_lines(text):
         if width is None:
             width = len(cells)
         if len(cells) != width:
