@@ -53,7 +53,7 @@ def main() -> None:
         synthesise(camp, n=a.n, seed=0)
         print(f"synth: {a.n} tools in {time.perf_counter() - t:.1f} s → {camp}")
         r = run_campaign(camp, res, workers=a.workers, progress=False)
-        print(f"run (hybrid, {a.workers} workers): {r['ok']} ok, {r['failed']} failed in {r['seconds']:.1f} s "
+        print(f"run (hybrid, {a.workers} workers): {r.ok} ok, {r.failed} failed in {r.seconds:.1f} s "
               f"(target < 60 s for 178 on 2 cores)")
 
     ident = {x["id"]: x for _, x in read_identified(res / "identified.csv").rows}

@@ -95,7 +95,7 @@ def speed(camp: Path, results: Path, n: int, workers: int, dask: bool, dask_tool
     r = run_library(lib, camp, results / "models", tmp / "pool", workers=workers, progress=False)
     dt = time.perf_counter() - t
     cpu = cpu_seconds(tmp / "pool")
-    print(f"{n} tools, process pool of {workers}: {dt:.1f} s wall ({r['ok']} ok); CPU per tool mean "
+    print(f"{n} tools, process pool of {workers}: {dt:.1f} s wall ({r.ok} ok); CPU per tool mean "
           f"{cpu.mean():.3f} s, max {cpu.max():.2f} s, sum {cpu.sum():.0f} s (sum/{workers} = "
           f"{cpu.sum() / workers:.0f} s); load average 1 min before {load:.1f}, after {os.getloadavg()[0]:.1f}")
     if dask:
@@ -120,7 +120,7 @@ def speed(camp: Path, results: Path, n: int, workers: int, dask: bool, dask_tool
                 dt = time.perf_counter() - t
             base = base or dt
             cpu = cpu_seconds(tmp / f"dask{w}")
-            print(f"{dask_tools} tools, Dask LocalCluster {w} worker(s) × 1 thread: {dt:.1f} s wall ({r['ok']} ok), "
+            print(f"{dask_tools} tools, Dask LocalCluster {w} worker(s) × 1 thread: {dt:.1f} s wall ({r.ok} ok), "
                   f"speed-up ×{base / dt:.2f}; CPU sum {cpu.sum():.0f} s; load average before {load:.1f}")
 
 

@@ -261,7 +261,7 @@ def test_campaign_cuts_each_measured_frf_to_its_trusted_band(campaign, tmp_path)
 
     d, _ = campaign
     r = run_campaign(d, tmp_path / "res", workers=1, progress=False)
-    assert r["ok"] == 2
+    assert r.ok == 2
     rows = _rows(tmp_path / "res" / "identified.csv")
     note = rows["T001"]["warnings"].split("; ")[0]
     assert note.startswith("note: fitted ") and "of campaign.band_hz 20–4000 Hz (below " in note

@@ -37,7 +37,7 @@ def test_synth_writes_a_campaign_the_pipeline_can_read(small):
 def test_run_identifies_every_tool_and_resumes(small, tmp_path):
     out = tmp_path / "res"
     r = run_campaign(small, out, workers=2, progress=False)
-    assert r["ok"] == 8 and r["failed"] == 0
+    assert r.ok == 8 and r.failed == 0
     rows = _rows(out / "identified.csv")
     assert list(rows[0]) == COLUMNS and len(rows) == 8
     truth = {t["id"]: t for t in _rows(small / "truth" / "truth.csv")}
@@ -45,7 +45,7 @@ def test_run_identifies_every_tool_and_resumes(small, tmp_path):
     assert np.median(errs) < 0.05  # kt is well identified through the measured subassembly
     # a re-run skips what is done
     r2 = run_campaign(small, out, workers=1, progress=False)
-    assert r2["skipped"] == 8 and r2["ok"] == 0
+    assert r2.skipped == 8 and r2.ok == 0
     assert len(_rows(out / "identified.csv")) == 8
 
 
@@ -57,7 +57,7 @@ def test_a_broken_item_is_recorded_and_the_rest_goes_on(small, tmp_path):
     (broken / "frf" / "T005.csv").write_text("freq_hz,real,imag\n1,2,3\n")
     out = tmp_path / "res"
     r = run_campaign(broken, out, workers=1, progress=False)
-    assert r["ok"] == 6 and r["failed"] == 2
+    assert r.ok == 6 and r.failed == 2
     rows = {x["id"]: x for x in _rows(out / "identified.csv")}
     assert rows["T003"]["status"] == "failed" and "not found" in rows["T003"]["error"]
     assert rows["T005"]["status"] == "failed" and "T005.csv" in rows["T005"]["error"]
@@ -65,7 +65,7 @@ def test_a_broken_item_is_recorded_and_the_rest_goes_on(small, tmp_path):
     with open(out / "identified.csv", "a") as fh:
         fh.write("T009,ER40,9.0,40")
     r2 = run_campaign(broken, out, workers=1, progress=False)
-    assert r2["skipped"] == 6 and r2["failed"] == 2
+    assert r2.skipped == 6 and r2.failed == 2
 
 
 @pytest.mark.slow
@@ -74,7 +74,7 @@ def test_dask_local_cluster(small, tmp_path):
 
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as lc:
         r = run_campaign(small, tmp_path / "res", dask=lc.scheduler_address, progress=False)
-    assert r["ok"] == 8
+    assert r.ok == 8
 
 
 @pytest.mark.slow
@@ -113,7 +113,7 @@ def test_band_outside_the_subassembly_is_refused_per_item(small, tmp_path):
     r = run_campaign(c2, tmp_path / "res", workers=1, progress=False)
     rows = {x["id"]: x for x in _rows(tmp_path / "res" / "identified.csv")}
     assert rows["T002"]["status"] == "failed" and "no extrapolation" in rows["T002"]["error"]
-    assert r["failed"] == 1
+    assert r.failed == 1
 
 
 def test_blank_subassembly_with_modal_fit(small, tmp_path):

@@ -37,7 +37,7 @@ def test_a_second_run_into_the_same_folder_refuses(small, tmp_path):
             run_campaign(small, out, workers=1, progress=False)
     assert not (out / "identified.csv").exists()
     r = run_campaign(small, out, workers=1, progress=False)  # the lock went with the first run
-    assert r["ok"] + r["failed"] == 6
+    assert r.ok + r.failed == 6
 
 
 @pytest.mark.parametrize("edit, field", [

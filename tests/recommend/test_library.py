@@ -197,7 +197,7 @@ def test_resume_after_a_kill_recomputes_only_what_is_missing(tmp_path):
     lib = _library(tmp_path / "lib.csv", GOOD + BAD[:2])
     counts = run_library(lib, root / "camp", root / "results" / "models", out, workers=1, n_samples=40,
                          rpm_points=150, progress=False)
-    assert (counts["skipped"], counts["ok"], counts["failed"]) == (1, 1, 2)
+    assert (counts.skipped, counts.ok, counts.failed) == (1, 1, 2)
     rows = _rows(out)
     assert rows["A16"] == before and rows["B12"]["status"] == "ok"
     assert len(rows) == 4

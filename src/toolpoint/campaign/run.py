@@ -34,8 +34,8 @@ from ..io.frf_files import read_frf
 from .config import Campaign, load_campaign
 from .results import COLUMNS, FILE_NAME, Appender, new_row, resume
 
-__all__ = ["COLUMNS", "MIN_POINTS", "Item", "identify_item", "item_seed", "prepare", "run_campaign", "dask_client",
-           "execute", "worker_init", "holder_subassemblies", "trusted_part"]
+__all__ = ["COLUMNS", "MIN_POINTS", "BatchResult", "Item", "identify_item", "item_seed", "prepare", "run_campaign",
+           "dask_client", "execute", "worker_init", "holder_subassemblies", "trusted_part"]
 
 #: Fewest frequency points of a measurement inside the campaign's band.
 MIN_POINTS = 10
@@ -247,7 +247,7 @@ def trusted_part(frf: FRF, path, band_hz: tuple[float, float]) -> tuple[FRF, str
 
 
 def run_campaign(folder, out_dir, *, method: str | None = None, workers: int | None = None,
-                 dask: str | None = None, seed: int = 0, progress: bool = True) -> dict:
+                 dask: str | None = None, seed: int = 0, progress: bool = True) -> BatchResult:
     """Identify every measurement of the campaign in ``folder``; rows go to ``out_dir/identified.csv``.
 
     Parameters
@@ -269,7 +269,7 @@ def run_campaign(folder, out_dir, *, method: str | None = None, workers: int | N
 
     Returns
     -------
-    dict
+    BatchResult
         ``ok``, ``failed`` and ``skipped`` (already done) counts, ``seconds``
         (wall time, s) and ``path`` (the CSV).
 
@@ -302,7 +302,7 @@ def run_campaign(folder, out_dir, *, method: str | None = None, workers: int | N
                 client.close()
 
 
-def _run_locked(c, out: Path, method, seed, workers, client, progress, t0, native) -> dict:
+def _run_locked(c, out: Path, method, seed, workers, client, progress, t0, native) -> BatchResult:
     path = out / FILE_NAME
     done = resume(path, {m.id for m in c.measurements})
     todo = [m for m in c.measurements if m.id not in done]
@@ -323,9 +323,29 @@ def _run_locked(c, out: Path, method, seed, workers, client, progress, t0, nativ
                 bar.update(1)
     finally:
         bar.close()
-    counts["seconds"] = time.perf_counter() - t0
-    counts["path"] = str(path)
-    return counts
+    return BatchResult(ok=counts["ok"], failed=counts["failed"], skipped=counts["skipped"],
+                       seconds=time.perf_counter() - t0, path=str(path))
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """What a batch run (``campaign run``, ``library``) did.
+
+    Attributes
+    ----------
+    ok, failed, skipped : int
+        Items finished in this run, items that failed (their rows say why), items kept from an earlier run.
+    seconds : float
+        Wall time of this run, s.
+    path : str
+        The results table.
+    """
+
+    ok: int
+    failed: int
+    skipped: int
+    seconds: float
+    path: str
 
 
 LOCK_NAME = ".toolpoint-run.lock"

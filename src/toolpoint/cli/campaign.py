@@ -218,10 +218,10 @@ def _run(args) -> int:
     check_number(args.seed, "--seed", minimum=0)
     r = run_campaign(args.campaign_dir, args.out, method=args.method, workers=args.workers, dask=args.dask,
                      seed=args.seed)
-    print(f"{r['ok']} identified, {r['failed']} failed, {r['skipped']} already done; "
-          f"{r['seconds']:.1f} s → {r['path']}")
-    if r["failed"]:  # like `library`: a bad row is reported (one line each, and in its row), the others go on
-        print(f"finished, {r['failed']} tools failed: their rows in {r['path']} say why; fix them and run again "
+    print(f"{r.ok} identified, {r.failed} failed, {r.skipped} already done; "
+          f"{r.seconds:.1f} s → {r.path}")
+    if r.failed:  # like `library`: a bad row is reported (one line each, and in its row), the others go on
+        print(f"finished, {r.failed} tools failed: their rows in {r.path} say why; fix them and run again "
               "(finished rows are kept)", file=sys.stderr)
         return 1  # 0 only when every tool succeeded, 2 for input that stops the run
     return 0

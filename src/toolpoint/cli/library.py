@@ -70,8 +70,8 @@ def run(args) -> int:
         if err.file is None and err.field in _OPTIONS:
             raise InputError(err.message, file="command line", field=_OPTIONS[err.field]) from None
         raise
-    print(f"{counts['ok']} tools ok, {counts['failed']} failed, {counts['skipped']} already done, "
-          f"{counts['seconds']:.1f} s → {counts['path']}")
+    print(f"{counts.ok} tools ok, {counts.failed} failed, {counts.skipped} already done, "
+          f"{counts.seconds:.1f} s → {counts.path}")
     if args.report:
         from ..recommend.report import write_report
 
@@ -79,7 +79,7 @@ def run(args) -> int:
             print(f"report → {write_report(args.out)}")
         except OSError as e:
             raise InputError(f"cannot write the report: {e}", file=args.out) from None
-    if counts["failed"]:  # a script can trust the code: 0 only when every tool succeeded (as make -k, rsync)
-        print(f"finished, {counts['failed']} tools failed (their rows say why)", file=sys.stderr)
+    if counts.failed:  # a script can trust the code: 0 only when every tool succeeded (as make -k, rsync)
+        print(f"finished, {counts.failed} tools failed (their rows say why)", file=sys.stderr)
         return 1
     return 0

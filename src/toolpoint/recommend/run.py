@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..campaign.config import load_campaign
-from ..campaign.run import execute
+from ..campaign.run import BatchResult, execute
 from ..errors import ExtrapolationWarning, InputError
 from ..identification.params import PARAMS
 from ..io.atomic import atomic_open, atomic_path
@@ -118,7 +118,7 @@ def _write_tool(tools_dir: Path, tool_id: str, result: dict, extra: dict) -> Non
 def run_library(library, campaign, models, out_dir, *, workers: int | None = None, dask: str | None = None,
                 n_samples: int = 200, rpm_points: int = 500, seed: int = 0, margin: float = 0.1,
                 rpm_tolerance: float = 0.01, outside: str = "widen", model: str = "anfis", progress: bool = True,
-                on_bad=None) -> dict:
+                on_bad=None) -> BatchResult:
     """Recommend operating points for every tool of a library (module docstring).
 
     Parameters
@@ -157,7 +157,7 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
 
     Returns
     -------
-    dict
+    toolpoint.campaign.run.BatchResult
         ``ok``, ``failed``, ``skipped`` counts, ``seconds``, ``path``.
 
     Raises
@@ -191,7 +191,7 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
 
 
 def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_samples, rpm_points, seed, margin,
-                rpm_tolerance, outside, model, progress, on_bad) -> dict:
+                rpm_tolerance, outside, model, progress, on_bad) -> BatchResult:
     """The locked part of :func:`run_library`: stale temporary files cleared, resume, compute, write rows."""
     for stale in tools_dir.glob(".*.tmp*"):  # left by a run killed while writing (atomic writes' temporaries)
         stale.unlink(missing_ok=True)
@@ -280,9 +280,8 @@ def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_
         bar.close()
         if client is not None:
             client.close()
-    counts["seconds"] = time.perf_counter() - t0
-    counts["path"] = str(path)
-    return counts
+    return BatchResult(ok=counts["ok"], failed=counts["failed"], skipped=counts["skipped"],
+                       seconds=time.perf_counter() - t0, path=str(path))
 
 
 def _execute(jobs, workers, client):
