@@ -1,6 +1,6 @@
 """The trusted band (toolpoint.trust): detected lower edge against the noise/signal crossing, false cuts, cost.
 
-Synthetic tool-point receptances (tests/test_trust.py: modes 650, 1056, 2400 Hz, 0–5000 Hz at 1 Hz)
+Synthetic tool-point receptances (tests/base/test_trust.py: modes 650, 1056, 2400 Hz, 0–5000 Hz at 1 Hz)
 with complex white noise in accelerance (σ_A per part) divided by −ω². The reference f_c is where
 the known noise level √2 σ_A/ω² meets the known clean |H| — independent of the detector, which
 sees only the noisy data. Also: clean FRFs and noise white in the receptance must keep their band.

@@ -3,7 +3,7 @@
 Runs ``benchmarks/bench_campaign.py`` (synth → run → learn → predict, seed 0) and compares what it prints with the
 README's campaign table: identification medians within ±30 % (relative) or 0.05 points, interval coverage within
 ±5 points, ANFIS / GP metrics within ±15 % relative, FRF errors within ±0.3 points. Times are not checked (they
-depend on the machine's load). Table 1 is checked by ``tests/test_readme.py`` (slow tier).
+depend on the machine's load). Table 1 is checked by ``tests/base/test_readme.py`` (slow tier).
 """
 
 from __future__ import annotations

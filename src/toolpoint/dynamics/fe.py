@@ -15,8 +15,8 @@ Element (Przemieniecki 1968; Friedman & Kosmatka 1993): cubic deflection and
 
 and the consistent mass (translational ρAL and rotary ρI/L parts, both over
 (1+Φ)², polynomials in Φ given below). The natural-frequency error falls as h²
-with the element length h (measured in ``tests/test_beam.py``; the tool-point
-FRF error likewise, ``tests/test_coupling.py``), so Richardson extrapolation in
+with the element length h (measured in ``tests/dynamics/test_beam.py``; the tool-point
+FRF error likewise, ``tests/dynamics/test_coupling.py``), so Richardson extrapolation in
 h² sharpens it. This is a check, not a hot path: it loops over frequencies.
 """
 

@@ -20,7 +20,7 @@ where Re μ changes sign the piece runs to the crossing (1/a_lim = 0, ε = 0 or
 (Newton), 1/a_lim is interpolated linearly in the tooth period between the
 piece's ends; the limit at a speed is 1 / max over (piece, lobe, branch) of
 the interpolated 1/a_lim. The difference to ``zoa_lobes`` is measured in
-``tests/test_library.py`` and ``docs/design/recommend.md``.
+``tests/recommend/test_library.py`` and ``docs/design/recommend.md``.
 """
 
 from __future__ import annotations
