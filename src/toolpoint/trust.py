@@ -75,9 +75,8 @@ from .errors import InputError
 from .frf import FRF
 
 __all__ = ["COHERENCE_MIN", "SNR_MIN", "WINDOW", "MIN_SLOPE_POINTS", "RISE_SLOPE", "RISE_CLIMB", "RISE_MARGIN",
-           "RISE_SMOOTH", "RISE_NEAR_ZERO",
-           "RECEPTANCE_RANGE", "TrustedBand", "Band", "check_band", "trusted_band", "common_band", "unit_note",
-           "edge_hits"]
+           "RISE_SMOOTH", "RISE_NEAR_ZERO", "RECEPTANCE_RANGE", "SPIKE_RATIO", "TrustedBand", "Band", "check_band",
+           "trusted_band", "common_band", "unit_note", "check_spikes", "edge_hits"]
 
 COHERENCE_MIN = 0.8
 """Lowest ordinary coherence γ² trusted at the band ends (γ² = 0.8: noise-to-signal power ratio 0.25)."""
@@ -445,6 +444,28 @@ def trusted_band(frf: FRF, *, quantity_measured: str | None = None, coherence_mi
     return TrustedBand(float(f[i]), float(f[j]), "; ".join(reasons), noise_quantity=noise_q)
 
 
+#: A point of a measured FRF this many times larger than both its neighbours (an end point: its one neighbour) is a
+#: damaged line — a number cut short ("-1.26973" for "-1.26973e-08"), a lost exponent — not a resonance: on a
+#: 1 Hz grid even a mode with ζ = 0.01 % at 1 kHz stands ≈ 500× above the points 1 Hz away.
+SPIKE_RATIO = 1e4
+
+
+def check_spikes(frf: FRF, path=None) -> None:
+    """Refuse a measured FRF with one point orders of magnitude above its neighbours, naming the frequency."""
+    a = np.abs(np.asarray(frf.values).reshape(len(frf), -1)).max(axis=1)
+    if a.size < 3:
+        return
+    left = np.r_[a[1], a[:-1]]  # the end points are compared with their one neighbour
+    right = np.r_[a[1:], a[-2]]
+    near = np.maximum(left, right)
+    bad = np.flatnonzero((near > 0) & (a > SPIKE_RATIO * near))
+    if bad.size:
+        k = int(bad[0])
+        raise InputError(f"the value at {frf.freq_hz[k]:g} Hz is {a[k] / near[k]:.2g}× its neighbours: a damaged or "
+                         "cut-short number (e.g. a lost exponent); fix or remove that line", file=path,
+                         field="values")
+
+
 class Band(NamedTuple):
     """One band for several measured FRFs (:func:`common_band`).
 
@@ -515,6 +536,9 @@ def common_band(frfs, *, band=None, files=None, field: str = "--band", hint: str
     'note: x.csv: band 100–2000 Hz given by --band (no automatic trimming)'
     """
     pairs = [(g, (files[k] if files is not None else None)) for k, g in enumerate(frfs) if g is not None]
+    for g, name in pairs:
+        if g.is_siso:
+            check_spikes(g, name if name is not None else g.meta.get("source"))
     tbs = [trusted_band(g, band=band, file=name, field=field, quantity_measured=quantity_measured)
            for g, name in pairs]
     names = [name if name is not None else g.meta.get("source", "") for g, name in pairs]

@@ -348,3 +348,23 @@ def test_running_median_is_the_windowed_median_with_edge_padding():
     k = 7
     want = [np.median([x[min(max(j, 0), x.size - 1)] for j in range(i - k, i + k + 1)]) for i in range(x.size)]
     np.testing.assert_array_equal(_running_median(x, 2 * k + 1), want)
+
+
+def test_a_cut_short_last_number_that_still_parses_is_refused(tmp_path, capsys):
+    """Issue: `1518,3.4596e-07,-1.26973` (for -1.26973e-08, with a final line break) was read as data and lobes
+    printed a 3.5e-06 mm minimum with exit 0."""
+    from toolpoint.cli.main import main
+
+    f = np.arange(1000.0, 1519.0)
+    h = 1 / (1e7 * (1 - (f / 1200) ** 2 + 0.04j * f / 1200))
+    lines = ["freq_hz,real,imag"] + [f"{a:g},{b.real:.6g},{b.imag:.6g}" for a, b in zip(f, h)]
+    lines[-1] = lines[-1].rsplit("e", 1)[0]  # the imaginary part lost its exponent
+    path = tmp_path / "cut.csv"
+    path.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "o.csv"
+    for argv in (["lobes", str(path), "--teeth", "2", "--tangential-coeff", "6e8", "--radial-ratio", "0.3",
+                  "--immersion", "1", "--rpm", "5000:20000", "--out", str(out)], ["modal", str(path), "--out", str(out)]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "cut.csv" in err and "1518 Hz" in err
+        assert not out.exists()
