@@ -362,8 +362,9 @@ def test_a_cut_short_last_number_that_still_parses_is_refused(tmp_path, capsys):
     path = tmp_path / "cut.csv"
     path.write_text("\n".join(lines) + "\n")
     out = tmp_path / "o.csv"
-    for argv in (["lobes", str(path), "--teeth", "2", "--tangential-coeff", "6e8", "--radial-ratio", "0.3",
-                  "--immersion", "1", "--rpm", "5000:20000", "--out", str(out)], ["modal", str(path), "--out", str(out)]):
+    lobes = ["lobes", str(path), "--teeth", "2", "--tangential-coeff", "6e8", "--radial-ratio", "0.3", "--immersion",
+             "1", "--rpm", "5000:20000", "--out", str(out)]
+    for argv in (lobes, ["modal", str(path), "--out", str(out)]):
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "cut.csv" in err and "1518 Hz" in err
