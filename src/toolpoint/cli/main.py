@@ -37,6 +37,8 @@ COMMANDS = {
     "report": "one self-contained HTML page of a library run (sortable overview, per-tool figures)",
     "cut": "chatter detection from a record of a cut (audio, accelerometer, UFF58): verdict, chatter frequency",
     "update": "test cuts → posterior lobes (5/50/95 %%), P(stable) map, parameters, the next test cut",
+    "simulate": "time-domain simulation of one milling cut: forces, chatter, surface location error, surface",
+    "map": "simulated stability and surface location error over a speed × depth grid, beside the SDM lobes",
 }
 
 
