@@ -373,10 +373,13 @@ def folder_lock(out: Path, what: str = "campaign run"):
             who = fh.read().strip() or "another process"
             raise InputError(f"another {what} ({who}) is writing to this folder; wait for it or choose "
                              "another --out", file=out, field="--out") from None
-        fh.seek(0)
-        fh.truncate()
-        fh.write(f"pid {os.getpid()}\n")
-        fh.flush()
+        try:  # who holds it, for a second run's message; a full disk is named like every other write
+            fh.seek(0)
+            fh.truncate()
+            os.write(fh.fileno(), f"pid {os.getpid()}\n".encode())  # unbuffered: nothing left to fail at close
+        except OSError as e:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+            raise InputError(f"cannot write: {e.strerror or e}", file=path) from None
         try:
             yield
         finally:

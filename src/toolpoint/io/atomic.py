@@ -20,7 +20,8 @@ def atomic_path(path: str | os.PathLike):
 
     The file gets the permissions of a plain ``open(path, "w")`` (0666 less the
     user's umask), not ``mkstemp``'s private 0600. Use for writers that want a
-    file name (``savefig``, ``pyuff``).
+    file name (``savefig``, ``pyuff``). An :class:`OSError` that names no file or
+    the temporary one (``write()`` on a full disk) is raised naming ``path``.
 
     Examples
     --------
@@ -40,6 +41,10 @@ def atomic_path(path: str | os.PathLike):
     try:
         yield tmp
         os.replace(tmp, path)
+    except OSError as err:  # write() and close() name no file (a full disk): name the file being written
+        if err.filename not in (None, tmp):
+            raise
+        raise OSError(err.errno, err.strerror or str(err), os.fspath(path)) from None
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)

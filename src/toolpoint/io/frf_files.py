@@ -41,8 +41,11 @@ downstream (squares in the fits, ω⁴ in conversions, 1/H in inverse RCSA):
   short), a last number with a missing or shorter exponent than every other
   number of its column (``1.2345e-08`` cut to ``1.2345e-0`` or ``1.23`` reads
   as 1.2345 or 1.23 m/N), or, in a column without exponents, with fewer digits
-  than each of them: the message names the line and says to end the file with
-  a line break if it is complete.
+  than each of them; in an export of more columns than are read, a last line
+  with fewer columns than the first or a cut number in a column not read: the
+  message names the line and says to end the file with a line break if it is
+  complete. A file cut exactly at a line break cannot be told from a shorter
+  one (none of the text formats states its number of lines).
 
 Every writer writes receptance, through :mod:`toolpoint.io.atomic`, so a
 failure never leaves a half-written file.
@@ -224,6 +227,12 @@ def read_cutpro(path, *, quantity: str | None = None, min_points: int = 1, label
     cols, names, scale = _columns(path, head, units, rows)
     if cols is not None:
         width = max(cols) + 1
+        if open_end and len(rows) > 1 and len(rows[-1][1]) < len(rows[0][1]):  # columns not read are cut too
+            n, cells = rows[-1]
+            raise InputError(f"line {n}: {len(cells)} columns, the first data line has {len(rows[0][1])} (the file "
+                             "ends without a line break: cut short?); if the file is complete, end it with a line "
+                             "break", file=path, field="columns")
+        _check_not_cut(path, rows, head[1], open_end)  # the last cell may be of a column not read
         picked = []
         for n, cells in rows:
             if len(cells) < width:
@@ -641,12 +650,13 @@ def _check_not_cut(path, rows, names, open_end: bool) -> None:
 
     ``rows`` are ``[(line number, cells), ...]`` of numbers. A cut removes the end of the file, so only
     the last cell of the last row can lose digits (a cut elsewhere leaves too few columns). Compared
-    with the other numbers of its column (at least 2 of them) it is refused when
+    with the other numbers of its column it is refused when
 
-    * they all have an exponent and it has none (and is not 0), or a shorter one;
-    * none of them has an exponent and it has fewer digits than each of them.
+    * they all have an exponent and it has none (and is not 0), or a shorter one (one other number is enough:
+      a file cut in its second data line is refused too);
+    * none of them has an exponent and it has fewer digits than each of them (at least 2 of them).
     """
-    if not open_end or len(rows) < 3:
+    if not open_end or len(rows) < 2:
         return
     n, cells = rows[-1]
     j = len(cells) - 1
@@ -655,10 +665,12 @@ def _check_not_cut(path, rows, names, open_end: bool) -> None:
         return
     m, e = _digits(cells[j])
     exps = [x for _, x in others if x is not None]
-    if len(exps) == len(others):
+    if not _is_number(cells[j]):  # a column not read ("-7.1e-" in the 6th column of a 3-column pick)
+        cut = True
+    elif len(exps) == len(others):
         cut = (e is None and float(cells[j]) != 0) or (e is not None and e < min(exps))
     else:
-        cut = not exps and e is None and m < min(d for d, _ in others)
+        cut = not exps and e is None and len(others) >= 2 and m < min(d for d, _ in others)
     if cut:
         raise InputError(f"line {n}: {cells[j].strip()!r} looks cut short (the file ends without a line break, "
                          "mid-number?); if the file is complete, end it with a line break", file=path,

@@ -96,8 +96,9 @@ _FORMULA = ("=", "+", "-", "@", "\t", "\r")
 def csv_safe(value) -> str:
     """A CSV cell a spreadsheet will not run as a formula (OWASP's "CSV injection" rule).
 
-    Text starting with ``= + - @``, a tab or a carriage return gets the standard quote prefix ``'``; numbers
-    (``-1.5``, ``+3e-7``) stay numbers. :func:`csv_unsafe` undoes it when toolpoint reads its own files back.
+    Text starting with ``= + - @``, a tab or a carriage return (after any ``'``) gets the standard quote prefix
+    ``'``; numbers (``-1.5``, ``+3e-7``) stay numbers. :func:`csv_unsafe` undoes it when toolpoint reads its own
+    files back.
 
     Examples
     --------
@@ -105,7 +106,7 @@ def csv_safe(value) -> str:
     ("'=cmd|' /C calc'!A0", '-1.5', 'EM10-45', '2.5')
     """
     text = str(value)
-    if text.startswith(_FORMULA):
+    if text.lstrip("'").startswith(_FORMULA):  # "'=x" too, or csv_unsafe would read it back as "=x"
         try:
             float(text)
             return text
@@ -115,8 +116,14 @@ def csv_safe(value) -> str:
 
 
 def csv_unsafe(text: str) -> str:
-    """The cell as written before :func:`csv_safe` (a leading ``'`` before a formula character removed)."""
-    return text[1:] if text.startswith("'") and text[1:].startswith(_FORMULA) else text
+    """The cell as written before :func:`csv_safe` (the ``'`` it put before a formula character removed).
+
+    Examples
+    --------
+    >>> [csv_unsafe(csv_safe(s)) for s in ("=1+1", "'=1+1", "''@x", "'a", "-1.5")]
+    ['=1+1', "'=1+1", "''@x", "'a", '-1.5']
+    """
+    return text[1:] if text.startswith("'") and text.lstrip("'").startswith(_FORMULA) else text
 
 
 def check_regular_file(path, *, what: str = "file") -> Path:
