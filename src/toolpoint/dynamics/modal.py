@@ -40,7 +40,9 @@ is removed and the rest refitted. A fit within 1e-6 relative RMS of the data
 counts as exact (computed FRFs are no finite sum of viscous modes below that).
 Last, an in-band mode the data do not determine (Gauss–Newton standard deviation
 of ln ζ above 1, or of f_n above ζ f_n) is removed. Poles outside the band are
-never reported as modes.
+never reported as modes. When an FRF is declared a driving point (``driving_point``),
+its modes of negative modal mass are dropped if the model without them is nearly as
+likely (BIC within 10), and otherwise kept with a :class:`DrivingPointWarning`.
 
 Examples
 --------
@@ -58,17 +60,18 @@ Two receptances of a two-mode structure (300 and 800 Hz, 2 % damping):
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg import qr
+from scipy.linalg.lapack import dgeqrf as _geqrf
 from scipy.signal import find_peaks
 
 from ..blas import single_thread_blas
 from ..errors import InputError
 from ..frf import FRF, QUANTITIES, check_freq_hz
 
-__all__ = ["ModalFit", "fit_modal", "fit_frfs", "ZETA_LIMITS"]
+__all__ = ["ModalFit", "fit_modal", "fit_frfs", "ZETA_LIMITS", "DrivingPointWarning"]
 
 ZETA_LIMITS = (1e-6, 0.5)
 """A fitted pole with a damping ratio outside these limits is not a mode (it is removed)."""
@@ -79,6 +82,11 @@ _POINTS_PER_MODE = 8  # fewest band points per requested mode (fit_modal's n_mod
 _MIN_POINTS = 10
 _PEAK_STARTS = 3  # starting poles from the most prominent peaks when the stabilisation diagram has none
 _EXACT = 1e-6  # relative RMS misfit below which a fit counts as exact (order selection only)
+_STRONG = 10.0  # BIC difference that is "very strong" evidence (Kass & Raftery): the driving-point rule's margin
+
+
+class DrivingPointWarning(UserWarning):
+    """A fit of a driving-point FRF keeps modes of negative modal mass, because the data demand them."""
 
 
 @dataclass(frozen=True)
@@ -111,6 +119,9 @@ class ModalFit:
     diagram : tuple
         The stabilisation diagram the automatic order started from: ``(order, poles)`` per LSCF model order
         (poles in rad/s, Im > 0); () when not computed.
+    notes : tuple of str
+        What the fit did or found that a user should read, one line each (the driving-point rule: modes of
+        negative modal mass dropped, or kept with a :class:`DrivingPointWarning`).
     """
 
     poles: np.ndarray
@@ -125,6 +136,7 @@ class ModalFit:
     residual_residues: np.ndarray | None = None
     velocity_residual: np.ndarray | None = None
     diagram: tuple = ()
+    notes: tuple = ()
 
     @property
     def n_modes(self) -> int:
@@ -312,29 +324,81 @@ class _Problem:
         # from every finite sum of viscous modes at about that level: below it, poles only chase that.
         self.floor = _EXACT**2 * float(np.sum(self.B**2))
         self.plim = (np.log(1e-7 * w.min()), np.log(10 * w.max()))  # range of ln σ and ln ω_d, rad/s
+        # a pole this far outside the range where poles are kept (_RESIDUAL) is removed anyway: stop refining
+        self.wstop = (0.25 * _RESIDUAL[0] * w.min(), 4.0 * _RESIDUAL[1] * w.max())
+        self._set_residual_columns()
         self._cache = {}
 
-    def design(self, poles):
-        """Weighted stacked real design matrices of the fit quantity: (m, 2F, P), or (1, 2F, P) weighted
-        by w0 only when the weights are separable (``shared``)."""
-        D = _basis(self.w, poles, self.residuals) * self.fac[:, None]
-        DW = D[None] * (self.w0 if self.shared else self.Wt.T)[:, :, None]
-        return np.concatenate([DW.real, DW.imag], 1)
+    def _set_residual_columns(self):
+        """The weighted residual-term rows (mm, k, 2F) of the transposed design matrix (independent of the poles);
+        and fresh work buffers."""
+        R = _basis(self.w, np.empty(0, complex), self.residuals) * self.fac[:, None]  # (F, k)
+        ws = self.w0 if self.shared else self.Wt.T  # (1, F) or (m, F)
+        RW = R.T[None] * ws[:, None, :]  # (mm, k, F)
+        self._resrows = np.ascontiguousarray(np.concatenate([RW.real, RW.imag], 2))
+        self._ws = {}  # reused work arrays: fresh (F × P) arrays cost page faults (≈ half the time of a solve)
 
-    def solve(self, poles):
-        """Coefficients (m, P), residual (m, 2F) and Q ((m or 1), 2F, P) for the poles."""
-        A = self.design(poles)
+    def _buffers(self, key, *shapes):
+        if key not in self._ws:
+            self._ws[key] = tuple(np.empty(sh) for sh in shapes)
+        return self._ws[key]
+
+    def design(self, poles):
+        """Weighted stacked real design matrices of the fit quantity, *transposed*: (mm, P, 2F), one column per
+        row, mm = m, or 1 (weighted by w0 only) when the weights are separable (``shared``); also
+        u = 1/(iω − λ), v = 1/(iω − conj λ), (n, F).
+
+        Written into a reused buffer: valid until the next call.
+        """
+        s = 1j * self.w[None, :]
+        u, v = 1.0 / (s - poles[:, None]), 1.0 / (s - np.conj(poles)[:, None])
+        F, n = self.w.size, poles.size
+        fw = self.fac[None, :] * (self.w0 if self.shared else self.Wt.T)  # (mm, F) complex: (iω)^k × weight
+        mm, k = self._resrows.shape[:2]
+        At, W = self._buffers(("design", n), (mm, 2 * n + k, 2 * F), (2 * n + k, 2 * F))
+        for e in range(mm):  # one design matrix per distinct weighting
+            t = (u + v) * fw[e]
+            At[e, 0:2 * n:2, :F], At[e, 0:2 * n:2, F:] = t.real, t.imag
+            t = (u - v) * (1j * fw[e])
+            At[e, 1:2 * n:2, :F], At[e, 1:2 * n:2, F:] = t.real, t.imag
+            At[e, 2 * n:] = self._resrows[e]
+        return At, W, u, v
+
+    def solve(self, poles, uv: bool = False):
+        """Coefficients (m, P), residual (m, 2F) and the projection factors (At, Rp) for the poles.
+
+        Least squares by the corrected seminormal equations with R from a Householder QR of the
+        column-scaled design matrix As = Atᵀ (LAPACK geqrf, Q never formed): c = R⁺R⁺ᵀAsᵀb plus one
+        correction step with the residual, as accurate as solving with Q (Björck) at half the cost.
+        R⁺ (pseudo-inverse, rcond 1e-13) keeps a rank-deficient basis (a pole without a modal
+        constant) harmless. The orthogonal projector onto the columns is As R⁺ R⁺ᵀ Asᵀ (Jacobian).
+        With ``uv`` also returns u, v of :meth:`design`. At lives in a reused buffer: the cached
+        evaluation (:meth:`_eval`) that refers to it is dropped here.
+        """
+        self._cache.clear()
+        At, W, u, v = self.design(poles)
         B = self.B1 if self.shared else self.B
-        s = np.linalg.norm(A, axis=1, keepdims=True)
-        s[s == 0] = 1.0
-        # scipy's economic QR per matrix: ~4× faster than numpy's batched QR for these tall, skinny ones
-        QR = [qr(a, mode="economic", check_finite=False) for a in A / s]
-        Q, R = np.stack([q for q, _ in QR]), np.stack([r for _, r in QR])
-        c = (np.linalg.pinv(R, rcond=1e-13) @ (Q.transpose(0, 2, 1) @ B)) / s.transpose(0, 2, 1)
-        r = (A @ c - B)[..., 0]
+        sc = np.sqrt(np.einsum("epf,epf->ep", At, At))[..., None]  # (mm, P, 1) column norms
+        sc[sc == 0] = 1.0
+        At /= sc
+        P = At.shape[1]
+        Rp = np.empty((At.shape[0], P, P))
+        for e in range(At.shape[0]):
+            if P:
+                W[...] = At[e]
+                qr_, _, _, _ = _geqrf(W.T, overwrite_a=1)  # W.T: Fortran-ordered, factorised in place
+                Rp[e] = np.linalg.pinv(np.triu(qr_[:P, :P]), rcond=1e-13)
+        As = At.transpose(0, 2, 1)
+        RpT = Rp.transpose(0, 2, 1)
+        c = Rp @ (RpT @ (At @ B))
+        r = As @ c - B
+        c -= Rp @ (RpT @ (At @ r))  # one correction step
+        r = (As @ c - B)[..., 0]
+        c = c / sc
         if self.shared:
             r = r * self.wt[:, None]
-        return c[..., 0], r, Q
+        out = (c[..., 0], r, (At, Rp))
+        return out + (u, v) if uv else out
 
     def rss(self, poles) -> float:
         """Weighted residual sum of squares."""
@@ -347,7 +411,8 @@ class _Problem:
         return self.N * np.log(max(rss, self.floor) / self.N) + kpar * np.log(self.N)
 
     def _eval(self, p):
-        """Poles, clipped parameters, coefficients, residual and Q at parameters p (the last one cached)."""
+        """Poles, clipped parameters, coefficients, residual, projection factors, u, v at parameters p (the last one
+        cached)."""
         key = p.tobytes()
         if key not in self._cache:
             n = p.size // 2
@@ -356,7 +421,7 @@ class _Problem:
             pc = np.clip(p, *self.plim)
             lam = -np.exp(pc[:n]) + 1j * np.exp(pc[n:])
             self._cache.clear()
-            self._cache[key] = (lam, pc) + self.solve(lam)
+            self._cache[key] = (lam, pc) + self.solve(lam, uv=True)
         return self._cache[key]
 
     def fun(self, p):
@@ -364,30 +429,43 @@ class _Problem:
         return self._eval(p)[3].ravel()
 
     def jac(self, p):
-        """Kaufman's variable-projection Jacobian (m 2F, 2n) at parameters p = (ln σ_r, ln ω_dr)."""
-        lam, pc, c, _, Q = self._eval(p)
+        """Kaufman's variable-projection Jacobian (m 2F, 2n) at parameters p = (ln σ_r, ln ω_dr).
+
+        A view of a reused buffer: valid until the next call.
+        """
+        lam, pc, c, _, (At, Rp), u, v = self._eval(p)
         n = lam.size
-        s = 1j * self.w[:, None]
-        u2, v2 = (1.0 / (s - lam)) ** 2, (1.0 / (s - np.conj(lam))) ** 2
+        F = self.w.size
+        u2, v2 = u * u, v * v  # (n, F)
         # mode r of FRF e is A_er u + conj(A_er) v (A = c_2r + i c_2r+1); d/dp = A u² g + conj(A g) v²
         # with g = dλ/dp: −σ for ln σ, iω_d for ln ω_d
         A = c[:, 0:2 * n:2] + 1j * c[:, 1:2 * n:2]  # (m, n)
-        Ag = np.concatenate([A * lam.real, A * (1j * lam.imag)], 1)  # (m, 2n)
-        V = (np.tile(u2, 2)[None] * Ag[:, None] + np.tile(v2, 2)[None] * np.conj(Ag)[:, None]) \
-            * (self.fac[:, None] * self.Wt.T[:, :, None])  # (m, F, 2n)
-        V = np.concatenate([V.real, V.imag], 1)
-        V = V - Q @ (Q.transpose(0, 2, 1) @ V)
-        V[..., pc != p] = 0.0  # the clipped residual is flat in a clipped parameter
-        return V.reshape(-1, 2 * n)
+        m = A.shape[0]
+        fw = self.fac[None, :] * self.Wt.T  # (m, F)
+        (Vt,) = self._buffers(("jac", n), (2 * n, m, 2 * F))  # rows: parameters
+        for e in range(m):
+            for h, g in enumerate((A[e] * lam.real, A[e] * (1j * lam.imag))):
+                d = (u2 * g[:, None] + v2 * np.conj(g)[:, None]) * fw[e]
+                Vt[h * n:(h + 1) * n, e, :F], Vt[h * n:(h + 1) * n, e, F:] = d.real, d.imag
+        # project out the columns of the design matrix: Vᵀ − (Vᵀ As) R⁺ R⁺ᵀ Asᵀ
+        if At.shape[0] == 1:  # shared: one projector for all FRFs
+            X = Vt.reshape(-1, 2 * F)
+            X -= ((X @ At[0].T) @ Rp[0] @ Rp[0].T) @ At[0]
+        else:
+            for e in range(m):
+                Vt[:, e] -= ((Vt[:, e] @ At[e].T) @ Rp[e] @ Rp[e].T) @ At[e]
+        Vt[pc != p] = 0.0  # the clipped residual is flat in a clipped parameter
+        return Vt.reshape(2 * n, -1).T
 
-    def refine(self, poles, tol: float = 1e-10):
+    def refine(self, poles, tol: float = 1e-10, stop=None):
         """Poles moved by Levenberg–Marquardt on the variable-projection residual.
 
         Marquardt's scaled damping on the 2n × 2n normal equations JᵀJ (J: Kaufman's Jacobian,
         m·2F rows): the step costs O(2n)³ instead of a QR of J, which was most of the time
         spent in MINPACK. Stops when an accepted, nearly Gauss–Newton step (damping ≤ 1e-2) lowers
         the residual sum of squares by less than the fraction ``tol`` or moves every ln σ, ln ω_d
-        by less than ``tol``.
+        by less than ``tol``; or when ``stop(poles)`` is true after an accepted step (a trial already
+        known to be rejected).
         """
         if poles.size == 0:
             return poles
@@ -418,6 +496,12 @@ class _Problem:
                     break
                 if np.any(p[:n] < self.plim[0]):
                     break  # a damping ran to 0 (ln σ below its clip): that pole is removed anyway
+                wn = np.hypot(np.exp(np.clip(p[:n], *self.plim)), np.exp(np.clip(p[n:], *self.plim)))
+                if np.any((wn < self.wstop[0]) | (wn > self.wstop[1])):
+                    break  # a pole ran far out of the range where poles are kept: it is removed anyway
+                x = np.clip(p, *self.plim)
+                if stop is not None and stop(-np.exp(x[:n]) + 1j * np.exp(x[n:])):
+                    break
                 J = self.jac(p)
                 mu = max(mu / 3.0, 1e-12)
             else:
@@ -515,10 +599,10 @@ _TRIAL_TOL = 1e-8  # LM tolerances while choosing the order (1e-6 stopped broad 
 _FINAL_TOL = 1e-10  # the final refinement of the chosen model
 
 
-def _refine_clean(prob, poles, f_lo, f_hi, tol=_TRIAL_TOL):
+def _refine_clean(prob, poles, f_lo, f_hi, tol=_TRIAL_TOL, stop=None):
     """Refine; remove poles that left the band or reached a damping limit; repeat until all are modes."""
     while True:
-        poles = prob.refine(poles, tol)
+        poles = prob.refine(poles, tol, stop)
         ok = _valid(poles, f_lo, f_hi)
         if ok.all():
             return poles
@@ -579,11 +663,14 @@ def _select(prob, poles, f, f_lo, f_hi, n_modes, max_modes):
         rss_t = prob.rss(trial)
         # judged by the criterion alone: a trial that lost a pole on the way (left the band, hit a
         # damping limit) may still be the better model
-        if prob.bic(rss_t, trial.size) >= prob.bic(rss, poles.size):
-            misses += 1  # try the next-largest residual elsewhere once more
-            tried |= np.abs(f - f[j]) <= 0.02 * f[j]
+        better = prob.bic(rss_t, trial.size) < prob.bic(rss, poles.size)
+        if better and trial.size > poles.size:
+            poles, rss, misses, tried = trial, rss_t, 0, np.zeros(f.size, bool)
             continue
-        poles, rss, misses, tried = trial, rss_t, 0, np.zeros(f.size, bool)
+        if better:  # no pole added, but the others moved to a better fit: keep them; still a miss here
+            poles, rss = trial, rss_t
+        misses += 1  # try the next-largest residual elsewhere once more
+        tried |= np.abs(f - f[j]) <= 0.02 * f[j]
     return _add_residual_poles(prob, poles, f_lo, f_hi)
 
 
@@ -597,12 +684,16 @@ def _add_residual_poles(prob, poles, f_lo, f_hi, most: int = 4):
     def n_in(p):
         return int(np.sum((np.abs(p) >= 2 * np.pi * f_lo) & (np.abs(p) <= 2 * np.pi * f_hi)))
 
+    def inside(lam):  # the new (last) pole is well inside the band: the trial will be rejected, stop refining
+        return lam.size == k + 1 and 2 * np.pi * 1.1 * f_lo < abs(lam[-1]) < 2 * np.pi * f_hi / 1.1
+
     rss = prob.rss(poles)
     for _ in range(most):
         best = None
+        k = poles.size
         for fs in (1.5 * f_hi, 0.5 * f_lo):
             trial = np.r_[poles, 2 * np.pi * fs * (-0.3 + 1j * np.sqrt(0.91))]  # |λ| = ω_s, ζ = 0.3
-            trial = _refine_clean(prob, trial, f_lo, f_hi)
+            trial = _refine_clean(prob, trial, f_lo, f_hi, stop=inside)
             if n_in(trial) > n_in(poles):  # it ran into the band: a mode, which only the forward step adds
                 continue
             b = prob.bic(prob.rss(trial), trial.size)
@@ -610,6 +701,8 @@ def _add_residual_poles(prob, poles, f_lo, f_hi, most: int = 4):
                 best = (b, trial)
         if best is None or best[0] >= prob.bic(rss, poles.size):
             return poles
+        if best[1].size <= poles.size:  # the new pole left: the others only moved to a better fit
+            return best[1]
         poles = best[1]
         rss = prob.rss(poles)
     return poles
@@ -618,7 +711,8 @@ def _add_residual_poles(prob, poles, f_lo, f_hi, most: int = 4):
 # --------------------------------------------------------------------------- entry points
 def fit_modal(freq_hz, Y, *, quantity: str = "receptance", noise: str | None = None, band=None,
               n_modes: int | None = None, coherence=None, weights=None, residuals: bool = True,
-              max_order: int | None = None, max_modes: int = 30, labels=()) -> ModalFit:
+              max_order: int | None = None, max_modes: int = 30, labels=(),
+              driving_point: int | None = None) -> ModalFit:
     """Fit common complex poles, modal constants and residual terms to the columns of ``Y``.
 
     Parameters
@@ -649,6 +743,13 @@ def fit_modal(freq_hz, Y, *, quantity: str = "receptance", noise: str | None = N
         Most modes the automatic order may reach.
     labels : sequence of str
         Names of the FRFs.
+    driving_point : int, optional
+        Index of the column of ``Y`` that is a driving point (response at the input, e.g. a tool-point
+        receptance): its modes must have positive modal mass (real-mode-equivalent a_r > 0, see
+        :meth:`ModalFit.real_modes`). The automatic order then drops modes of negative mass when a
+        model without them is nearly as likely (BIC within 10); when the data demand them, the fit is
+        kept and a :class:`DrivingPointWarning` (and ``ModalFit.notes``) names them. With ``n_modes``
+        given, such modes are only named. None (default): no such check.
 
     Returns
     -------
@@ -693,12 +794,19 @@ def fit_modal(freq_hz, Y, *, quantity: str = "receptance", noise: str | None = N
     if zero.size:
         raise InputError(f"FRF {int(zero[0])} is zero everywhere in the band: nothing to fit (need an FRF that is "
                          "not all zero)", field="values")
+    if driving_point is not None and (int(driving_point) != driving_point or not 0 <= driving_point < Y.shape[1]):
+        raise InputError(f"must be the index of one of the {Y.shape[1]} FRFs, got {driving_point!r}",
+                         field="driving_point")
     w = 2 * np.pi * f
     Yq = Y * _factor(w, k - k_in)[:, None]  # into the measured quantity
     Wt = _weights(Yq, coherence, weights, sel)
     with single_thread_blas():  # tall-skinny QRs: threads only add overhead
-        return _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, tuple(labels),
-                    noise or quantity)
+        fit = _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, tuple(labels),
+                   noise or quantity, None if driving_point is None else int(driving_point))
+    for note in fit.notes:
+        if note.startswith("warning: "):
+            warnings.warn(note[len("warning: "):], DrivingPointWarning, stacklevel=2)
+    return fit
 
 
 def _weights(Yq, coherence, weights, sel) -> np.ndarray:
@@ -724,7 +832,7 @@ def _weights(Yq, coherence, weights, sel) -> np.ndarray:
     return W
 
 
-def _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, labels, quantity) -> ModalFit:
+def _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, labels, quantity, driving) -> ModalFit:
     f_lo, f_hi = float(f[0]), float(f[-1])
     prob = _Problem(w, Yq, Wt, k, residuals)
     mag = np.sqrt(np.sum(np.abs(Yq * Wt) ** 2, 1))
@@ -763,6 +871,9 @@ def _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, labels, quan
             if bad is None:
                 break
             poles = _refine_clean(prob, np.delete(poles, bad), f_lo, f_hi, _FINAL_TOL)
+    notes = ()
+    if driving is not None:
+        poles, notes = _positive_masses(prob, poles, f_lo, f_hi, driving, enforce=n_modes is None)
     poles = poles[np.argsort(np.abs(poles))]
     c, _, _ = prob.solve(poles)
     n = poles.size
@@ -777,11 +888,65 @@ def _fit(f, w, Yq, Wt, k, residuals, n_modes, max_order, max_modes, labels, quan
     fn = np.abs(poles) / (2 * np.pi)
     mode = (fn >= f_lo) & (fn <= f_hi)
     kw = dict(residual_poles=poles[~mode], residual_residues=res[~mode],
-              diagram=tuple((first + i, np.asarray(d)) for i, d in enumerate(diagram)))
+              diagram=tuple((first + i, np.asarray(d)) for i, d in enumerate(diagram)), notes=notes)
     fit = ModalFit(poles[mode], res[mode], U, L, (f_lo, f_hi), quantity, np.zeros(c.shape[0]), labels,
                    velocity_residual=V, **kw)
     err = np.linalg.norm(fit.values(f, quantity) - Yq, axis=0) / np.linalg.norm(Yq, axis=0)
     return ModalFit(fit.poles, fit.residues, U, L, fit.band_hz, quantity, err, labels, velocity_residual=V, **kw)
+
+
+def _negative_masses(prob, poles, f_lo, f_hi, driving) -> np.ndarray:
+    """Indices of the in-band poles whose modal constant on FRF ``driving`` is a negative (or infinite) modal
+    mass: real-mode-equivalent a_r = −2 Re(A_r conj λ_r) ≤ 0 (:meth:`ModalFit.real_modes`)."""
+    c, _, _ = prob.solve(poles)
+    n = poles.size
+    A = c[driving, 0:2 * n:2] + 1j * c[driving, 1:2 * n:2]
+    a = -2 * (A * np.conj(poles)).real
+    inband = (np.abs(poles) >= 2 * np.pi * f_lo) & (np.abs(poles) <= 2 * np.pi * f_hi)
+    return np.flatnonzero(inband & ~(a > 0))
+
+
+def _positive_masses(prob, poles, f_lo, f_hi, driving, enforce=True):
+    """The driving-point rule: poles whose in-band modes all have positive modal mass on FRF ``driving``, if
+    the data allow; and the notes (one line each) saying what was done.
+
+    A driving point's modes all have positive modal mass; a mode of negative mass is a fit artefact (a noise
+    pole, one real mode split in two) — or the FRF is no driving point (a transfer FRF's modal constants
+    alternate in sign). The data decide which: the modes of negative mass are removed one at a time (the
+    removal that raises the criterion least first, the others refitted) until none is left, and that
+    model replaces the fit when its BIC exceeds the fit's by at most 10 ("very strong" evidence, Kass &
+    Raftery). Otherwise the data demand those modes: the fit is kept whole, and a warning names them. A
+    real mode is thus never removed for its sign alone.
+    """
+    neg = _negative_masses(prob, poles, f_lo, f_hi, driving)
+    if neg.size == 0:
+        return poles, ()
+    fn = np.abs(poles) / (2 * np.pi)
+
+    def names(idx):
+        return ", ".join(f"{x:.1f}" for x in np.sort(fn[idx])) + " Hz"
+
+    why = "the number of modes was given"
+    if enforce:
+        bic0 = prob.bic(prob.rss(poles), poles.size)
+        cur, cur_neg = poles, neg
+        while cur_neg.size:
+            best = None
+            for r in cur_neg:
+                trial = _refine_clean(prob, np.delete(cur, r), f_lo, f_hi, _FINAL_TOL)
+                b = prob.bic(prob.rss(trial), trial.size)
+                if best is None or b < best[0]:
+                    best = (b, trial)
+            if best[0] - bic0 > _STRONG:
+                why = f"without them the BIC rises by {best[0] - bic0:.3g}"
+                break
+            cur = best[1]
+            cur_neg = _negative_masses(prob, cur, f_lo, f_hi, driving)
+        else:
+            return cur, (f"note: driving point: modes of negative modal mass dropped at {names(neg)} (BIC "
+                         f"{best[0] - bic0:+.3g} without them: as likely)",)
+    return poles, (f"warning: driving point: modes of negative modal mass kept at {names(neg)} ({why}): check "
+                   "that the FRF is a driving point (a transfer FRF's modal constants alternate in sign)",)
 
 
 def _undetermined(prob, poles, f_lo, f_hi):
@@ -831,6 +996,7 @@ def _with(prob, residuals):
     out = object.__new__(_Problem)
     out.__dict__.update(prob.__dict__)
     out.residuals, out._cache = tuple(residuals), {}
+    out._set_residual_columns()
     return out
 
 
@@ -840,7 +1006,8 @@ def fit_frfs(frfs, *, noise: str | None = None, band=None, n_modes: int | None =
     The noise quantity is, in order: ``noise``; the quantity the file held
     (``frf.meta["file_quantity"]``, set by the readers, which convert to receptance);
     the FRF's own ``quantity``. ``frf.meta["coherence"]`` ((F,) γ²), when every FRF
-    has it, gives the point weights.
+    has it, gives the point weights. The first FRF with a true ``frf.meta["driving_point"]``
+    is the ``driving_point`` of :func:`fit_modal` unless that is given.
 
     Parameters
     ----------
@@ -867,6 +1034,9 @@ def fit_frfs(frfs, *, noise: str | None = None, band=None, n_modes: int | None =
     if any(g.quantity != quantity for g in frfs):
         Y = np.stack([g.to_receptance().values for g in frfs], -1)
         quantity = "receptance"
+    if "driving_point" not in kw:
+        flagged = [k for k, g in enumerate(frfs) if g.meta.get("driving_point")]
+        kw["driving_point"] = flagged[0] if flagged else None
     if "coherence" not in kw and all("coherence" in g.meta for g in frfs):
         kw["coherence"] = np.stack([np.asarray(g.meta["coherence"], float).reshape(-1) for g in frfs], -1)
     return fit_modal(frfs[0].freq_hz, Y, quantity=quantity, noise=q, band=band, n_modes=n_modes,
