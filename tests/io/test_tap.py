@@ -70,9 +70,9 @@ def test_exponential_window_shifts_poles_by_one_over_tau():
     assert res.added_damping(500.0) == pytest.approx(1 / (2 * np.pi * 500 * tau))
     # corrected_damping undoes the pole shift exactly
     w2 = np.abs(lam2)
-    fn, z = corrected_damping(w2 / (2 * np.pi), -lam2.real / w2, tau)
-    np.testing.assert_allclose(fn, S.FN, rtol=1e-12)
-    np.testing.assert_allclose(z, S.ZETA, rtol=1e-12)
+    c = corrected_damping(w2 / (2 * np.pi), -lam2.real / w2, tau)
+    np.testing.assert_allclose(c.fn_hz, S.FN, rtol=1e-12)
+    np.testing.assert_allclose(c.zeta, S.ZETA, rtol=1e-12)
 
 
 def test_several_files_one_hit_each_equal_one_long_record(synth, tmp_path):

@@ -313,7 +313,8 @@ def _summary(res, outs, edge=None, at_edge=False) -> None:
                       f"(chatter {res.chatter_hz[k]:.1f} Hz)")
     else:
         print("no chatter found in the speed range (no lobe reaches it)")
-    pr, pd = res.pocket()
+    best = res.pocket()
+    pr, pd = best.rpm, best.depth_m
     if np.isfinite(pd):
         print(f"best stable pocket: {1e3 * pd:.4g} mm at {pr:.0f} rpm")
     else:

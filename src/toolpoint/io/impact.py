@@ -81,7 +81,7 @@ from ..errors import InputError
 from ..frf import FRF
 
 __all__ = ["RESPONSES", "Record", "Hit", "TapResult", "read_record", "find_hits", "impact_frf", "plot_tap",
-           "corrected_damping"]
+           "corrected_damping", "CorrectedDamping"]
 
 RESPONSES = {"acceleration": "accelerance", "velocity": "mobility", "displacement": "receptance"}
 """Response kind → the FRF quantity it gives over force."""
@@ -274,7 +274,23 @@ class TapResult:
         return np.zeros_like(f) if self.tau_s is None else 1.0 / (2 * np.pi * f * self.tau_s)
 
 
-def corrected_damping(fn_hz, zeta, tau_s: float | None):
+@dataclass(frozen=True)
+class CorrectedDamping:
+    """Modal frequency and damping with an exponential window's added damping removed (:func:`corrected_damping`).
+
+    Attributes
+    ----------
+    fn_hz : numpy.ndarray
+        Natural frequency, Hz.
+    zeta : numpy.ndarray
+        Damping ratio.
+    """
+
+    fn_hz: np.ndarray
+    zeta: np.ndarray
+
+
+def corrected_damping(fn_hz, zeta, tau_s: float | None) -> CorrectedDamping:
     """Modal frequency and damping with the exponential window's added damping removed.
 
     The window e^{-t/τ} moves each pole s = −ζω + iω_d to s − 1/τ (ω_d is
@@ -291,8 +307,8 @@ def corrected_damping(fn_hz, zeta, tau_s: float | None):
 
     Returns
     -------
-    tuple of numpy.ndarray
-        (fn_hz, zeta) of the structure without the window.
+    CorrectedDamping
+        ``fn_hz`` and ``zeta`` of the structure without the window.
 
     Examples
     --------
@@ -300,17 +316,17 @@ def corrected_damping(fn_hz, zeta, tau_s: float | None):
 
     >>> w = 2 * np.pi * 500.0
     >>> lam = -0.02 * w + 1j * w * np.sqrt(1 - 0.02**2) - 1 / 0.1
-    >>> fn, z = corrected_damping(abs(lam) / (2 * np.pi), -lam.real / abs(lam), 0.1)
-    >>> round(float(fn), 9), round(float(z), 9)
+    >>> c = corrected_damping(abs(lam) / (2 * np.pi), -lam.real / abs(lam), 0.1)
+    >>> round(float(c.fn_hz), 9), round(float(c.zeta), 9)
     (500.0, 0.02)
     """
     fn, z = np.asarray(fn_hz, dtype=float), np.asarray(zeta, dtype=float)
     if tau_s is None:
-        return fn, z
+        return CorrectedDamping(fn, z)
     w = 2 * np.pi * fn
     sigma, wd = z * w - 1.0 / tau_s, w * np.sqrt(1 - z**2)
     w0 = np.hypot(sigma, wd)
-    return w0 / (2 * np.pi), sigma / w0
+    return CorrectedDamping(w0 / (2 * np.pi), sigma / w0)
 
 
 # ---------------------------------------------------------------- reading
@@ -576,6 +592,29 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
     >>> len(res.used), float(res.coherence.min()) > 0.999, [round(f, 6) for f in res.band_hz]
     (2, True, [0.0, 1000.0])
     """
+    recs, dt, kind = _check_inputs(records, estimator, output, detrend, force_drop_db)
+    hits, used = _hits_to_average(recs, threshold, min_gap_s, pretrigger_s, drop_bad)
+    n, tau, fblk, xblk = _hit_blocks(recs, used, dt, exp_window_s)
+    we = np.ones(n) if tau is None else np.exp(-np.arange(n) * dt / tau)
+    fblk, xblk, wf = _windowed(recs, used, fblk, xblk, dt, force_window_s, detrend, kind, tau)
+    freq, sff, sxx, sxf = _spectra(fblk * wf * we, xblk * we, dt)
+    quantity = RESPONSES[kind]
+    keep, notes = _band(freq, sff, used, dt, fmax_hz, force_drop_db, output == "receptance" and
+                        quantity != "receptance", recs[0].source)
+    freq, sff, sxx, sxf = freq[keep], sff[keep], sxx[keep], sxf[keep]
+    h, coh = _estimate(freq, sff, sxx, sxf, estimator, recs[0].source)
+    if detrend == "auto":
+        notes.append({"acceleration": "offset and linear drift of the acceleration removed per block "
+                                      "(least-squares line) before the FFT",
+                      "velocity": "velocity offset (block mean) removed before the FFT",
+                      "displacement": "displacement offset (pre-trigger mean) removed before the FFT"}[kind])
+    frf = _tap_frf(freq, h, coh, recs, used, estimator, tau, quantity, output, label)
+    return TapResult(frf, coh, hits, [h.number for h in used], tau, recs, (float(freq[0]), float(freq[-1])),
+                     tuple(notes))
+
+
+def _check_inputs(records, estimator, output, detrend, force_drop_db):
+    """(records as a list, sampling step s, response kind), after checking the options and the records agree."""
     recs = [records] if isinstance(records, Record) else list(records)
     if not recs:
         raise InputError("no records", field="records")
@@ -595,6 +634,14 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
         if r.response_kind != kind:
             raise InputError(f"response is {r.response_kind}, {recs[0].source} has {kind}", file=r.source or None,
                              field="response")
+    return recs, dt, kind
+
+
+def _hits_to_average(recs, threshold, min_gap_s, pretrigger_s, drop_bad):
+    """(every hit found, the hits to average): cut-short hits dropped, bad ones dropped or refused.
+
+    The warnings name the caller of :func:`impact_frf` (stacklevel 3).
+    """
     hits, number = [], 1
     for i, r in enumerate(recs):
         found = find_hits(r, threshold=threshold, min_gap_s=min_gap_s, pretrigger_s=pretrigger_s,
@@ -608,37 +655,46 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
             if all(g.cut_s is not None for g in hits):
                 raise InputError(f"{h.describe()}: no complete hit to average (min_gap_s = {min_gap_s:g} s of "
                                  "record is needed after a trigger)", file=src or None, field="hits")
-            warnings.warn(f"{h.describe(src)}: dropped", stacklevel=2)
+            warnings.warn(f"{h.describe(src)}: dropped", stacklevel=3)
             continue
         if h.bad and drop_bad:
-            warnings.warn(f"{h.describe(src)}: dropped", stacklevel=2)
+            warnings.warn(f"{h.describe(src)}: dropped", stacklevel=3)
             continue
         if h.clipped:
             raise InputError(f"{h.describe()}; use --drop-bad (drop_bad=True) to leave it out",
                              file=src or None, field="overload")
         if h.double_at_s is not None:
-            warnings.warn(f"{h.describe(src)}: kept (use --drop-bad to leave it out)", stacklevel=2)
+            warnings.warn(f"{h.describe(src)}: kept (use --drop-bad to leave it out)", stacklevel=3)
         used.append(h)
     if not used:
         raise InputError(f"all {len(hits)} hits were dropped as bad", file=recs[0].source or None, field="hits")
+    return hits, used
+
+
+def _hit_blocks(recs, used, dt, exp_window_s):
+    """(block length n, exponential window τ s or None, force blocks, response blocks), each (hits, n)."""
     n = min(h.stop - h.start for h in used)
     if n < 8:
         raise InputError(f"hit blocks of {n} samples are too short (hits too close: raise min_gap_s or record "
                          "longer)", file=recs[0].source or None, field="time_s")
-    t = np.arange(n) * dt
     tau = None
     if exp_window_s is not None:
         tau = n * dt / np.log(100.0) if exp_window_s == "auto" else float(exp_window_s)
         if not tau > 0:
             raise InputError(f"exponential window time constant must be > 0 s, got {exp_window_s}",
                              field="exp_window_s")
-    we = np.ones(n) if tau is None else np.exp(-t / tau)
     fblk = np.stack([recs[h.record].force_n[h.start:h.start + n] for h in used])
     xblk = np.stack([recs[h.record].response[h.start:h.start + n] for h in used])
     for h, x in zip(used, xblk):
         if np.ptp(x) == 0:
             raise InputError(f"hit {h.number}: the response is {x[0]:g} throughout its block: no signal",
                              file=recs[h.record].source or None, field="response")
+    return n, tau, fblk, xblk
+
+
+def _windowed(recs, used, fblk, xblk, dt, force_window_s, detrend, kind, tau):
+    """(force blocks, response blocks, force windows): detrended, and a warning where a response leaks."""
+    n = fblk.shape[1]
     if force_window_s is None:
         ends = np.array([h.pulse_end - h.start + h.width for h in used])
     else:
@@ -653,13 +709,20 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
         if tail > LEAK_LEVEL * np.abs(x).max() and tau is None:
             warnings.warn(f"{recs[h.record].source}: hit {h.number}: the response has not died out by the end of "
                           f"its {n * dt:.4g} s block ({tail / np.abs(x).max():.1%} of its peak): leakage; "
-                          "use longer records or an exponential window", stacklevel=2)
-    F = np.fft.rfft(fblk * wf * we, axis=1)
-    X = np.fft.rfft(xblk * we, axis=1)
-    freq = np.fft.rfftfreq(n, dt)
-    sff = np.sum(np.abs(F) ** 2, axis=0)
-    sxx = np.sum(np.abs(X) ** 2, axis=0)
-    sxf = np.sum(X * np.conj(F), axis=0)
+                          "use longer records or an exponential window", stacklevel=3)
+    return fblk, xblk, wf
+
+
+def _spectra(fw, xw, dt):
+    """(frequencies Hz, S_ff, S_xx, S_xf) summed over the windowed blocks ``fw``, ``xw``."""
+    F = np.fft.rfft(fw, axis=1)
+    X = np.fft.rfft(xw, axis=1)
+    freq = np.fft.rfftfreq(fw.shape[1], dt)
+    return freq, np.sum(np.abs(F) ** 2, axis=0), np.sum(np.abs(X) ** 2, axis=0), np.sum(X * np.conj(F), axis=0)
+
+
+def _band(freq, sff, used, dt, fmax_hz, force_drop_db, positive, source):
+    """(mask of the lines kept, notes): up to ``fmax_hz`` and the end of the force band; only f > 0 if ``positive``."""
     notes = []
     keep = np.ones(freq.size, bool) if fmax_hz is None else freq <= fmax_hz
     if force_drop_db is not None:
@@ -668,37 +731,40 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
         if f_end is not None:
             if not np.any(keep & (freq < f_end)):
                 raise InputError(f"{level_note}; no frequency line is left below it (fmax {fmax_hz} Hz)",
-                                 file=recs[0].source or None, field="force_n")
+                                 file=source or None, field="force_n")
             if fmax_hz is None or f_end <= fmax_hz:
                 notes.append(f"band ends at {freq[freq < f_end][-1]:.6g} Hz: {level_note}; nothing written above "
                              "(force_drop_db / --force-drop)")
             keep &= freq < f_end
-    quantity = RESPONSES[kind]
-    if output == "receptance" and quantity != "receptance":
+    if positive:
         keep &= freq > 0
     if not keep.any():
         raise InputError(f"no frequency line at or below {fmax_hz} Hz", field="fmax_hz")
-    freq, sff, sxx, sxf = freq[keep], sff[keep], sxx[keep], sxf[keep]
+    return keep, notes
+
+
+def _estimate(freq, sff, sxx, sxf, estimator, source):
+    """(H1 or H2 estimate, coherence γ²) from the spectra; refused where S_ff or S_xf is zero."""
     zero = np.flatnonzero((sff == 0) | (np.abs(sxf) == 0))
     if zero.size:
         what = "force spectrum" if sff[zero[0]] == 0 else "cross spectrum (response × force)"
-        raise InputError(f"the {what} is zero at {freq[zero[0]]:.6g} Hz: lower fmax", file=recs[0].source or None,
+        raise InputError(f"the {what} is zero at {freq[zero[0]]:.6g} Hz: lower fmax", file=source or None,
                          field="force_n" if sff[zero[0]] == 0 else "response")
     with np.errstate(all="ignore"):
         h = sxf / sff if estimator == "H1" else sxx / np.conj(sxf)
         coh = np.clip(np.abs(sxf) ** 2 / (sff * sxx), 0.0, 1.0)
-    if detrend == "auto":
-        notes.append({"acceleration": "offset and linear drift of the acceleration removed per block "
-                                      "(least-squares line) before the FFT",
-                      "velocity": "velocity offset (block mean) removed before the FFT",
-                      "displacement": "displacement offset (pre-trigger mean) removed before the FFT"}[kind])
+    return h, coh
+
+
+def _tap_frf(freq, h, coh, recs, used, estimator, tau, quantity, output, label):
+    """The FRF with its metadata, as receptance (exact under an exponential window) or the measured quantity."""
     meta = {"estimator": estimator, "hits": [h.number for h in used], "tau_s": tau,
             "source": ", ".join(r.source for r in recs), "format": "tap", "file_quantity": quantity}
     if len(used) == 1:
         src = recs[used[0].record].source
         warnings.warn(f"{src + ': ' if src else ''}one hit: its coherence is 1 by construction (one average) and "
                       "says nothing about the FRF's quality, so none is reported; average 3–5 hits to measure it",
-                      stacklevel=2)
+                      stacklevel=3)
     else:
         meta["coherence"] = coh
     frf = FRF(freq, h, quantity, label, meta)
@@ -710,8 +776,7 @@ def impact_frf(records, *, estimator: str = "H1", output: str = "receptance", th
         frf = FRF(freq, h / (2j * np.pi * freq + 1.0 / tau) ** power, "receptance", label, meta)
     elif output == "receptance":
         frf = frf.to_receptance()
-    return TapResult(frf, coh, hits, [h.number for h in used], tau, recs, (float(freq[0]), float(freq[-1])),
-                     tuple(notes))
+    return frf
 
 
 def _detrend(fblk, xblk, inside, pre, kind):

@@ -18,7 +18,7 @@ Geometry and sign conventions: :mod:`toolpoint.stability.milling`.
 
 from .cutting import CuttingConditions
 from .cutting import immersion_angles
-from .milling import Lobe, LobeResult, average_directional_matrix, directional_coefficients
+from .milling import Lobe, LobeResult, Pocket, average_directional_matrix, directional_coefficients
 from .sdm import sdm_lobes, sdm_spectral_radius
 from .statespace import ModalModel, StateSpaceModel, from_modal_fit
 from .zoa import zoa_lobes
@@ -28,6 +28,7 @@ __all__ = [
     "Lobe",
     "LobeResult",
     "ModalModel",
+    "Pocket",
     "StateSpaceModel",
     "average_directional_matrix",
     "directional_coefficients",

@@ -9,7 +9,9 @@ The one pipeline behind ``toolpoint lobes`` and a notebook's call (:func:`lobes_
    ``method="zoa"`` and the cross-check of the semi-discretisation.
 3. **Semi-discretisation** (``method="sdm"``) on a modal model fitted in the band
    (:func:`toolpoint.dynamics.modal.fit_frfs`, weighted as the band's noise is white). The SDM never declares
-   stability on a failed model; the model is refused (one line naming the file) when
+   stability on a failed model. The tool-point FRF is a driving point (a direct FRF at the tool tip; with cross
+   FRFs, xx and yy): the fit enforces positive modal mass on it, and its notes (modes of negative mass dropped, or
+   kept with a warning) join the result's. The model is refused (one line naming the file) when
 
    * the fit leaves ≥ 95 % of the FRF unexplained (noise only) or > 50 % (:data:`BAD_FIT`),
    * it holds no mode inside the band, or
@@ -169,6 +171,8 @@ def lobes_from_frf(frf_x: FRF, cutting: CuttingConditions, rpm, *, frf_y: FRF | 
     res = zoa
     if method == "sdm":
         res, modal = _sdm(cut, files, b, cutting, rpm, n_modes, accuracy, progress, log)
+        for fit in modal:  # the driving-point rule's notes (modes of negative modal mass dropped or kept)
+            notes += [n for n in fit.notes if n not in notes]
         notes += _agreement(res, zoa)
     data_hz = frf_x.freq_hz
     edge = edge_hits(res.chatter_hz, (b.lo_hz, b.hi_hz), data_hz) & np.isfinite(res.depth_m)
@@ -183,8 +187,11 @@ def lobes_from_frf(frf_x: FRF, cutting: CuttingConditions, rpm, *, frf_y: FRF | 
 
 
 def _sdm(cut, files, band, cutting, rpm, n_modes, accuracy, progress, log):
-    """Modal model of the cut FRFs (checked) and the semi-discretisation on it."""
-    from ..dynamics.modal import fit_frfs
+    """Modal model of the cut FRFs (checked) and the semi-discretisation on it.
+
+    The tool-point FRFs are driving points (direct FRFs at the tool tip): each fit enforces positive modal mass on
+    its direct FRF (``driving_point=0`` of :func:`~toolpoint.dynamics.modal.fit_frfs`; with cross FRFs, xx for
+    force x and yy for force y), and its notes join the result's."""
     from .sdm import sdm_lobes
     from .statespace import from_modal_fit
 
@@ -194,8 +201,8 @@ def _sdm(cut, files, band, cutting, rpm, n_modes, accuracy, progress, log):
         fits = []
         for direct, cross in (("FRF", "--frf-yx"), ("--frf-y" if "--frf-y" in cut else "FRF", "--frf-xy")):
             flags = [direct] + ([cross] if cross in cut else [])
-            try:
-                fit = fit_frfs([cut[f] for f in flags], n_modes=n_modes, noise=noise)
+            try:  # the direct FRF (xx for force x, yy for force y) is the driving point
+                fit = _quiet_fit([cut[f] for f in flags], n_modes=n_modes, noise=noise, driving_point=0)
             except InputError as err:
                 raise InputError(f"common-pole fit of {' and '.join(flags)}: {err.message}",
                                  file=files[flags[-1]], field=flags[-1]) from None
@@ -217,15 +224,25 @@ def _sdm(cut, files, band, cutting, rpm, n_modes, accuracy, progress, log):
 
 
 def _fit_one(frf, flag, path, n_modes, noise):
-    """Complex modes of one direct receptance, refused when they cannot carry the SDM."""
-    from ..dynamics.modal import fit_frfs
-
+    """Complex modes of one direct receptance (a driving point), refused when they cannot carry the SDM."""
     try:
-        fit = fit_frfs([frf], n_modes=n_modes, noise=noise)
+        fit = _quiet_fit([frf], n_modes=n_modes, noise=noise, driving_point=0)
     except InputError as err:
         raise InputError(err.message, file=path, field=flag) from None
     _check_model(fit, frf, flag, path)
     return fit
+
+
+def _quiet_fit(frfs, **kw):
+    """:func:`~toolpoint.dynamics.modal.fit_frfs` with its :class:`DrivingPointWarning` left to ``fit.notes``
+    (carried into :attr:`MeasuredLobes.notes`, so the CLI prints it once)."""
+    import warnings
+
+    from ..dynamics.modal import DrivingPointWarning, fit_frfs
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DrivingPointWarning)
+        return fit_frfs(frfs, **kw)
 
 
 def _check_model(fit, frf: FRF, flag, path) -> None:

@@ -207,6 +207,22 @@ class Lobe:
 
 
 @dataclass(frozen=True)
+class Pocket:
+    """The best stable pocket of a stability limit (:meth:`LobeResult.pocket`).
+
+    Attributes
+    ----------
+    rpm : float
+        Spindle speed, rpm (nan when there is no pocket).
+    depth_m : float
+        Stability limit there, m (nan when there is no pocket).
+    """
+
+    rpm: float
+    depth_m: float
+
+
+@dataclass(frozen=True)
 class LobeResult:
     """Stability lobes on a spindle-speed grid (SI: depth in m).
 
@@ -267,7 +283,7 @@ class LobeResult:
         # Points on a lobe's own boundary (f_c T an integer up to round-off) belong to the lower k.
         return np.where(ok, np.floor(np.where(ok, waves, 0.0) + 1e-9), -1).astype(int)
 
-    def pocket(self) -> tuple[float, float]:
+    def pocket(self) -> Pocket:
         """Best stable pocket: the highest local maximum of the limit strictly inside the speed range.
 
         A local maximum is a run of equal finite limits whose neighbours on
@@ -276,12 +292,12 @@ class LobeResult:
 
         Returns
         -------
-        (rpm, depth_m) : tuple of float
-            rpm and m; ``(nan, nan)`` when the limit has no such maximum.
+        Pocket
+            Speed (rpm) and limit (m); both nan when the limit has no such maximum.
         """
         d = np.asarray(self.depth_m, dtype=float)
         if d.size < 3:
-            return float("nan"), float("nan")
+            return Pocket(float("nan"), float("nan"))
         start = np.r_[0, np.flatnonzero(d[1:] != d[:-1]) + 1]  # runs of equal values
         stop = np.r_[start[1:], d.size]
         inner = (start > 0) & (stop < d.size)
@@ -289,10 +305,10 @@ class LobeResult:
         val = d[start]
         peak = np.isfinite(val) & (d[start - 1] < val) & (d[stop] < val)
         if not peak.any():
-            return float("nan"), float("nan")
+            return Pocket(float("nan"), float("nan"))
         j = int(np.argmax(np.where(peak, val, -np.inf)))
         mid = (start[j] + stop[j] - 1) // 2
-        return float(self.rpm[mid]), float(d[mid])
+        return Pocket(float(self.rpm[mid]), float(d[mid]))
 
     def plot(self, ax=None, **kw):
         """Stability chart, speed (rpm) against depth (mm).

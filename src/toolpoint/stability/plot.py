@@ -29,7 +29,7 @@ def chart_top_mm(result) -> float:
     top = 1.1 * fin.max()
     low = 1e3 * result.min_depth_m if np.isfinite(result.min_depth_m) else fin.min()
     top = float(min(top, 10 * low)) if low > 0 else float(top)
-    pocket = 1e3 * result.pocket()[1]
+    pocket = 1e3 * result.pocket().depth_m
     return max(top, 1.1 * pocket) if np.isfinite(pocket) else top
 
 
@@ -85,7 +85,8 @@ def plot_lobes(result, ax=None, *, show_lobes: bool | None = None, ymax_mm: floa
         mr, md = result.min_rpm, 1e3 * result.min_depth_m
         if inside(mr, md):
             ax.plot([mr], [md], "v", color="k", ms=6, label=f"minimum {md:.3g} mm @ {mr:.0f} rpm")
-        pr, pd = result.pocket()
+        best = result.pocket()
+        pr, pd = best.rpm, best.depth_m
         if inside(pr, 1e3 * pd):
             ax.plot([pr], [1e3 * pd], "^", mfc="white", mec="k", ms=7,
                     label=f"best pocket {1e3 * pd:.3g} mm @ {pr:.0f} rpm")

@@ -551,10 +551,9 @@ def _zoa_minimum(sysm: _System, freq_hz: np.ndarray, phi: np.ndarray) -> float:
     from .zoa import depth_and_phase, oriented_eigenvalues
 
     h0 = average_directional_matrix(sysm.teeth, sysm.tangential_coeff, sysm.radial_ratio, sysm.phi_st, sysm.phi_ex)
-    depth, _, valid = depth_and_phase(oriented_eigenvalues(h0, phi[:, 0, 0], phi[:, 1, 1], phi[:, 0, 1],
-                                                           phi[:, 1, 0]))
-    if valid.any():
-        return float(depth[valid].min())
+    zero_order = depth_and_phase(oriented_eigenvalues(h0, phi[:, 0, 0], phi[:, 1, 1], phi[:, 0, 1], phi[:, 1, 0]))
+    if zero_order.valid.any():
+        return float(zero_order.depth_m[zero_order.valid].min())
     hmax = np.abs(sysm.directional(M_MIN)).max()
     return float(1.0 / max(hmax * np.abs(phi[0]).max(), 1e-300))
 
@@ -695,12 +694,35 @@ def sdm_lobes(
     if not step > 1 or not (0 < rtol < 0.1):
         raise InputError("need step > 1 and 0 < rtol < 0.1", field="step/rtol")
     f, phi = _zoa_grid(sysm)
+    depth_min, depth_max = _depth_range(sysm, f, phi, depth_min, depth_max)
+    start, f_wave = _starts(sysm, grid, f, phi, seed, depth_min, depth_max)
+    if m_max is None:
+        m_max = int(round(M_MAX * max(acc, 1.0)))
+    msteps, spacing = sysm.resolution(grid, m, acc, m_max, f_wave)
+    limit, evaluations = _limits(sysm, grid, msteps, spacing, start, depth_min, depth_max, step, rtol, progress)
+    params = dict(cut.as_dict(), cutting=cut, phi_st=sysm.phi_st, phi_ex=sysm.phi_ex, m=msteps,
+                  node_spacing=spacing, accuracy=acc, depth_min=depth_min, depth_max=depth_max, step=step,
+                  rtol=rtol, seed=seed, evaluations=evaluations, model=sysm.model)
+    return _sdm_result(sysm, grid, limit, msteps, spacing, params)
+
+
+def _depth_range(sysm: _System, f, phi, depth_min, depth_max) -> tuple[float, float]:
+    """The depth search range, m: the given ends, else 1/4 and 100 × the zero-order minimum; checked."""
     if depth_min is None or depth_max is None:
         scale = _zoa_minimum(sysm, f, phi)
         depth_min = scale / 4 if depth_min is None else depth_min
         depth_max = 100 * scale if depth_max is None else depth_max
     if not (0 < depth_min < depth_max and np.isfinite(depth_max)):
         raise InputError(f"need 0 < depth_min < depth_max, got {depth_min:g}, {depth_max:g} m", field="depth")
+    return depth_min, depth_max
+
+
+def _starts(sysm: _System, grid, f, phi, seed, depth_min, depth_max):
+    """(first depth of the upward search per speed m, highest chatter frequency to resolve Hz or None).
+
+    Seeded: a fraction of the zero-order limit of each speed, within the range;
+    else ``depth_min`` everywhere (and no chatter frequency known).
+    """
     start = np.full(grid.size, float(depth_min))
     f_wave = None
     if seed:
@@ -710,10 +732,11 @@ def sdm_lobes(
         if np.any(np.isfinite(zoa.chatter_hz)):
             # Chatter waves, not the highest mode, set the resolution: the exponentials integrate any mode exactly.
             f_wave = WAVE_MARGIN * float(np.nanmax(zoa.chatter_hz))
-    if m_max is None:
-        m_max = int(round(M_MAX * max(acc, 1.0)))
-    msteps, spacing = sysm.resolution(grid, m, acc, m_max, f_wave)
+    return start, f_wave
 
+
+def _limits(sysm: _System, grid, msteps, spacing, start, depth_min, depth_max, step, rtol, progress):
+    """(limit per speed m: the smallest depth found unstable, Floquet matrices computed), block by block."""
     n = grid.size
     lo = np.zeros(n)  # largest depth known stable
     hi = np.full(n, np.inf)  # smallest depth known unstable
@@ -728,16 +751,17 @@ def sdm_lobes(
             bar.add(blk.size)
     finally:
         bar.close()
+    return hi, count[0]
 
-    limit = hi
+
+def _sdm_result(sysm: _System, grid, limit, msteps, spacing, params) -> LobeResult:
+    """The LobeResult: chatter frequencies at the limit, lobes, and the lowest limit."""
+    n = grid.size
     chatter = np.full(n, np.nan)
     fin = np.isfinite(limit)
     if fin.any():
         chatter[fin] = sysm.critical(grid[fin], limit[fin], msteps[fin], spacing[fin])[1]
     lobes = _split_lobes(grid, limit, chatter, sysm.teeth)
-    params = dict(cut.as_dict(), cutting=cut, phi_st=sysm.phi_st, phi_ex=sysm.phi_ex, m=msteps,
-                  node_spacing=spacing, accuracy=acc, depth_min=depth_min, depth_max=depth_max, step=step,
-                  rtol=rtol, seed=seed, evaluations=count[0], model=sysm.model)
     if not fin.any():
         return LobeResult(grid, limit, chatter, lobes, "sdm", params=params)
     j = int(np.argmin(limit))

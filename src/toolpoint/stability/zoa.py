@@ -28,7 +28,19 @@ a_lim depends on ω_c only; each k maps the same depth curve to another speed
 range, which is why all lobes cost one eigenvalue evaluation. The limit at a
 speed is the minimum over lobes and over both eigenvalue branches.
 
-Between neighbouring FRF points μ is interpolated linearly (complex), so Re μ
+Near a sharp resonance Φ turns by up to ~0.25 rad between 1 Hz points, and one
+such interval spans hundreds of rpm at low lobe numbers: with μ linear between
+the FRF points the limit would be drawn as straight chords. So each FRF
+interval is first split into ⌈δ/:data:`MAX_TURN`⌉ equal parts (at most
+:data:`MAX_PARTS`), δ = |Φ_{i+1} − Φ_i| / min(|Φ_i|, |Φ_{i+1}|) (≈ the phase
+turn plus the relative change of |Φ|; the largest over Φ_xx, Φ_yy, Φ_xy, Φ_yx),
+and Φ is interpolated at the new frequencies by cubic Hermite polynomials
+(second-order finite-difference slopes; :func:`refine_frf_grid`); the FRF
+points keep their values.
+The split depends on the FRFs only — not on the speeds asked for or the
+cutting conditions — and :func:`~toolpoint.stability.zoa_batch.zoa_limits`
+refines the same way, so the two agree. Between neighbouring points of the
+refined grid μ is interpolated linearly (complex), so Re μ
 and 1/a_lim are linear in frequency there and ε follows from the interpolated
 μ exactly. Where Re μ changes sign between two points the lobe is kept up to
 the crossing, where a_lim → ∞ and ε → 0 or 2π: the lobe flank rises to its
@@ -44,6 +56,8 @@ h_xx = N K_n/4 in slotting.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..errors import InputError
@@ -51,7 +65,8 @@ from ..frf import FRF, check_freq_hz
 from .cutting import CuttingConditions, check_cutting
 from .milling import Lobe, LobeResult, average_directional_matrix, check_rpm
 
-__all__ = ["zoa_lobes", "oriented_eigenvalues", "depth_and_phase", "MAX_LOBE_POINTS"]
+__all__ = ["zoa_lobes", "oriented_eigenvalues", "depth_and_phase", "DepthPhase", "MAX_LOBE_POINTS", "MAX_TURN",
+           "MAX_PARTS", "interval_parts", "refine_frf_grid"]
 
 # Work is streamed over blocks of at most this many (segment, lobe) pairs, so
 # memory stays bounded however fine the FRF or low the minimum speed.
@@ -59,6 +74,102 @@ _BLOCK = 500_000
 # The lobes kept in the result (for plots and --lobes-out) are thinned, every
 # s-th FRF point, to at most this many points; the limit uses every point.
 MAX_LOBE_POINTS = 1_000_000
+MAX_TURN = 0.05
+"""Largest change δ = |Φ_{i+1} − Φ_i| / min(|Φ_i|, |Φ_{i+1}|) (≈ the phase turn plus the relative change of |Φ|, rad) of
+the FRFs between two points of the grid μ is interpolated linearly on: FRF intervals with more are split
+(:func:`interval_parts`)."""
+MAX_PARTS = 16
+"""Most parts an FRF interval is split into."""
+
+
+def interval_parts(freq_hz, values) -> np.ndarray:
+    """Parts (1 … :data:`MAX_PARTS`) to split each FRF interval into: ⌈δ_i / :data:`MAX_TURN`⌉, with
+    δ_i = |Φ_{i+1} − Φ_i| / min(|Φ_i|, |Φ_{i+1}|); 1 from 0 Hz and where Φ is 0 or not finite.
+
+    Parameters
+    ----------
+    freq_hz : numpy.ndarray
+        (F,) increasing frequencies, Hz.
+    values : numpy.ndarray
+        (F,) or (n, F) complex FRF values on ``freq_hz``, one row per FRF.
+
+    Returns
+    -------
+    numpy.ndarray
+        int64 of shape (F − 1,) or (n, F − 1).
+    """
+    y = np.asarray(values)
+    a = np.abs(y)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        turn = np.abs(np.diff(y, axis=-1)) / np.minimum(a[..., 1:], a[..., :-1])
+        parts = np.ceil(np.minimum(turn, MAX_PARTS * MAX_TURN) / MAX_TURN)
+    parts = np.where(np.isfinite(parts) & (parts > 1), parts, 1).astype(np.int64)
+    parts[..., np.asarray(freq_hz)[:-1] <= 0] = 1  # no lobes from 0 Hz
+    return parts
+
+
+def refine_frf_grid(freq_hz, values, parts):
+    """FRFs on their refined grids: interval i of row r split into ``parts[r, i]`` equal parts.
+
+    Φ at the new points is the cubic Hermite polynomial between the interval's ends, with the slopes
+    second-order finite differences (as ``numpy.gradient(…, edge_order=2)``); the FRF points keep their values.
+
+    Parameters
+    ----------
+    freq_hz : numpy.ndarray
+        (F,) increasing frequencies, Hz (at least 3).
+    values : numpy.ndarray
+        (n, F) complex FRF values.
+    parts : numpy.ndarray
+        (n, F − 1) or (F − 1,) (the same for every row) integers ≥ 1 (:func:`interval_parts`).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        (n, L) frequencies and values, L = the most points of a row; a shorter row is padded at its end with its
+        last frequency and NaN.
+    """
+    f = np.asarray(freq_hz, float)
+    y = np.asarray(values, complex)
+    n, F = y.shape
+    parts = np.broadcast_to(np.asarray(parts, np.int64), (n, F - 1))
+    extra = parts - 1
+    shift = np.zeros((n, F), np.int64)
+    np.cumsum(extra, axis=1, out=shift[:, 1:])
+    L = int(F + shift[:, -1].max())
+    fs = np.full((n, L), f[-1])
+    ys = np.full((n, L), np.nan + 0j)
+    rows = np.arange(n)[:, None]
+    pos = np.arange(F)[None, :] + shift
+    fs[rows, pos] = f
+    ys[rows, pos] = y
+    r, i = np.nonzero(extra)
+    if r.size:
+        cnt = extra[r, i]
+        e = np.repeat(np.arange(r.size), cnt)
+        j = 1 + np.arange(e.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)  # 1 … parts − 1
+        re, ie = r[e], i[e]
+        t = j / parts[re, ie]
+        h = f[ie + 1] - f[ie]
+        h00, h10 = (1 + 2 * t) * (1 - t) ** 2, t * (1 - t) ** 2
+        h01, h11 = t * t * (3 - 2 * t), t * t * (t - 1)
+        d0, d1 = _slopes(f, y, r, i), _slopes(f, y, r, i + 1)
+        out = pos[re, ie] + j
+        fs[re, out] = f[ie] + t * h
+        ys[re, out] = (h00 * y[re, ie] + h10 * h * d0[e] + h01 * y[re, ie + 1] + h11 * h * d1[e])
+    return fs, ys
+
+
+def _slopes(f, y, r, i):
+    """dΦ/df of row r at point i: second-order finite differences (those of ``numpy.gradient(…, edge_order=2)``)."""
+    F = f.size
+    c = np.clip(i, 1, F - 2)  # the three points used: c − 1, c, c + 1
+    h1, h2 = f[c] - f[c - 1], f[c + 1] - f[c]
+    y0, y1, y2 = y[r, c - 1], y[r, c], y[r, c + 1]
+    inner = (-h2 / (h1 * (h1 + h2))) * y0 + ((h2 - h1) / (h1 * h2)) * y1 + (h1 / (h2 * (h1 + h2))) * y2
+    first = (-(2 * h1 + h2) / (h1 * (h1 + h2))) * y0 + ((h1 + h2) / (h1 * h2)) * y1 + (-h1 / (h2 * (h1 + h2))) * y2
+    last = (h2 / (h1 * (h1 + h2))) * y0 + (-(h1 + h2) / (h1 * h2)) * y1 + ((2 * h2 + h1) / (h2 * (h1 + h2))) * y2
+    return np.where(i == 0, first, np.where(i == F - 1, last, inner))
 
 
 def oriented_eigenvalues(h0: np.ndarray, phi_xx: np.ndarray, phi_yy: np.ndarray, phi_xy=None,
@@ -95,7 +206,26 @@ def oriented_eigenvalues(h0: np.ndarray, phi_xx: np.ndarray, phi_yy: np.ndarray,
     return np.stack([tr / 2 + s, tr / 2 - s])
 
 
-def depth_and_phase(mu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+@dataclass(frozen=True)
+class DepthPhase:
+    """Zero-order depth limit, phase and validity at each eigenvalue μ (:func:`depth_and_phase`).
+
+    Attributes
+    ----------
+    depth_m : numpy.ndarray
+        a_lim = −1/(2 Re μ), m (inf where not valid).
+    eps_rad : numpy.ndarray
+        ε = π + 2 arg(−μ), rad: phase between the inner and outer waves.
+    valid : numpy.ndarray
+        Re μ < 0 beyond round-off (a > 0).
+    """
+
+    depth_m: np.ndarray
+    eps_rad: np.ndarray
+    valid: np.ndarray
+
+
+def depth_and_phase(mu: np.ndarray) -> DepthPhase:
     """Depth limit, phase and validity from eigenvalues μ.
 
     Parameters
@@ -105,17 +235,13 @@ def depth_and_phase(mu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
 
     Returns
     -------
-    depth : numpy.ndarray
-        a_lim = −1/(2 Re μ), m (inf where not valid).
-    eps : numpy.ndarray
-        ε = π + 2 arg(−μ), rad.
-    valid : numpy.ndarray
-        Re μ < 0 beyond round-off (a > 0).
+    DepthPhase
+        Arrays of the shape of ``mu``.
     """
     valid = _negative(mu)
     with np.errstate(divide="ignore", invalid="ignore"):
         depth = np.where(valid, -0.5 / mu.real, np.inf)
-    return depth, _phase(mu), valid
+    return DepthPhase(depth, _phase(mu), valid)
 
 
 def _negative(mu):
@@ -243,11 +369,19 @@ def zoa_lobes(
     frf_x = _as_receptance(frf_x, "frf_x")
     f, phi = _common_grid(frf_x, {"frf_y": frf_y, "frf_xy": frf_xy, "frf_yx": frf_yx})
     _check_not_zero(phi, f)
+    names = [k for k in ("xx", "yy", "xy", "yx") if phi[k] is not None]
+    stack = np.stack([phi[k] for k in names])
+    parts = interval_parts(f, stack).max(axis=0)
+    if np.any(parts > 1):  # Hermite-refined grid where the FRFs turn fast (module docstring)
+        fs, ys = refine_frf_grid(f, stack, parts)
+        f = fs[0]
+        phi = dict(phi, **dict(zip(names, ys)))
     phi_st, phi_ex = cut.immersion_angles
     h0 = average_directional_matrix(cut.teeth, cut.tangential_coeff, cut.radial_ratio, phi_st, phi_ex)
 
     mu = oriented_eigenvalues(h0, phi["xx"], phi["yy"], phi["xy"], phi["yx"])  # (2, nf)
-    depth, eps, valid = depth_and_phase(mu)
+    zero_order = depth_and_phase(mu)
+    depth, eps, valid = zero_order.depth_m, zero_order.eps_rad, zero_order.valid
     valid &= f[None, :] > 0
     # Waves per tooth period at lobe k: f_c T = k + ε/2π; speed n = 60 f_c / (N (k + ε/2π)).
     c = 60.0 * f / cut.teeth  # rpm·(waves per tooth period)
@@ -318,14 +452,10 @@ def _at(mu, f, b, i, t):
     return mt, ft
 
 
-def _envelope(grid, teeth_c, f, mu, valid):
-    """Minimum over lobes of the lobe curves, sampled on ``grid``: (limit m, chatter Hz, lobe k).
+def _piece_ends(grid, teeth_c, f, mu, valid):
+    """The pieces of :func:`_pieces` with, at both ends, c = 60 f/N and ε/2π, and the lobes k that meet the grid.
 
-    ``teeth_c`` is 60/N (rpm per Hz and wave per tooth period). Every piece
-    (see :func:`_pieces`) of every lobe k whose speed span meets
-    the grid contributes at the grid speeds it spans (a lobe may fold back in
-    speed, so each piece is intersected with the grid on its own), streamed
-    in blocks of at most ``_BLOCK`` (piece, k) pairs.
+    Returns (b, i, t_a, t_b, c_a, c_b, ε_a/2π, ε_b/2π, k_lo, k_hi), one entry per piece.
     """
     rmin, rmax = grid[0], grid[-1]
     b, i, ta, tb = _pieces(mu, valid, f)
@@ -338,7 +468,19 @@ def _envelope(grid, teeth_c, f, mu, valid):
     ca, cb = teeth_c * fa, teeth_c * fb
     klo_a, khi_a = _k_range(ca, fra, rmin, rmax)
     klo_b, khi_b = _k_range(cb, frb, rmin, rmax)
-    klo, khi = np.minimum(klo_a, klo_b), np.maximum(khi_a, khi_b)
+    return b, i, ta, tb, ca, cb, fra, frb, np.minimum(klo_a, klo_b), np.maximum(khi_a, khi_b)
+
+
+def _envelope(grid, teeth_c, f, mu, valid):
+    """Minimum over lobes of the lobe curves, sampled on ``grid``: (limit m, chatter Hz, lobe k).
+
+    ``teeth_c`` is 60/N (rpm per Hz and wave per tooth period). Every piece
+    (see :func:`_pieces`) of every lobe k whose speed span meets
+    the grid contributes at the grid speeds it spans (a lobe may fold back in
+    speed, so each piece is intersected with the grid on its own), streamed
+    in blocks of at most ``_BLOCK`` (piece, k) pairs.
+    """
+    b, i, ta, tb, ca, cb, fra, frb, klo, khi = _piece_ends(grid, teeth_c, f, mu, valid)
     counts = np.maximum(khi - klo + 1, 0)
 
     limit = np.full(grid.size, np.inf)

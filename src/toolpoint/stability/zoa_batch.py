@@ -13,7 +13,11 @@ over frequency is needed. As in :mod:`~toolpoint.stability.zoa`,
     1/a_lim = −2 Re μ  (1/m),   ε = π + 2 arg(−μ),
     tooth period T = (k + ε/2π) / f,  n = 60 / (N T)  (rpm),  k = 0, 1, …
 
-μ is interpolated linearly between FRF points, so 1/a_lim is linear there;
+Each FRF interval is first split where the sample's Φ turns fast, exactly as in ``zoa_lobes``
+(:func:`~toolpoint.stability.zoa.interval_parts`, :func:`~toolpoint.stability.zoa.refine_frf_grid`:
+⌈|Φ_{i+1} − Φ_i| / min(|Φ_i|, |Φ_{i+1}|) / 0.05⌉ parts, cubic Hermite Φ at the new points) — per sample, depending on its FRF only; the samples' refined
+grids are padded to one length with invalid points. μ is interpolated linearly between the points of that grid,
+so 1/a_lim is linear there;
 where Re μ changes sign the piece runs to the crossing (1/a_lim = 0, ε = 0 or
 2π), so a lobe flank rises to its asymptote instead of being cut. Unlike
 ``zoa_lobes``, which solves for the exact point of each grid speed on a piece
@@ -29,6 +33,7 @@ import numpy as np
 
 from .cutting import CuttingConditions
 from .milling import average_directional_matrix, check_rpm
+from .zoa import interval_parts, refine_frf_grid
 
 __all__ = ["zoa_limits"]
 
@@ -102,12 +107,22 @@ def zoa_limits(freq_hz, receptance, cutting: CuttingConditions, rpm, *, cap_m: f
     step = step if G > 2 and np.allclose(np.diff(grid), step, rtol=1e-9, atol=0) else None
     chunk = max(1, int(_BLOCK_ENTRIES // max(1, 4 * G)))
     for s0 in range(0, H.shape[0], chunk):
-        mu = lam[None, :, None] * H[s0:s0 + chunk, None, :]  # (n, 2, F)
-        _accumulate(qmax[s0:s0 + chunk], mu, f, 60.0 / cutting.teeth, period, rmin, rmax, q_cap, subdivide, step)
+        fs, Hs = _refined(f, H[s0:s0 + chunk])  # (n, F') each: the samples' own refined grids, padded
+        mu = lam[None, :, None] * Hs[:, None, :]  # (n, 2, F')
+        _accumulate(qmax[s0:s0 + chunk], mu, fs, 60.0 / cutting.teeth, period, rmin, rmax, q_cap, subdivide, step)
     with np.errstate(divide="ignore"):
         limit = np.where(qmax > 0, 1.0 / np.where(qmax > 0, qmax, 1.0), np.inf)[:, ::-1]
     limit = np.minimum(limit, cap_m)
     return limit[0] if single else limit
+
+
+def _refined(f, H):
+    """(frequencies, receptances), each (n, F'): every row on its own refined grid (as ``zoa_lobes`` refines it),
+    padded at the end with its last frequency and NaN (invalid: no piece there)."""
+    parts = interval_parts(f, H)  # (n, F − 1)
+    if not np.any(parts > 1):
+        return np.broadcast_to(f, H.shape), H
+    return refine_frf_grid(f, H, parts)
 
 
 def _accumulate(qmax, mu, f, teeth_c, period, rmin, rmax, q_cap, subdivide, step):
@@ -118,7 +133,7 @@ def _accumulate(qmax, mu, f, teeth_c, period, rmin, rmax, q_cap, subdivide, step
     few hundred speeds — and only the rest are split into their ``subdivide`` parts.
     """
     scale = np.abs(mu).max(axis=1, keepdims=True)
-    valid = np.isfinite(mu) & (mu.real < -1e-9 * scale) & (f > 0)
+    valid = np.isfinite(mu) & (mu.real < -1e-9 * scale) & (f[:, None, :] > 0)
     v0, v1 = valid[..., :-1], valid[..., 1:]
     q = np.where(valid, -2.0 * mu.real, 0.0)
     keep = (v0 | v1) & (np.maximum(q[..., :-1], q[..., 1:]) > q_cap)
@@ -140,7 +155,8 @@ def _accumulate(qmax, mu, f, teeth_c, period, rmin, rmax, q_cap, subdivide, step
     mt = m0[:, None] + t * (m1 - m0)[:, None]
     mt[:, 0] = np.where(ta > 0, 1j * mt[:, 0].imag, mt[:, 0])  # exactly Re μ = 0 at a crossing
     mt[:, -1] = np.where(tb < 1, 1j * mt[:, -1].imag, mt[:, -1])
-    c = teeth_c * (f[i][:, None] + t * (f[i + 1] - f[i])[:, None])  # 60 f / N, increasing along the piece
+    fa, fb = f[s, i], f[s, i + 1]
+    c = teeth_c * (fa[:, None] + t * (fb - fa)[:, None])  # 60 f / N, increasing along the piece
     frac = (np.pi + 2 * np.arctan2(-mt.imag, -mt.real)) / (2 * np.pi)  # in [0, 1]
     qt = np.maximum(-2.0 * mt.real, 0.0)
     # pass 1: lobe k of the whole piece has its tooth period (1/rpm) within [(k + fr_lo)/c_hi, (k + fr_hi)/c_lo]
