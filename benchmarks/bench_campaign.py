@@ -80,7 +80,8 @@ def main() -> None:
         if split.get(m.id) != "test":
             continue
         try:
-            pred, joint, _ = predict_frf(camp, m.diameter_mm, m.overhang_mm, res / "models")
+            r = predict_frf(camp, m.diameter_mm, m.overhang_mm, res / "models")
+            pred, joint = r.frf, r.joint.joint
         except InputError as e:
             print(f"  {m.id} (D {m.diameter_mm:g}, L {m.overhang_mm:g}): no prediction — {e}")
             failed += 1

@@ -34,7 +34,7 @@ from toolpoint.campaign.synth import truth_joint
 from toolpoint.dynamics.model import ToolPointModel
 from toolpoint.stability.zoa_batch import zoa_limits
 from toolpoint.recommend.run import run_library
-from toolpoint.recommend.uncertainty import JointPredictor
+from toolpoint.campaign.distribution import JointPredictor
 from toolpoint.stability import CuttingConditions
 
 HEADER = ("id,diameter_mm,overhang_mm,teeth,holder,tangential_coeff_n_mm2,radial_ratio,material,radial_immersion,"

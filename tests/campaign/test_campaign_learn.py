@@ -137,7 +137,7 @@ def test_gp_baseline_saved_and_rebuilt_exactly(campaign):
     """learn saves each GP baseline; the rebuilt GP (kernel fixed, refitted on the saved data) predicts the
     test rows as the GP fitted by learn did (its test metrics, recomputed), and its predictive σ grows
     away from the training data."""
-    from toolpoint.campaign.predict import load_gp_models
+    from toolpoint.campaign.models import load_gp_models
     from toolpoint.learning.metrics import paper_metrics
 
     folder, result, _ = campaign
@@ -247,7 +247,7 @@ def test_bad_input(tmp_path):
 
     few = write_identified(tmp_path / "few", identified_rows(n=39, n_failed=3))
     with pytest.raises(InputError) as err:  # 39 ok rows < 30 + 10
-        learn(few, **quiet)
+        learn(few, test_size=30, **quiet)
     assert err.value.field == "status" and "39" in str(err.value)
     with pytest.raises(InputError) as err:  # exactly test_size + 10 rows pass the row check ...
         learn(few, test_size=29, mfs=2, **quiet)
@@ -311,7 +311,7 @@ def test_more_parameters_than_identified_rows_is_said(tmp_path):
 
 
 def test_learn_leaves_exactly_the_models_predict_will_use(tmp_path):
-    from toolpoint.campaign.predict import load_gp_models, load_models
+    from toolpoint.campaign.models import load_gp_models, load_models
 
     folder = write_identified(tmp_path, identified_rows(n=60, n_failed=0))
     quick = dict(test_size=12, mfs=(2, 2), epochs=3, baselines=False, plots=False)

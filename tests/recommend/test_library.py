@@ -227,7 +227,7 @@ def test_coverage_of_the_true_limit_on_held_out_tools():
     (6 tools; it is over-confident on 40 training rows: RMS z of the truth 1.3–1.4) and 0.872 in the
     benchmark: docs/design/recommend.md.
     """
-    from toolpoint.recommend.uncertainty import JointPredictor
+    from toolpoint.campaign.distribution import JointPredictor
 
     root = small_campaign()
     with open(root / "results" / "models" / "split.csv", newline="") as fh:
@@ -260,8 +260,8 @@ def test_gp_model_samples_the_gp_predictive_distribution(tmp_path):
     (not the ANFIS ones); a models folder without saved GPs is refused with a clear error."""
     import json
 
-    from toolpoint.campaign.predict import load_gp_models
-    from toolpoint.recommend.uncertainty import JointPredictor
+    from toolpoint.campaign.models import load_gp_models
+    from toolpoint.campaign.distribution import JointPredictor
 
     root = small_campaign()
     models = root / "results" / "models"
@@ -351,9 +351,9 @@ def test_a_limit_at_the_depth_cap_is_shown_as_at_least_the_cap():
     lq = np.array([[cap, 4e-3], [cap, 5e-3], [cap, 6e-3]])
     samples = np.full((10, 2), cap)
     job = SimpleNamespace(rpm=rpm, margin=0.1)
-    p = _point(job, 0, "pocket", nominal, lq, lq[0], samples, cap)
+    p = _point(job, nominal, lq, lq[0], samples, cap, 0, "pocket", lq[0][0])
     assert p["capped"] == ["limit_nominal_mm", "limit_p05_mm", "limit_p50_mm", "limit_robust_p05_mm"]
-    assert _point(job, 1, "pocket", nominal, lq, lq[0], samples, cap)["capped"] == []
+    assert _point(job, nominal, lq, lq[0], samples, cap, 1, "pocket", lq[0][1])["capped"] == []
     joint = {k: {"p05": 1.0, "p50": 1.0, "p95": 1.0} for k in ("kt", "ct", "kr", "cr")}
     summary = {"points": [p], "joint": joint, "min_limit_mm": {"p05": 4.0}, "cap_mm": 1e3 * cap}
     row = _ok_row(SimpleNamespace(id="EM28-80"), summary, 0.0, [])

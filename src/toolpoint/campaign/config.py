@@ -52,7 +52,7 @@ from ..errors import InputError
 from ..io.table import read_rows
 from ..io.toml import TomlReader, load_toml
 from ..io.frf_files import read_frf
-from ..dynamics.inverse_rcsa import subassembly_from_blank, subassembly_from_files
+from ..dynamics.inverse_rcsa import subassembly_from_blank, subassembly_from_files, subassembly_replicates
 from ..identification.optim import check_method
 from ..identification.params import Bounds
 from ..dynamics.subassembly import Subassembly
@@ -128,6 +128,20 @@ class Campaign:
         except ValueError as e:
             raise InputError(str(e), file=self.toml, field=where) from None
 
+
+    def subassembly_replicates(self, name: str, freq_hz, n: int, seed: int) -> list[Subassembly]:
+        """Bootstrap replicates of a blank-measured holder's subassembly on ``freq_hz``
+        (:func:`~toolpoint.dynamics.inverse_rcsa.subassembly_replicates`); [] for a model (exact) or FRF-file
+        source (not sampled)."""
+        src = self.holders[name]
+        if src.kind != "blank" or n < 1:
+            return []
+        r = TomlReader(str(self.toml))
+        blank = Component("blank", parse_segments(r, src.spec, f"holders.{name}.blank", self.materials))
+        keys = [self.folder / src.spec[k] for k in ("G11", "G12", "G22")]
+        reps = subassembly_replicates(blank, float(src.spec["x2_mm"]) * MM, *(read_frf(p) for p in keys), n=n,
+                                      rng=np.random.default_rng(seed), band=src.spec.get("band_hz"))
+        return [s.at(np.asarray(freq_hz, float)) for s in reps]
 
     def _measured_subassembly(self, name: str) -> Subassembly:
         src = self.holders[name]

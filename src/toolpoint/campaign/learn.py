@@ -23,7 +23,7 @@ baselines on the same split: a Gaussian process and gradient boosting.
 The pipeline: read rows → split → per target fit ANFIS and baselines → metrics
 → write models, ``split.csv``, ``metrics.json``/``.csv`` and plots. The GP baseline of a
 log10 target is saved too (``gp_<target>.json``: training data, per-row noise and fitted kernel
-hyper-parameters, from which :func:`~toolpoint.campaign.predict.load_gp_models` rebuilds it exactly),
+hyper-parameters, from which :func:`~toolpoint.campaign.models.load_gp_models` rebuilds it exactly),
 for its predictive standard deviation (``toolpoint library --model gp``). It returns a
 :class:`LearnResult`; ``toolpoint campaign learn`` prints it. Why these choices
 (weighting, log targets, over-fitting of the 3×7 grid) and what they measured:
@@ -49,6 +49,7 @@ from ..io.atomic import atomic_open
 from ..learning.anfis import ANFIS, predict_quietly
 from ..learning.figures import membership_figure, per_sample_figure, regression_figure, save_png
 from ..learning.metrics import PAPER_METRICS, paper_metrics
+from . import calibration
 from .results import FILE_NAME, IdentifiedRows, read_identified
 
 __all__ = [
@@ -62,7 +63,7 @@ INPUTS = ("diameter_mm", "overhang_mm")
 REQUIRED_FOR_PREDICT = "kt"
 #: The file in the models folder naming the models one ``learn`` wrote.
 MANIFEST = "manifest.json"
-#: ``format`` of a saved GP baseline (``gp_<target>.json``; read by :func:`toolpoint.campaign.predict.load_gp_models`).
+#: ``format`` of a saved GP baseline (``gp_<target>.json``; read by :func:`toolpoint.campaign.models.load_gp_models`).
 GP_FORMAT = "toolpoint.gp"
 #: Damping parameters: learned by default only where the file has their intervals.
 DAMPING = ("ct", "cr")
@@ -129,8 +130,12 @@ class LearnResult:
         Target → the model with the lowest test MAPE.
     paper : dict
         Target → the paper's test metrics (:data:`PAPER`) and ``n``.
+    uncertainty : dict
+        Parameter → ``kind`` (``model``/``spread``), ``sigma_log10`` (decades), ``coverage90`` (held-out
+        coverage of the 90 % interval, cross-conformal), ``n`` (held-out rows), ``reason``
+        (:mod:`.calibration`; saved as ``models/uncertainty.json``).
     files : dict
-        What was written: ``split``, ``<target>`` (model JSON), ``gp_<target>`` (the GP
+        What was written: ``uncertainty``, ``split``, ``<target>`` (model JSON), ``gp_<target>`` (the GP
         baseline, log10 targets only), ``<target>_plots``, ``metrics_json``, ``metrics_csv``.
     notes : list of str
         Lines for the user about the data as a whole.
@@ -159,6 +164,7 @@ class LearnResult:
     best_test_model: dict
     paper: dict
     files: dict
+    uncertainty: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
     target_notes: dict = field(default_factory=dict)
     models_dir: str = ""
@@ -182,6 +188,9 @@ class _Data:
     share: dict  # parameter → share of rows where identified
     identified: dict  # parameter → (n,) bool
     sigma: dict  # parameter → (n,) relative standard error (floored), inf without an interval
+    test_size: int  # held-out rows of the split
+    intervals: dict  # parameter → ((n,), (n,)) 95 % interval, SI (NaN where none)
+    all_values: dict  # parameter → (n,) SI, NaN where not a number (every parameter in the file)
 
 
 @dataclass(frozen=True)
@@ -212,8 +221,24 @@ def _anfis_settings(mfs, mf, order, epochs, step_size, log_target, seed) -> dict
 
 
 def _check_test_size(test_size) -> None:
+    if test_size == "auto":
+        return
     if isinstance(test_size, bool) or not isinstance(test_size, (int, np.integer)) or test_size < 1:
-        raise InputError(f"must be a whole number ≥ 1, got {test_size!r}", field="test_size")
+        raise InputError(f"must be a whole number ≥ 1 or 'auto', got {test_size!r}", field="test_size")
+
+
+def auto_test_size(n_ok: int) -> int:
+    """The held-out test set of ``test_size="auto"``: the paper's 30 of 178 (17 %), at most 30 rows.
+
+    A fixed 30 starved small campaigns (40 tools left 10 for training); the σ the library samples with comes
+    from cross-validation over every tool (:mod:`.calibration`), not from this split.
+
+    Examples
+    --------
+    >>> auto_test_size(178), auto_test_size(60), auto_test_size(40)
+    (30, 10, 7)
+    """
+    return int(min(PAPER_N_TEST, max(1, round(n_ok * PAPER_N_TEST / 178))))
 
 
 def _check_targets(targets) -> list[str] | None:
@@ -236,6 +261,8 @@ def _read(path: Path, candidates: list[str], explicit: bool, test_size: int) -> 
         required += [f"{t}_{b}" for t in DAMPING for b in ("lo", "hi")]
     table = read_identified(path, list(dict.fromkeys(required)))
     ok: IdentifiedRows = table.ok()
+    if test_size == "auto":
+        test_size = auto_test_size(len(ok))
     if len(ok) < test_size + MIN_TRAIN:
         raise InputError(f"{len(ok)} rows with status ok, need at least test_size + {MIN_TRAIN} = "
                          f"{test_size + MIN_TRAIN}", file=path, field="status")
@@ -250,7 +277,9 @@ def _read(path: Path, candidates: list[str], explicit: bool, test_size: int) -> 
             sigma[t] = np.maximum(ok.sigma_ln(t), SIGMA_FLOOR)
     for t in candidates:  # a target that is learned must be a number in every ok row
         ok.check_numbers(t)
-    return _Data(path, len(table), ids, X, values, share, identified, sigma)
+    return _Data(path, len(table), ids, X, values, share, identified, sigma, int(test_size),
+                 {t: ok.interval(t) for t in PARAMS if table.has_interval(t)},
+                 {t: ok.column(t, required=False) for t in PARAMS if ok.has(t)})
 
 
 def _split(n: int, test_size: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -447,6 +476,171 @@ def _fit_target(t: str, data: _Data, train_idx, test_idx, anfis: dict, *, baseli
     return _Fit(notes, model=model, metrics=scores, baseline_settings=settings, y_test=yte, p_test=p_te, gp=gp)
 
 
+# ------------------------------------------------------------- uncertainty
+def _clip_log10(data: _Data, t: str) -> tuple[float, float]:
+    """log10 of the range the identification explored for ``t``: values and their 95 % intervals (inside the
+    search bounds by construction)."""
+    v = [data.all_values.get(t, np.array([]))]
+    if t in data.intervals:
+        v += list(data.intervals[t])
+    v = np.concatenate(v)
+    v = v[np.isfinite(v) & (v > 0)]
+    return (float(np.log10(v.min())), float(np.log10(v.max()))) if v.size else (-np.inf, np.inf)
+
+
+def _cross_validate(t: str, data: _Data, anfis: dict, folds: int, seed: int):
+    """Held-out log10 residuals of ``t``: every ok row predicted by an ANFIS (same settings, same weighting)
+    trained on the other folds; only rows where ``t`` was identified are scored.
+
+    Returns (X, residual, fold, fold → training inputs) or None when a fold cannot be trained."""
+    n = len(data.ids)
+    y = data.values[t]
+    keep = data.identified.get(t, np.ones(n, bool))
+    sig = data.sigma.get(t, np.full(n, SIGMA_FLOOR))
+    usable = np.isfinite(sig) & np.isfinite(y) & (y > 0 if anfis["log_target"] else True)
+    fold = calibration.fold_ids(n, folds, seed)
+    res = np.full(n, np.nan)
+    trained = {}
+    for k in range(folds):
+        fit = usable & (fold != k)
+        test = keep & (fold == k) & np.isfinite(y) & (y > 0)
+        if not test.any():
+            continue
+        if fit.sum() < 3 or np.any(np.ptp(data.X[fit], axis=0) == 0):
+            return None
+        model = ANFIS(**anfis, target_name=t)
+        try:
+            with single_thread_blas(), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                model.fit(data.X[fit], y[fit], sample_weight=_weights(y[fit], sig[fit], anfis["log_target"]))
+        except ValueError:
+            return None
+        pred, _ = predict_quietly(model, data.X[test])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            res[test] = np.log10(y[test]) - np.log10(np.where(pred > 0, pred, np.nan))
+        trained[k] = data.X[fit]
+    scored = np.isfinite(res)
+    # a prediction ≤ 0 of a positive parameter is an infinitely wrong prediction, not a missing one
+    bad = keep & np.isfinite(y) & (y > 0) & ~scored & np.isin(fold, list(trained))
+    res[bad] = np.inf
+    rows = scored | bad
+    return data.X[rows], res[rows], fold[rows], trained
+
+
+def _cross_validate_power_law(t: str, data: _Data, folds: int, seed: int):
+    """Held-out log10 residuals of the family's power law in (D, L), fitted to identified rows only."""
+    n = len(data.ids)
+    y = data.values.get(t, data.all_values.get(t))
+    keep = data.identified.get(t, np.ones(n, bool)) & np.isfinite(y) & (y > 0)
+    fold = calibration.fold_ids(n, folds, seed)
+    res = np.full(n, np.nan)
+    trained = {}
+    for k in range(folds):
+        fit, test = keep & (fold != k), keep & (fold == k)
+        if not test.any():
+            continue
+        if fit.sum() < 5:
+            return None
+        coef = calibration.fit_power_law(data.X[fit], np.log10(y[fit]))
+        res[test] = np.log10(y[test]) - calibration.power_law(coef, data.X[test])
+        trained[k] = data.X[fit]
+    rows = np.isfinite(res)
+    return data.X[rows], res[rows], fold[rows], trained, keep
+
+
+def _cross_validate_neighbours(t: str, data: _Data, folds: int, seed: int):
+    """Held-out log10 residuals of the local campaign value: median of the nearest identified tools."""
+    n = len(data.ids)
+    y = data.all_values.get(t)
+    keep = data.identified.get(t, np.zeros(n, bool)) & np.isfinite(y) & (y > 0)
+    if keep.sum() < 2 * calibration.K_LOCAL:
+        return None
+    fold = calibration.fold_ids(n, folds, seed)
+    res = np.full(n, np.nan)
+    trained = {}
+    lo, hi = data.X.min(axis=0), data.X.max(axis=0)
+    for k in range(folds):
+        fit, test = keep & (fold != k), keep & (fold == k)
+        if not test.any():
+            continue
+        m = calibration.local_median(data.X[test], data.X[fit], np.log10(y[fit]), lo, hi)
+        res[test] = np.log10(y[test]) - m
+        trained[k] = data.X[fit]
+    rows = np.isfinite(res)
+    return data.X[rows], res[rows], fold[rows], trained, keep
+
+
+def _uncertainty(data: _Data, fits: dict, train_idx, anfis: dict, folds: int, seed: int) -> dict:
+    """Parameter → :class:`~.calibration.ParameterUncertainty`.
+
+    A parameter identified in at least :data:`IDENTIFIABLE_SHARE` of the ok rows takes the predictor with the
+    lower cross-validated error — its ANFIS or the family's power law in (D, L) (an over-fitted ANFIS loses to
+    it) — with the σ its held-out residuals calibrate; one rarely identified, or not learned, takes the
+    campaign's spread."""
+    out = {}
+    n = len(data.ids)
+    for t in PARAMS:
+        values = data.all_values.get(t)
+        if values is None:
+            continue
+        clip = _clip_log10(data, t)
+        share = data.share.get(t, 1.0)
+        if share >= IDENTIFIABLE_SHARE:
+            options = []
+            if t in fits:
+                cv = _cross_validate(t, data, anfis, folds, seed)
+                if cv is not None:
+                    X, r, fold, trained = cv
+                    usable = np.isfinite(data.sigma.get(t, np.full(n, SIGMA_FLOOR))) & np.isfinite(values)
+                    t_fit = train_idx[usable[train_idx]]
+                    rng = fits[t].model.input_range_
+                    options.append(calibration.fit_uncertainty(
+                        t, X, r, fold, trained, data.X[t_fit], rng[:, 0], rng[:, 1], clip, values,
+                        what=f"ANFIS {'x'.join(map(str, np.broadcast_to(anfis['n_mfs'], (2,))))}"))
+            cv = _cross_validate_power_law(t, data, folds, seed)
+            if cv is not None:
+                X, r, fold, trained, keep = cv
+                coef = calibration.fit_power_law(data.X[keep], np.log10(values[keep]))
+                Xk = data.X[keep]
+                options.append(calibration.fit_uncertainty(
+                    t, X, r, fold, trained, Xk, Xk.min(axis=0), Xk.max(axis=0), clip, values, kind="powerlaw",
+                    coef=coef, what=f"power law {t} ∝ D^{coef[1]:.2f} L^{coef[2]:.2f} (ANFIS: see its own row)"
+                    if t in fits else f"power law {t} ∝ D^{coef[1]:.2f} L^{coef[2]:.2f}"))
+            learned = [u for u in options if u.kind != "spread"]
+            if learned:
+                best = min(learned, key=lambda u: u.cv["rms_log10"])
+                if len(options) > 1:
+                    other = [u for u in options if u is not best][0]
+                    best = dataclasses.replace(best, reason=best.reason + (
+                        f"; chosen over the {'power law' if best.kind == 'model' else 'ANFIS'} (held-out RMS "
+                        f"{best.cv['rms_log10']:.3g} vs {other.cv.get('rms_log10', math.nan):.3g} decades)"))
+                out[t] = best
+                continue
+            if options:
+                out[t] = options[0]
+                continue
+            why = "too few identified rows to cross-validate a model"
+        else:
+            why = (f"identified in only {100 * share:.0f} % of the ok rows (< {100 * IDENTIFIABLE_SHARE:.0f} %): "
+                   "a model would extrapolate what the campaign did not measure" if t in data.share else
+                   "no intervals to judge it by")
+            cv = _cross_validate_neighbours(t, data, folds, seed) if t in data.share else None
+            if cv is not None:
+                X, r, fold, trained, keep = cv
+                Xk = data.X[keep]
+                out[t] = calibration.fit_uncertainty(
+                    t, X, r, fold, trained, Xk, data.X.min(axis=0), data.X.max(axis=0), clip, values,
+                    kind="neighbours", y_log10=np.log10(values[keep]),
+                    what=f"local campaign value (median of the {calibration.K_LOCAL} nearest of the "
+                         f"{int(keep.sum())} tools that identified it; {why})")
+                continue
+        try:
+            out[t] = calibration.spread_uncertainty(t, values, clip, f"campaign spread: {why}")
+        except InputError as err:
+            raise InputError(err.message, file=data.path, field=t) from None
+    return out
+
+
 # ------------------------------------------------------------------ output
 def _writing(path: Path, what: str = "cannot write"):
     """InputError for an OSError while writing ``path``."""
@@ -561,7 +755,8 @@ def _write_metrics(result: LearnResult, json_path: Path, csv_path: Path) -> None
 def learn(
     results_dir,
     *,
-    test_size=30,
+    test_size="auto",
+    cv_folds=calibration.CV_FOLDS,
     mfs=(3, 7),
     mf="gauss",
     order=1,
@@ -580,8 +775,11 @@ def learn(
     results_dir : path-like
         Folder holding ``identified.csv``; models go to ``results_dir/models``,
         plots to ``results_dir/plots``.
-    test_size : int, default 30
-        Ok rows held out for testing (paper: 30 of 178).
+    test_size : int or "auto", default "auto"
+        Ok rows held out for the test metrics (paper: 30 of 178); ``"auto"``: :func:`auto_test_size`.
+    cv_folds : int, default 5
+        Folds of the cross-validation over every ok row that calibrates each parameter's predictive σ
+        (``models/uncertainty.json``, :mod:`.calibration`).
     mfs : int or (int, int), default (3, 7)
         MFs per input (D, L): ANFIS ``n_mfs``.
     mf, order, epochs, step_size : ANFIS settings
@@ -616,6 +814,8 @@ def learn(
     >>> r.metrics["kt"]["anfis"]["test"]["mape"]  # doctest: +SKIP
     """
     _check_test_size(test_size)
+    if isinstance(cv_folds, bool) or not isinstance(cv_folds, (int, np.integer)) or cv_folds < 2:
+        raise InputError(f"must be a whole number ≥ 2, got {cv_folds!r}", field="cv_folds")
     anfis = _anfis_settings(mfs, mf, order, epochs, step_size, log_target, seed)
     explicit = _check_targets(targets)
     results_dir = Path(results_dir)
@@ -624,6 +824,7 @@ def learn(
     candidates = explicit if explicit is not None else list(PARAMS)
 
     data = _read(path, candidates, explicit is not None, test_size)
+    test_size = data.test_size
     train_idx, test_idx = _split(len(data.ids), test_size, seed)
     Xtr, Xte = data.X[train_idx], data.X[test_idx]
     for i, name in enumerate(INPUTS):
@@ -669,6 +870,9 @@ def learn(
         why = excluded.get(REQUIRED_FOR_PREDICT, "not among the targets")
         raise InputError(f"no {REQUIRED_FOR_PREDICT} model could be learned ({why}); `toolpoint predict` needs one, "
                          "so nothing was written", file=path, field=REQUIRED_FOR_PREDICT)
+    with single_thread_blas():
+        unc = _uncertainty(data, fits, train_idx, anfis, int(cv_folds), int(seed))
+    files["uncertainty"] = str(models_dir / calibration.FILE_NAME)
     files["metrics_json"] = str(models_dir / "metrics.json")
     files["metrics_csv"] = str(models_dir / "metrics.csv")
     result = LearnResult(
@@ -685,6 +889,7 @@ def learn(
             "baselines": bool(baselines),
             "identifiable_ratio": IDENTIFIED_RATIO,
             "identifiable_share": IDENTIFIABLE_SHARE,
+            "cv_folds": int(cv_folds),
         },
         inputs=list(INPUTS),
         n_rows=data.n_rows,
@@ -701,6 +906,8 @@ def learn(
         best_test_model=best,
         paper={t: dict(PAPER[t], n=PAPER_N_TEST) for t in candidates if t in PAPER},
         files=files,
+        uncertainty={t: {"kind": u.kind, "sigma_log10": u.sigma_log10, "coverage90": u.cv.get("coverage90", math.nan),
+                         "n": u.cv.get("n", 0), "reason": u.reason} for t, u in unc.items()},
         notes=notes,
         target_notes=target_notes,
         models_dir=str(models_dir),
@@ -718,6 +925,10 @@ def learn(
                 raise _writing(models_dir / f"gp_{t}.json")(err) from None
         if plots:
             _write_plots(t, fit, plots_dir)
+    try:
+        calibration.write_uncertainty(models_dir / calibration.FILE_NAME, unc)
+    except OSError as err:
+        raise _writing(models_dir / calibration.FILE_NAME)(err) from None
     _write_metrics(result, models_dir / "metrics.json", models_dir / "metrics.csv")
     _write_manifest(models_dir, learned, [t for t, fit in fits.items() if fit.gp is not None])
     return result

@@ -17,7 +17,7 @@ from ..errors import InputError
 
 #: run_library() keyword → CLI option, to name the option in an InputError.
 _OPTIONS = {"n_samples": "--samples", "rpm_points": "--rpm-points", "margin": "--margin",
-            "rpm_tolerance": "--rpm-tolerance", "outside": "--outside"}
+            "rpm_tolerance": "--rpm-tolerance", "outside": "--outside", "sub_replicates": "--subassembly-replicates"}
 
 
 def register(sub) -> None:
@@ -40,8 +40,12 @@ def register(sub) -> None:
     p.add_argument("--outside", choices=("widen", "refuse"), default="widen",
                    help="a tool outside the learned (D, L) range: widen its uncertainty (default) or refuse it")
     p.add_argument("--model", choices=("anfis", "gp"), default="anfis",
-                   help="joint distribution from the ANFIS models (σ from training residuals and identification "
-                   "intervals; default) or from the GP baselines 'campaign learn' saved (their own predictive σ)")
+                   help="joint distribution as 'campaign learn' calibrated it (ANFIS or the family's power law with a "
+                   "cross-validated σ, or the campaign's spread; default) or from the GP baselines it saved (their "
+                   "own predictive σ, not calibrated out of sample)")
+    p.add_argument("--subassembly-replicates", type=int, default=8,
+                   help="bootstrap replicates of a blank-measured holder's subassembly the samples spread over (its "
+                   "measurement uncertainty; 0: exact; default 8)")
     p.add_argument("--seed", type=int, default=0,
                    help="seed of the joint samples (each tool its own from it; default 0)")
     p.add_argument("--report", action="store_true", help="also write DIR/report.html")
@@ -65,6 +69,7 @@ def run(args) -> int:
         counts = run_library(args.library, args.campaign, args.models, args.out, workers=args.workers,
                              dask=args.dask, n_samples=args.samples, rpm_points=args.rpm_points, seed=args.seed,
                              margin=args.margin, rpm_tolerance=args.rpm_tolerance, outside=args.outside,
+                             sub_replicates=args.subassembly_replicates,
                              model=args.model, on_bad=say)
     except InputError as err:  # a setting: name its option
         if err.file is None and err.field in _OPTIONS:

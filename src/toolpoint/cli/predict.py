@@ -39,8 +39,9 @@ def run(args) -> int:
     out = out_path(args.out, "--out", inputs=inputs)
     plot = out_path(args.plot, "--plot", inputs=inputs) if args.plot else None
     with warnings_to_stderr():
-        frf, joint, notes = predict_frf(args.source, args.diameter, args.overhang, args.models, holder=args.holder)
-    for n in notes:
+        pred = predict_frf(args.source, args.diameter, args.overhang, args.models, holder=args.holder)
+    frf, joint = pred.frf, pred.joint
+    for n in joint.notes:
         print(f"note: {n}", file=sys.stderr)
     fig = None
     if plot:
@@ -54,7 +55,9 @@ def run(args) -> int:
     if fig is not None:
         save_figure(fig, plot)
     f_pk, h_pk = frf.peak()
-    print("predicted joint: " + ", ".join(f"{p} = {v:.4g} {UNITS[p]}" for p, v in zip(PARAMS, joint)))
+    print("predicted joint (median, 90 % interval calibrated on held-out tools):")
+    for k, p in enumerate(PARAMS):
+        print(f"  {p} = {joint.joint[k]:.4g} {UNITS[p]}  [{joint.p05[k]:.4g}, {joint.p95[k]:.4g}]")
     print(f"dominant peak {f_pk:g} Hz, |h| = {h_pk:.4g} m/N → {out}")
     return 0
 

@@ -14,6 +14,8 @@ Columns (one tool per row; lengths in mm, speeds in rpm):
 * ``rpm_min``, ``rpm_max``: the spindle's usable speed range, rpm
 * ``flute_length_mm``: optional: flute length, mm (default: the campaign's tool family rule)
 * ``material``: optional: work material (a preset name when the coefficients are empty)
+* ``tangential_coeff_sigma_pct``, ``radial_ratio_sigma_pct``: optional: one standard deviation of K_t and K_r,
+  % (default: the preset's, or 10 % and 15 % for coefficients given in the row; :mod:`.materials`)
 
 A file that cannot be read, has no header or no rows, or lacks a required
 column is an :class:`~toolpoint.errors.InputError`. A bad *row* (a missing
@@ -48,7 +50,7 @@ from pathlib import Path
 from ..errors import InputError
 from ..io.table import read_table
 from ..stability.cutting import CuttingConditions
-from .materials import PRESETS, preset
+from .materials import LIBRARY_UNCERTAINTY, PRESETS, preset, uncertainty
 
 __all__ = ["REQUIRED", "OPTIONAL", "LibraryTool", "BadRow", "read_library"]
 
@@ -56,7 +58,8 @@ __all__ = ["REQUIRED", "OPTIONAL", "LibraryTool", "BadRow", "read_library"]
 REQUIRED = ("id", "diameter_mm", "overhang_mm", "teeth", "holder", "radial_immersion", "milling", "rpm_min",
             "rpm_max")
 #: Optional columns (the cutting coefficients are needed unless ``material`` names a preset).
-OPTIONAL = ("tangential_coeff_n_mm2", "radial_ratio", "flute_length_mm", "material")
+OPTIONAL = ("tangential_coeff_n_mm2", "radial_ratio", "flute_length_mm", "material", "tangential_coeff_sigma_pct",
+            "radial_ratio_sigma_pct")
 
 
 @dataclass(frozen=True)
@@ -79,6 +82,9 @@ class LibraryTool:
         Where K_t, K_r come from (``library`` or the preset's source).
     line : int
         Line in the file.
+    cutting_sigma_ln : (float, float)
+        One standard deviation of ln K_t and ln K_r (:mod:`.materials`; the row's ``*_sigma_pct`` columns
+        override it).
     """
 
     id: str
@@ -92,6 +98,7 @@ class LibraryTool:
     rpm_max: float
     cutting_source: str
     line: int
+    cutting_sigma_ln: tuple = LIBRARY_UNCERTAINTY
 
 
 @dataclass(frozen=True)
@@ -140,10 +147,12 @@ def _tool(row: dict, line: int, tid: str) -> LibraryTool:
     material = (row.get("material") or "").strip()
     kt = _number(row, "tangential_coeff_n_mm2", required=False)
     kr = _number(row, "radial_ratio", positive=False, required=False)
+    sigma = LIBRARY_UNCERTAINTY
     if kt is not None and kr is not None:
         kt_si, source = kt * 1e6, "library"
     elif kt is None and kr is None and material and preset(material) is not None:
         kt_si, kr, source = preset(material)
+        sigma = uncertainty(material)
     elif kt is None and kr is None:
         known = ", ".join(PRESETS)
         if material:
@@ -162,7 +171,13 @@ def _tool(row: dict, line: int, tid: str) -> LibraryTool:
     lo, hi = _number(row, "rpm_min"), _number(row, "rpm_max")
     if not lo < hi:
         raise ValueError(f"rpm_min ({lo:g}) must be below rpm_max ({hi:g})")
-    return LibraryTool(tid, holder, material, D, L, flute, cut, lo, hi, source, line)
+    given = [_number(row, f"{c}_sigma_pct", positive=False, required=False)
+             for c in ("tangential_coeff", "radial_ratio")]
+    for name, g in zip(("tangential_coeff_sigma_pct", "radial_ratio_sigma_pct"), given):
+        if g is not None and not 0 <= g <= 100:
+            raise ValueError(f"{name}: must be a percentage in [0, 100], got {g:g}")
+    sigma = tuple(math.log1p(g / 100) if g is not None else s for g, s in zip(given, sigma))
+    return LibraryTool(tid, holder, material, D, L, flute, cut, lo, hi, source, line, sigma)
 
 
 def read_library(path: str | os.PathLike) -> tuple[list[LibraryTool], list[BadRow]]:
@@ -213,17 +228,21 @@ def read_library(path: str | os.PathLike) -> tuple[list[LibraryTool], list[BadRo
     return tools, bad
 
 
-_SAFE_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
+_SAFE_ID = re.compile(r"[A-Z0-9][A-Z0-9._-]{0,63}")
+_HASHED = re.compile(r".*-[0-9a-fA-F]{10}")  # what a hashed stem looks like: such an id is hashed too
 _RESERVED = {"con", "prn", "aux", "nul", *(f"com{i}" for i in range(10)), *(f"lpt{i}" for i in range(10))}
 
 
 def tool_file_stem(tool_id: str) -> str:
     """The file name stem of a tool's result files: a tool id from a library never becomes a path as it is.
 
-    An id of at most 64 letters, digits, ``.``, ``_``, ``-`` (starting with a letter or digit, not a reserved device
-    name such as ``CON`` or ``NUL``) is its own stem, so ``EM10-45`` gives ``tools/EM10-45.json``. Any other id — path
-    separators, ``..``, NUL, newlines, 300 characters, a leading ``=`` — gives its safe characters (at most 40) and a
-    hash of the whole id: unique, bounded, inside the folder. The tool's JSON records the id itself.
+    An id of at most 64 capital letters, digits, ``.``, ``_``, ``-`` (starting with a letter or digit, not a
+    reserved device name such as ``CON`` or ``NUL.x``, not ending with ``.`` or with ``-`` and 10 hex digits) is its
+    own stem, so ``EM10-45`` gives ``tools/EM10-45.json``. Any other id — lower-case letters, path separators,
+    ``..``, NUL, newlines, 300 characters, a leading ``=`` — gives its safe characters (at most 40) and a hash of
+    the whole id: safe, bounded (≤ 64 characters), inside the folder, and unique even where the file system
+    ignores case (``em10`` and ``EM10`` are two tools on macOS and Windows too) and whatever ids the library
+    holds (an id never equals another id's hashed stem). The tool's JSON records the id itself.
 
     Examples
     --------
@@ -231,12 +250,20 @@ def tool_file_stem(tool_id: str) -> str:
     'EM10-45'
     >>> tool_file_stem("../../x")
     'x-9bdbf20b56'
-    >>> len(tool_file_stem("a" * 300)), tool_file_stem("CON").startswith("CON-")
-    (51, True)
+    >>> tool_file_stem("x-9bdbf20b56") != tool_file_stem("../../x"), tool_file_stem("em10-45")
+    (True, 'em10-45-53a2595e41')
+    >>> len(tool_file_stem("a" * 300)), tool_file_stem("CON").startswith("CON-"), tool_file_stem("CON.x")
+    (51, True, 'CON_x-eb2aca898c')
     """
+    def reserved(stem: str) -> bool:  # Windows takes ``stem.<ext>`` for a device (``CON``, ``nul.x``)
+        return stem.split(".")[0].lower() in _RESERVED
+
     tool_id = str(tool_id)
-    if _SAFE_ID.fullmatch(tool_id) and tool_id.split(".")[0].lower() not in _RESERVED and not tool_id.endswith("."):
+    if (_SAFE_ID.fullmatch(tool_id) and not reserved(tool_id) and not tool_id.endswith(".")
+            and not _HASHED.fullmatch(tool_id)):
         return tool_id
     slug = re.sub(r"[^A-Za-z0-9._-]+", "_", tool_id).strip("._-")[:40]
+    if reserved(slug):
+        slug = slug.replace(".", "_", 1)  # "CON.x-…" would still be the device CON
     digest = hashlib.sha1(tool_id.encode("utf-8", "surrogatepass")).hexdigest()[:10]
     return f"{slug}-{digest}" if slug else f"tool-{digest}"

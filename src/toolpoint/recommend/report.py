@@ -201,6 +201,11 @@ def _section(d: Path, tid: str, n_data: int) -> str:
                   "</tr>" for p in s["points"])
     best = s["points"][0]
     notes = "".join(f"<li>{html.escape(str(n))}</li>" for n in s.get("notes", []))
+    src = s.get("sources") or {}
+    if src:  # which uncertain input makes the band at the recommended point (share of the variance of ln a)
+        parts = ", ".join(f"{html.escape(k)} {100 * v:.0f} %" for k, v in sorted(src.items(), key=lambda kv: -kv[1]))
+        notes += (f"<li>uncertainty at the recommended point: <b>{html.escape(str(s.get('dominant_source')))}</b> "
+                  f"dominates ({parts} of the variance of ln a<sub>lim</sub>)</li>")
     cut = s.get("cutting", {})
     return (f'<details id="tool-{html.escape(tid)}" data-src="d{n_data}" ontoggle="draw(this)"'
             f'{" open" if n_data == 1 else ""}><summary><b>{html.escape(tid)}</b>: {best["rpm"]:.0f} rpm, '
@@ -209,7 +214,9 @@ def _section(d: Path, tid: str, n_data: int) -> str:
             f"{html.escape(str(s.get('holder', '')))}; {cut.get('teeth', '')} teeth, K<sub>t</sub> "
             f"{cut.get('tangential_coeff', 0) / 1e6:.4g} N/mm², K<sub>r</sub> {cut.get('radial_ratio', 0):.3g} "
             f"({html.escape(str(cut.get('source', '')))}), a<sub>e</sub>/D {cut.get('radial_immersion', '')}, "
-            f"{cut.get('milling', '')} milling; {s['n_samples']} joint samples</p>"
+            f"{cut.get('milling', '')} milling; {s['n_samples']} samples of the joint, K<sub>t</sub>, K<sub>r</sub>"
+            f"{' and the subassembly' if s.get('subassembly_replicates') else ''}; P(stable) holds over the speed "
+            f"tolerance ±{100 * s.get('rpm_tolerance', 0):.3g} %</p>"
             f"<ul>{notes}</ul><table><thead><tr><th>point</th><th>rpm</th><th>depth mm (recommended)</th>"
             f"<th>5 % limit mm</th><th>50 % limit mm</th><th>P(stable)</th></tr></thead><tbody>{pts}</tbody></table>"
             f'{_joint_table(s)}<div class="figs"></div>'
@@ -283,8 +290,10 @@ def write_report(out_dir, path=None) -> Path:
     page = (f"<!DOCTYPE html><html lang=en><head><meta charset=utf-8><title>toolpoint library report</title>"
             f"<style>{_STYLE}</style><script>{_SCRIPT}</script></head><body>"
             f"<h1>Recommended spindle speeds and depths</h1>"
-            f"<p>{len(rows)} tools from <code>{html.escape(str(table))}</code>. Recommended depth: the 5 % limit "
-            "(95 % of the sampled joints stable), minimum over the spindle-speed tolerance, less the margin. "
+            f"<p>{len(rows)} tools from <code>{html.escape(str(table))}</code>. Recommended depth: the depth 95 % "
+            "of the samples (joint, cutting coefficients, subassembly) keep stable at every speed within the "
+            "spindle-speed tolerance, less the margin; where no pocket is worth its uncertainty, the depth stable at "
+            "every speed (point 'minimum'). P(stable) is calibrated out of sample (docs/design/recommend.md). "
             "Click a header to sort; type to filter; click a tool to open its figures.</p>"
             f'<input id="filter" placeholder="filter tools…" oninput="filterRows(this.value)">'
             f'<table id="overview"><thead><tr>{head}</tr></thead><tbody>{"".join(body)}</tbody></table>'

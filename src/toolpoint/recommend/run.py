@@ -11,8 +11,11 @@ process pool or on an existing Dask cluster, like ``campaign run``.
 ``recommendations.csv`` columns (:data:`COLUMNS`; depths mm, speeds rpm, joint SI):
 ``id, status`` (``ok``/``failed``), ``holder, diameter_mm, overhang_mm, teeth, material, cutting_source,
 outside_range`` (δ, range widths), ``<p>_p05, <p>_p50, <p>_p95`` for kt, ct, kr, cr, ``rpm, kind``
-(``pocket``/``edge``), ``limit_nominal_mm, limit_p50_mm, limit_p05_mm, depth_mm`` (recommended),
-``p_stable`` (at the recommended point), ``min_limit_p05_mm`` (stable at every speed with 95 %),
+(``pocket``/``minimum``/``edge``), ``limit_nominal_mm, limit_p50_mm, limit_p05_mm, depth_mm`` (recommended),
+(``minimum`` where no pocket is worth its uncertainty (the depth stable at every speed)),
+``p_stable`` (at the recommended point, for any speed within the tolerance), ``dominant_uncertainty`` (the input
+whose uncertainty makes most of the band there: joint, cutting K_t, cutting K_r, subassembly),
+``min_limit_p05_mm`` (stable at every speed with 95 %),
 ``notes, error``.
 """
 
@@ -38,7 +41,7 @@ from ..io.atomic import atomic_open, atomic_path
 from ..io.table import csv_safe, csv_unsafe, read_table
 from .engine import ToolJob, evaluate_tool
 from .library import read_library, tool_file_stem
-from .uncertainty import WIDEN_PER_RANGE, JointPredictor
+from ..campaign.distribution import JointPredictor
 
 __all__ = ["COLUMNS", "FILE_NAME", "run_library"]
 
@@ -46,7 +49,7 @@ FILE_NAME = "recommendations.csv"
 COLUMNS = (["id", "status", "holder", "diameter_mm", "overhang_mm", "teeth", "material", "cutting_source",
             "outside_range"] + [f"{p}_{q}" for p in PARAMS for q in ("p05", "p50", "p95")]
            + ["rpm", "kind", "limit_nominal_mm", "limit_p50_mm", "limit_p05_mm", "depth_mm", "p_stable",
-              "min_limit_p05_mm", "notes", "error"])
+              "dominant_uncertainty", "min_limit_p05_mm", "notes", "error"])
 
 
 def _resume(path: Path, tools_dir: Path, ids: set, model: str) -> set:
@@ -101,24 +104,25 @@ def _ok_row(tool, summary, delta, notes) -> dict:
     for k in best.get("capped", ()):  # not a computed limit: above the depth searched
         if k in cells:
             cells[k] = f">={summary['cap_mm']:.4g}"
+    cells["dominant_uncertainty"] = summary.get("dominant_source") or ""
     return _row(tool, "ok", outside_range=float(delta), min_limit_p05_mm=summary["min_limit_mm"]["p05"],
                 notes="; ".join(notes), **cells)
 
 
-def _write_tool(tools_dir: Path, tool_id: str, result: dict, extra: dict) -> None:
+def _write_tool(tools_dir: Path, tool_id: str, result, extra: dict) -> None:
     buf = io.BytesIO()
-    np.savez_compressed(buf, **result["arrays"])
+    np.savez_compressed(buf, **result.arrays)
     stem = tool_file_stem(tool_id)  # never the id as it is: ids come from a file anyone may have written
     with atomic_path(tools_dir / f"{stem}.npz") as tmp:
         Path(tmp).write_bytes(buf.getvalue())
     with atomic_open(tools_dir / f"{stem}.json", "w", encoding="utf-8") as fh:
-        json.dump({**result["summary"], **extra}, fh, indent=1, allow_nan=True)
+        json.dump({**result.summary, **extra}, fh, indent=1, allow_nan=True)
 
 
 def run_library(library, campaign, models, out_dir, *, workers: int | None = None, dask: str | None = None,
                 n_samples: int = 200, rpm_points: int = 500, seed: int = 0, margin: float = 0.1,
                 rpm_tolerance: float = 0.01, outside: str = "widen", model: str = "anfis", progress: bool = True,
-                on_bad=None) -> BatchResult:
+                on_bad=None, sub_replicates: int = 8) -> BatchResult:
     """Recommend operating points for every tool of a library (module docstring).
 
     Parameters
@@ -154,6 +158,9 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
         Progress bar on stderr.
     on_bad : callable, optional
         Called with one line per bad tool (default: warnings are not emitted; lines are in the table).
+    sub_replicates : int, default 8
+        Bootstrap replicates of each blank-measured holder's subassembly that the samples are spread over (its
+        own measurement uncertainty; 0: taken as exact). About 0.5 s CPU each, once per holder.
 
     Returns
     -------
@@ -168,7 +175,8 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
     """
     if outside not in ("widen", "refuse"):
         raise InputError(f"must be 'widen' or 'refuse', got {outside!r}", field="outside")
-    for name, v, lo in (("n_samples", n_samples, 2), ("rpm_points", rpm_points, 3)):
+    for name, v, lo in (("n_samples", n_samples, 2), ("rpm_points", rpm_points, 3),
+                        ("sub_replicates", sub_replicates, 0)):
         if not isinstance(v, (int, np.integer)) or v < lo:
             raise InputError(f"must be a whole number ≥ {lo}, got {v!r}", field=name)
     if not (0 <= margin < 1):
@@ -177,7 +185,7 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
         raise InputError(f"must be in [0, 0.5), got {rpm_tolerance!r}", field="rpm_tolerance")
     tools, bad = read_library(library)
     c = load_campaign(campaign)
-    predictor = JointPredictor(models, model)
+    predictor = JointPredictor(models, model, bounds=c.bounds)
     from ..campaign.run import dask_client, folder_lock
 
     client = dask_client(dask) if dask else None
@@ -187,11 +195,12 @@ def run_library(library, campaign, models, out_dir, *, workers: int | None = Non
     with folder_lock(out, "library run"):  # a second run into this folder refuses instead of doubling rows
         return _run_locked(tools, bad, c, predictor, client, out, tools_dir, workers=workers, n_samples=n_samples,
                            rpm_points=rpm_points, seed=seed, margin=margin, rpm_tolerance=rpm_tolerance,
-                           outside=outside, model=model, progress=progress, on_bad=on_bad)
+                           outside=outside, model=model, progress=progress, on_bad=on_bad,
+                           sub_replicates=sub_replicates)
 
 
 def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_samples, rpm_points, seed, margin,
-                rpm_tolerance, outside, model, progress, on_bad) -> BatchResult:
+                rpm_tolerance, outside, model, progress, on_bad, sub_replicates) -> BatchResult:
     """The locked part of :func:`run_library`: stale temporary files cleared, resume, compute, write rows."""
     for stale in tools_dir.glob(".*.tmp*"):  # left by a run killed while writing (atomic writes' temporaries)
         stale.unlink(missing_ok=True)
@@ -203,7 +212,7 @@ def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_
     failed_rows = [_row(b, "failed", error=b.error) for b in bad]
     jobs, notes_of = [], {}
     dist = predictor.predict([t.diameter_mm for t in todo], [t.overhang_mm for t in todo]) if todo else None
-    subs = {}
+    subs, reps = {}, {}
     for k, t in enumerate(todo):
         notes = []
         if t.holder not in c.holders:
@@ -222,7 +231,8 @@ def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_
                 failed_rows.append(_row(t, "failed", outside_range=delta, error=f"{t.id}: {where}: refused "
                                                                                 "(--outside widen to allow)"))
                 continue
-            notes.append(f"{where}: σ widened ×{1 + WIDEN_PER_RANGE * delta:.2g}" if model == "anfis" else
+            widen = float(dist.sigma_log10[k, 0] / max(predictor.parameters["kt"].sigma_log10, 1e-300))
+            notes.append(f"{where}: σ of kt widened ×{widen:.2g}" if model == "anfis" else
                          f"{where}: the GP's own σ (not widened)")
             report(f"warning: {t.id}: {notes[-1]}")
         if t.holder not in subs:
@@ -232,26 +242,35 @@ def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_
                 subs[t.holder] = c.subassembly(t.holder, np.arange(lo, hi + 0.5))
             else:
                 subs[t.holder] = c.subassembly(t.holder, None)
+            keep = subs[t.holder].freq_hz > 0
+            reps[t.holder] = c.subassembly_replicates(t.holder, subs[t.holder].freq_hz[keep], sub_replicates, seed)
         sub = subs[t.holder]
         keep = sub.freq_hz > 0
+        rep_R = np.stack([r.R for r in reps[t.holder]]) if reps[t.holder] else None
         notes_of[t.id] = (t, notes, delta)
         jobs.append(ToolJob(t.id, c.family, t.diameter_mm, t.overhang_mm, t.flute_length_mm, sub.freq_hz[keep],
                             sub.R[keep], t.holder, t.cutting, np.linspace(t.rpm_min, t.rpm_max, rpm_points),
                             dist.log10_median[k], dist.sigma_log10[k], n_samples, _seed(seed, t.id), margin,
-                            rpm_tolerance))
+                            rpm_tolerance, dist.clip_log10, tuple(t.cutting_sigma_ln), rep_R))
     counts = {"ok": 0, "failed": 0, "skipped": len(done)}
     from tqdm import tqdm
 
     bar = tqdm(total=len(todo) + len(bad), desc="library", unit="tool", disable=not progress or None,
                file=sys.stderr)
     try:
-        with open(path, "a", newline="", encoding="utf-8") as fh:
-            w = csv.DictWriter(fh, COLUMNS)
+        # unbuffered: a row is on disk when append returns, and a full disk is met there, not again at close
+        with open(path, "ab", buffering=0) as fh:
 
             def append(row):
-                w.writerow(row)
-                fh.flush()
-                os.fsync(fh.fileno())
+                text = io.StringIO(newline="")
+                csv.DictWriter(text, COLUMNS).writerow(row)
+                data = memoryview(text.getvalue().encode("utf-8"))
+                try:
+                    while data:  # a raw write may take part of it
+                        data = data[fh.write(data):]
+                    os.fsync(fh.fileno())
+                except OSError as e:  # a full disk mid-run: finished rows stay; named like every other write
+                    raise InputError(f"cannot write: {e.strerror or e}", file=path) from None
                 counts[row["status"]] += 1
                 bar.update(1)
 
@@ -265,6 +284,7 @@ def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_
                     report(f"error: {msg}")
                     append(_row(t, "failed", error=msg))
                     continue
+                notes = notes + result.summary.get("engine_notes", [])
                 _write_tool(tools_dir, t.id, result, {"notes": notes, "outside_range": delta,
                                                       "cutting": {"teeth": t.cutting.teeth,
                                                                   "tangential_coeff": t.cutting.tangential_coeff,
@@ -275,7 +295,7 @@ def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_
                                                       "holder": t.holder, "diameter_mm": t.diameter_mm,
                                                       "overhang_mm": t.overhang_mm, "material": t.material,
                                                       "model": model})
-                append(_ok_row(t, result["summary"], delta, notes))
+                append(_ok_row(t, result.summary, delta, notes))
     finally:
         bar.close()
         if client is not None:
