@@ -224,7 +224,7 @@ def _rise_edge(frf: FRF, file) -> tuple[int, str]:
     if slope > RISE_SLOPE:
         return 0, ""
     n = min(v + 1, 2 * WINDOW)  # where the rise starts: steepest, the artefact (if any) far above the noise
-    if _lag1_correlation(fk[:n], h[k0:][:n]) < RISE_SMOOTH:
+    if _lag1_correlation(fk[:n], h[k0:][:n]) < RISE_SMOOTH and not _sinks_into_noise(fk, h[k0:], end):
         return 0, ""  # a rise made of noise ×1/ω²: the noise rule's to judge
     if not climbed.size:
         raise InputError(f"the receptance rises towards 0 Hz over the whole band (log–log slope {slope:.1f} from "
@@ -239,6 +239,31 @@ def _rise_edge(frf: FRF, file) -> tuple[int, str]:
                          file=file, field="values")
     return i, (f"below {f[i]:g} Hz the receptance rises towards 0 Hz as f^{slope:.1f} (a grounded structure tends "
                "to its static compliance: an offset or drift in the acceleration signal ÷ −ω²)")
+
+
+def _sinks_into_noise(f: np.ndarray, h: np.ndarray, end: int) -> bool:
+    """Whether the falling low end ``[0, end]`` of a rise starts above its noise and then sinks below it: a run of
+    :data:`WINDOW` points with Ŝ ≥ :data:`SNR_MIN` · σ̂ (the noise rule's test) followed, before ``end``, by a run of
+    :data:`WINDOW` points without.
+
+    Below its first mode a grounded structure's |H| stays near its static compliance while noise white in accelerance
+    (×1/ω² in receptance) only falls with f: the signal-to-noise ratio of structure plus such noise grows with f. One
+    that is high at the lowest frequencies, drops under the noise and recovers has a third part there, rising towards
+    0 Hz faster than the noise: an artefact (offset or drift ÷ −ω²) whose residuals are the noise's at high noise,
+    so it does not look smooth. (A free structure's mass line f⁻² and accelerance noise keep a constant ratio.)
+    """
+    ok = _running_median(np.abs(h), WINDOW) >= SNR_MIN * _noise_sigma(f, h)
+    first = _first_run(ok[: end + 1], WINDOW)
+    if first is None:
+        return False
+    return _first_run(~ok[first: end + 1], WINDOW) is not None
+
+
+def _noise_sigma(f: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """σ̂ per point: the running median (:data:`WINDOW`) of the neighbour residual over √(ln 2) (module docstring)."""
+    resid = np.concatenate([[np.nan], _neighbour_residual(f, h), [np.nan]])
+    resid[0], resid[-1] = resid[1], resid[-2]
+    return _running_median(resid, WINDOW) / math.sqrt(math.log(2.0))
 
 
 def _lag1_correlation(f: np.ndarray, h: np.ndarray) -> float:
@@ -284,9 +309,7 @@ def _noise_edge(frf: FRF, quantity_measured: str | None) -> tuple[int, str, str]
     f, h = frf.freq_hz, frf.values
     if f.size < 3 * WINDOW:
         return 0, "", ""
-    resid = np.concatenate([[np.nan], _neighbour_residual(f, h), [np.nan]])
-    resid[0], resid[-1] = resid[1], resid[-2]
-    sigma = _running_median(resid, WINDOW) / math.sqrt(math.log(2.0))
+    sigma = _noise_sigma(f, h)
     signal = _running_median(np.abs(h), WINDOW)
     ok = signal >= SNR_MIN * sigma  # a zero FRF with zero noise is exact data, not noise
     i = _first_run(ok, WINDOW)

@@ -27,7 +27,7 @@ def reference():
     return lobes_from_frf(reference_frf(), CUT, RPM).lobes
 
 
-@pytest.mark.parametrize("seed, noise", [(0, 1.0), (1, 1.0), (2, 10.0), (3, 30.0)])
+@pytest.mark.parametrize("seed, noise", [(0, 1.0), (1, 1.0), (2, 10.0), (3, 30.0), (2, 100.0), (3, 100.0), (7, 100.0)])
 def test_rise_towards_0_hz_is_cut_and_the_limit_is_the_structures(reference, seed, noise):
     frf = lab_like_frf(seed, noise=NOISE_ACCELERANCE * noise)
     tb = trusted_band(frf)
@@ -154,3 +154,73 @@ def test_modal_plot_shows_the_stabilisation_diagram(tmp_path):
     for f0 in DOMINANT_HZ:
         hits = sum(np.any(np.abs(np.abs(lam) / (2 * np.pi) - f0) < 0.01 * f0) for _, lam in fit.diagram)
         assert hits >= 0.8 * len(orders)
+
+
+# ------------------------------------------------------------------------- issue 20: the tool point, a driving point
+PYUFF_1 = __import__("pathlib").Path(__file__).resolve().parents[1] / "data" / "pyuff" / "meas_point_1.txt"
+
+
+def named_hz(note):
+    """The frequencies a driving-point note names ("… at 142.2, 460.4 Hz …")."""
+    import re
+
+    return np.array([float(x) for x in re.search(r" at ([\d., ]+) Hz", note).group(1).split(", ")])
+
+
+def test_sdm_fit_of_the_lab_like_tool_point_has_positive_modal_masses():
+    """The tool point is a driving point: the SDM's modal fit is declared one, and every mode of the lab-like FRF
+    (a grounded structure, positive masses) comes out with a positive real-mode-equivalent a_r = 1/m_r; nothing to
+    drop or name."""
+    res = lobes_from_frf(lab_like_frf(1, noise=NOISE_ACCELERANCE * 10), CUT, RPM[::40], method="sdm")
+    (fit,) = res.modal
+    for f0 in DOMINANT_HZ:
+        assert np.min(np.abs(fit.fn_hz - f0)) < 0.02 * f0
+    a = -2 * (fit.residues[:, 0] * np.conj(fit.poles)).real  # independent of ModalFit.real_modes
+    assert np.all(a > 0) and fit.notes == ()
+    assert not any("driving point" in n for n in res.notes)
+
+
+def test_sdm_fit_of_a_driving_point_with_wrong_sign_modes_keeps_them_and_says_so():
+    """pyuff's meas_point_1.txt (said to be a driving point) swings the other way at 142, 460 and 959 Hz: the SDM's
+    fit keeps those measured modes and the result's notes name exactly them (once, no Python warning)."""
+    import warnings
+
+    y = np.genfromtxt(PYUFF_1, dtype=complex)
+    f = np.arange(y.size, dtype=float)
+    frf = FRF(f[1:], y[1:] / (2j * np.pi * f[1:]) ** 2, meta={"file_quantity": "accelerance"})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the driving-point warning is a note of the result, not a Python warning
+        res = lobes_from_frf(frf, CUT, np.linspace(500.0, 5000.0, 6), method="sdm")
+    peaks = np.array([52.0, 142.0, 279.0, 460.0, 687.0, 959.0])  # the measured peaks (tests/dynamics/test_modal.py)
+    assert np.all(np.min(abs(peaks[:, None] - res.modal[0].fn_hz[None]), 1) <= 1.0)  # no measured mode lost
+    dp = [n for n in res.notes if "driving point" in n]
+    assert len(dp) == 1 and dp[0].startswith("warning: driving point: modes of negative modal mass kept")
+    assert named_hz(dp[0]) == pytest.approx([142.2, 460.4, 958.5], abs=1.0)
+
+
+def test_check_declares_one_frf_a_driving_point(tmp_path, capsys):
+    """`toolpoint check` on one FRF: a driving point — the lab-like file has no negative modal mass (nothing said);
+    the pyuff file's wrong-sign modes are named as a problem and marked doubtful, and `--driving-point none` turns
+    the rule off."""
+    path = tmp_path / "lab.txt"
+    write_tsv(lab_like_frf(2, noise=NOISE_ACCELERANCE * 10), path)
+    assert main(["check", str(path)]) == 0
+    cap = capsys.readouterr()
+    assert "negative modal mass" not in cap.out + cap.err
+    assert "looks wrong: nothing found" in cap.out
+    assert main(["check", str(path), "--driving-point", "none"]) == 0
+    assert capsys.readouterr().out == cap.out  # nothing to drop or mark: the same screen
+    y = np.genfromtxt(PYUFF_1, dtype=complex)
+    f = np.arange(y.size, dtype=float)
+    csv = tmp_path / "p1.csv"
+    np.savetxt(csv, np.c_[f[1:], y[1:].real, y[1:].imag], delimiter=",", header="freq_hz,real,imag", comments="")
+    assert main(["check", str(csv), "--quantity", "accelerance"]) == 0
+    cap = capsys.readouterr()
+    lines = [x for x in cap.out.splitlines() if "negative modal mass kept" in x]
+    assert len(lines) == 1 and "warning" not in cap.err
+    assert named_hz(lines[0]) == pytest.approx([142.2, 460.4, 958.5], abs=1.0)
+    rows = [x.split() for x in cap.out.splitlines() if x.strip().endswith(("clear", "weak", "doubtful"))]
+    doubtful = sorted(float(r[1]) for r in rows if r[-1] == "doubtful")
+    assert doubtful == pytest.approx([142.2, 460.4, 958.5], abs=1.0)
+    assert main(["check", str(csv), "--quantity", "accelerance", "--driving-point", "none"]) == 0
+    assert "negative modal mass" not in capsys.readouterr().out

@@ -171,3 +171,66 @@ def test_given_band_is_noted_and_outside_names_the_file(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err == (f"toolpoint modal: error: {paths[0]}: --band: band 4000–5000 Hz holds 0 of the data's points "
                    "(the data cover 1–3000 Hz)\n") and not out.exists()
+
+
+# --------------------------------------------------------------------------- driving point (issue 20)
+def test_one_frf_is_a_driving_point_lab_like(tmp_path, capsys):
+    """One FRF is a driving point by default: the lab-like tool point (positive modal masses) fits with every
+    a_r = −2 Re(A_r conj λ_r) > 0 from the CSV's columns, and nothing about negative masses is said."""
+    from lab_like import DOMINANT_HZ, NOISE_ACCELERANCE, lab_like_frf, write_tsv
+
+    path = tmp_path / "lab.txt"
+    write_tsv(lab_like_frf(1, noise=NOISE_ACCELERANCE * 30), path)
+    out = tmp_path / "modes.csv"
+    assert main(["modal", str(path), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "negative modal mass" not in err
+    _, fn, ze, A = read_modes(out)
+    lam = 2 * np.pi * fn * (-ze + 1j * np.sqrt(1 - ze**2))
+    assert np.all(-2 * (A[:, 0] * np.conj(lam)).real > 0)
+    for f0 in DOMINANT_HZ:
+        assert np.min(np.abs(fn - f0)) < 0.02 * f0
+
+
+def test_driving_point_with_wrong_sign_modes_is_named_once_and_kept(tmp_path, capsys):
+    """pyuff's meas_point_1.txt (said to be a driving point; docs/design/measurements.md) swings the other way at
+    142, 460 and 959 Hz: every measured mode is kept, one warning names exactly those; `--driving-point none`
+    says nothing, and gives the same modes."""
+    y = np.genfromtxt(DATA / "meas_point_1.txt", dtype=complex)
+    f = np.arange(y.size, dtype=float)
+    path = write_csv(tmp_path / "p1.csv", f[1:], y[1:])
+    out, off = tmp_path / "modes.csv", tmp_path / "off.csv"
+    assert main(["modal", path, "--quantity", "accelerance", "--out", str(out)]) == 0
+    err = capsys.readouterr().err.splitlines()
+    dp = [x for x in err if "driving point" in x]
+    assert len(dp) == 1 and dp[0].startswith("warning: driving point: modes of negative modal mass kept")
+    named = np.array([float(x) for x in dp[0].split(" kept at ")[1].split(" Hz")[0].split(", ")])
+    assert named == pytest.approx([142.2, 460.4, 958.5], abs=1.0)
+    _, fn, _, _ = read_modes(out)
+    peaks = np.array([52.0, 142.0, 279.0, 460.0, 687.0, 959.0])
+    assert np.all(np.min(abs(peaks[:, None] - fn[None]), 1) <= 1.0)  # no measured mode lost
+    assert main(["modal", path, "--quantity", "accelerance", "--driving-point", "none", "--out", str(off)]) == 0
+    assert "driving point" not in capsys.readouterr().err
+    assert np.array_equal(read_modes(off)[1], fn)
+
+
+def test_driving_point_of_several_frfs_is_off_unless_given(tmp_path, capsys):
+    """Several FRFs: no driving point by default; `--driving-point 0` declares the first (pyuff point 1) one."""
+    Y = np.stack([np.genfromtxt(DATA / f"meas_point_{k}.txt", dtype=complex) for k in (1, 2)], -1)
+    f = np.arange(Y.shape[0], dtype=float)
+    paths = [write_csv(tmp_path / f"p{k}.csv", f[1:], Y[1:, k]) for k in range(2)]
+    out = tmp_path / "modes.csv"
+    assert main(["modal", *paths, "--quantity", "accelerance", "--out", str(out)]) == 0
+    assert "driving point" not in capsys.readouterr().err
+    assert main(["modal", *paths, "--quantity", "accelerance", "--driving-point", "0", "--out", str(out)]) == 0
+    assert "driving point: modes of negative modal mass" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("value", ["2", "-1", "x", "0.5"])
+def test_bad_driving_point_is_one_line_exit_2(value, tmp_path, capsys):
+    Y = FOUR.frf(F, "receptance")
+    paths = [write_csv(tmp_path / f"y{k}.csv", F, Y[:, k]) for k in range(2)]
+    out = tmp_path / "modes.csv"
+    assert main(["modal", *paths, "--driving-point", value, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--driving-point" in err and not out.exists()

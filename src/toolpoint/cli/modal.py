@@ -1,4 +1,5 @@
-"""``toolpoint modal FRF... [--quantity Q] [--band LO:HI] [--modes N|auto] --out modes.csv [--plot PNG]``.
+"""``toolpoint modal FRF... [--quantity Q] [--band LO:HI] [--modes N|auto] [--driving-point K|none] --out modes.csv
+[--plot PNG]``.
 
 A common-pole modal fit (:func:`toolpoint.dynamics.modal.fit_frfs`) of one or
 several FRFs of one structure to one input, all on one frequency grid. The fit
@@ -15,16 +16,21 @@ FRF k in the order given, the complex modal constant A_kr of the *receptance*
 
 with λ_r = −ζ_r ω_r + iω_r √(1 − ζ_r²), ω_r = 2π f_r. (Mobility and
 accelerance are iω H and −ω² H.)
+
+``--driving-point K`` declares FRF K (0-based; default 0 for one FRF, none for several) a driving point: its
+modes must have positive modal mass (:func:`~toolpoint.dynamics.modal.fit_modal`). The fit's notes — modes of
+negative mass dropped, or kept and named with a warning — go to stderr after the band's.
 """
 
 from __future__ import annotations
 
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..dynamics.modal import fit_frfs
+from ..dynamics.modal import DrivingPointWarning, fit_frfs
 from ..errors import InputError
 from ..frf import FRF
 from ..io.atomic import atomic_open
@@ -49,6 +55,11 @@ def register(sub) -> None:
                    "noise ×1/ω² and low coherence left out, with a note — above 0 Hz)")
     p.add_argument("--modes", default="auto", metavar="N|auto",
                    help="number of modes, or auto (default: chosen by the Bayesian information criterion)")
+    p.add_argument("--driving-point", metavar="K|none",
+                   help="0-based index K of the FRF (in the order given) that is a driving point (response at the "
+                   "input, e.g. the tool point's direct FRF): its modes must have positive modal mass — modes of "
+                   "negative mass are dropped when the data cannot tell the models apart, else kept with a warning "
+                   "naming them (default: 0 when one FRF is given, none when several; none: no such check)")
     p.add_argument("--out", required=True,
                    help="modes CSV: freq_hz,damping_ratio, then A{k}_real,A{k}_imag per FRF k (1, 2, …): modal "
                    "constants of the receptance, m/N × rad/s = m/(N s)")
@@ -69,6 +80,23 @@ def parse_modes(text: str) -> int | None:
     return n
 
 
+def parse_driving_point(text: str | None, n_frfs: int) -> int | None:
+    """``--driving-point``: None (not given) → 0 for one FRF, None for several; ``"none"`` → None; an index K with
+    0 ≤ K < ``n_frfs`` → K; otherwise an InputError naming the flag."""
+    if text is None:
+        return 0 if n_frfs == 1 else None
+    if text.strip().lower() == "none":
+        return None
+    try:
+        k = int(text)
+    except ValueError:
+        k = -1
+    if not 0 <= k < n_frfs:
+        raise InputError(f"expected the 0-based index of one of the {n_frfs} FRF(s) (0–{n_frfs - 1}) or none, got "
+                         f"{text!r}", file="command line", field="--driving-point")
+    return k
+
+
 def run(args) -> int:
     """Fit the FRF files, write ``--out`` (and ``--plot``); returns exit code 0.
 
@@ -79,6 +107,7 @@ def run(args) -> int:
     plot = out_path(args.plot, "--plot", inputs=args.frf) if args.plot else None
     band = parse_band(args.band)
     n_modes = parse_modes(args.modes)
+    driving = parse_driving_point(getattr(args, "driving_point", None), len(args.frf))
     with warnings_to_stderr():
         frfs = [read_frf(path, quantity=args.quantity) for path in args.frf]
         b = common_band(frfs, band=band, files=args.frf)
@@ -87,7 +116,10 @@ def run(args) -> int:
         band = None if (b.lo_hz, b.hi_hz) == (f[0], f[-1]) else (b.lo_hz, b.hi_hz)
         _check(frfs, args.frf, band)
         try:
-            fit = fit_frfs(frfs, band=band, n_modes=n_modes, noise=b.noise_quantity or None)
+            with warnings.catch_warnings():  # the driving-point warning is in fit.notes, printed below
+                warnings.simplefilter("ignore", DrivingPointWarning)
+                fit = fit_frfs(frfs, band=band, n_modes=n_modes, noise=b.noise_quantity or None,
+                               driving_point=driving)
         except InputError as e:
             flag = {"band": "--band", "n_modes": "--modes"}.get(e.field)
             if flag is None:
@@ -103,7 +135,7 @@ def run(args) -> int:
         save_figure(fig, plot)
     print(fit.table())
     print(f"{fit.n_modes} modes, {fit.band_hz[0]:g}–{fit.band_hz[1]:g} Hz, {len(frfs)} FRFs → {out}")
-    for note in notes:
+    for note in notes + list(fit.notes):
         print(note, file=sys.stderr)
     return 0
 

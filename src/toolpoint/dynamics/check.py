@@ -6,8 +6,10 @@ One call, :func:`check_measurement`, collects from the data alone:
   coherence, a given band) and the unit hint;
 * the modes of the modal fit in that band (:func:`toolpoint.dynamics.modal.fit_frfs`, weighted as the noise is
   white), each with a confidence word — **clear**: its peak |A_r|/σ_r is ≥ 20 % of the largest |H| in the band;
-  **weak**: 5–20 %; **doubtful**: below 5 %, or, for a single FRF (a driving point), a modal constant on the other
-  side from its largest mode's (a negative modal mass);
+  **weak**: 5–20 %; **doubtful**: below 5 %, or a negative modal mass on the driving point;
+* the driving point (``driving_point``: by default FRF 0 when one FRF is given, none when several): the fit enforces
+  positive modal mass on it (:func:`~toolpoint.dynamics.modal.fit_modal`'s rule: modes of negative mass dropped when
+  the data cannot tell, else kept and named); the fit's notes are printed, its warnings are problems;
 * the coherence (when the file has one): its median and the share of the band below 0.8;
 * what looks wrong, one line each: no resonance in the band, a dominant peak at a band edge, a poor fit, low
   coherence, a large share of the data left out.
@@ -15,6 +17,7 @@ One call, :func:`check_measurement`, collects from the data alone:
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -64,24 +67,30 @@ class MeasurementCheck:
         for name, c in self.coherence.items():
             lines.append(f"coherence {name}: median {c['median']:.3f}, {100 * c['below']:.0f} % of the band "
                          f"below {COHERENCE_MIN:g}")
+        if self.fit is not None:
+            lines += [f"  {n}" for n in self.fit.notes if n.startswith("note: ")]
         lines.append("looks wrong:" if self.problems else "looks wrong: nothing found")
         lines += [f"  - {p}" for p in self.problems]
         return "\n".join(lines)
 
 
-def check_measurement(frfs, *, files=None, band=None, n_modes: int | None = None) -> MeasurementCheck:
+def check_measurement(frfs, *, files=None, band=None, n_modes: int | None = None,
+                      driving_point: int | None | str = "auto") -> MeasurementCheck:
     """Check measured FRFs before they are trusted (module docstring).
 
     Parameters
     ----------
     frfs : sequence of FRF
-        Measured SISO FRFs on one grid (the first a driving point, e.g. the tool point).
+        Measured SISO FRFs on one grid (e.g. the tool point, a driving point).
     files : sequence of str, optional
         Their file names, for the lines.
     band : (float, float), optional
         A given band, Hz (no detection).
     n_modes : int, optional
         Modes of the fit (default: chosen by the fit).
+    driving_point : int or None, optional
+        Index of the FRF that is a driving point (its modes must have positive modal mass), None for none; default
+        ``"auto"``: 0 when one FRF is given (a tool-point FRF is a driving point), none when several.
 
     Returns
     -------
@@ -96,7 +105,7 @@ def check_measurement(frfs, *, files=None, band=None, n_modes: int | None = None
     >>> [round(x) for x in c.fit.fn_hz], c.confidence, c.problems
     ([900], ('clear',), ())
     """
-    from .modal import fit_frfs
+    from .modal import DrivingPointWarning, fit_frfs
 
     frfs = list(frfs)
     names = [str(n) for n in files] if files is not None else [g.label or f"FRF {k + 1}" for k, g in enumerate(frfs)]
@@ -107,10 +116,16 @@ def check_measurement(frfs, *, files=None, band=None, n_modes: int | None = None
     if kept < 0.7:
         problems.append(f"only {100 * kept:.0f} % of the data lies in the trusted band")
     cut = [b.cut(g) for g in frfs]
+    if isinstance(driving_point, str) and driving_point == "auto":
+        driving_point = 0 if len(frfs) == 1 else None
     fit, conf = None, ()
     try:
-        fit = fit_frfs(cut, n_modes=n_modes, noise=b.noise_quantity or None)
+        with warnings.catch_warnings():  # the driving-point warning is in fit.notes: one of the problems below
+            warnings.simplefilter("ignore", DrivingPointWarning)
+            fit = fit_frfs(cut, n_modes=n_modes, noise=b.noise_quantity or None, driving_point=driving_point)
     except InputError as err:
+        if err.field == "driving_point":
+            raise
         problems.append(f"modal fit failed: {err.message}")
     if fit is not None:
         if fit.n_modes == 0:
@@ -119,15 +134,12 @@ def check_measurement(frfs, *, files=None, band=None, n_modes: int | None = None
         sigma = -fit.poles.real
         size = np.abs(fit.residues[:, 0]) / np.maximum(sigma, 1e-300) / max(top, 1e-300)
         words = np.where(size >= 0.2, "clear", np.where(size >= 0.05, "weak", "doubtful"))
-        if len(cut) == 1 and fit.n_modes:
-            # a driving point's modes all lie on the side of its largest one (Im A_r < 0 in our sign convention):
-            # a mode on the other side is a negative modal mass — or the FRF is no driving point
-            side = np.sign(fit.residues[int(np.argmax(size)), 0].imag)
-            wrong = ~(side * fit.residues[:, 0].imag > 0.5 * np.abs(fit.residues[:, 0]))
+        if driving_point is not None and fit.n_modes:
+            # a driving point's modes all have positive modal mass (a_r = −2 Re(A_r conj λ_r) > 0): a mode of
+            # negative mass the fit kept is a fit artefact the data demand — or the FRF is no driving point
+            wrong = ~(fit.real_modes()[0][:, driving_point] > 0)
             words = np.where(wrong, "doubtful", words)
-            if wrong.any():
-                problems.append(f"{int(wrong.sum())} mode(s) with a modal constant of the other sign (negative "
-                                "modal mass at a driving point): a fit artefact, or the FRF is not a driving point")
+        problems += [n[len("warning: "):] for n in fit.notes if n.startswith("warning: ")]
         conf = tuple(str(w) for w in words)
         if float(np.max(fit.fit_error)) > 0.2:
             problems.append(f"the modal fit leaves {100 * float(np.max(fit.fit_error)):.0f} % of the band "

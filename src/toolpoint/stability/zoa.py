@@ -100,11 +100,16 @@ def interval_parts(freq_hz, values) -> np.ndarray:
     """
     y = np.asarray(values)
     a = np.abs(y)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        turn = np.abs(np.diff(y, axis=-1)) / np.minimum(a[..., 1:], a[..., :-1])
-        parts = np.ceil(np.minimum(turn, MAX_PARTS * MAX_TURN) / MAX_TURN)
-    parts = np.where(np.isfinite(parts) & (parts > 1), parts, 1).astype(np.int64)
-    parts[..., np.asarray(freq_hz)[:-1] <= 0] = 1  # no lobes from 0 Hz
+    turn = np.abs(y[..., 1:] - y[..., :-1])
+    m = np.minimum(a[..., 1:], a[..., :-1])
+    with np.errstate(invalid="ignore"):
+        split = (turn > MAX_TURN * m) & (m > 0)  # most intervals turn less and stay whole
+    split[..., np.asarray(freq_hz)[:-1] <= 0] = False  # no lobes from 0 Hz
+    parts = np.ones(split.shape, np.int64)
+    idx = np.nonzero(split)
+    with np.errstate(invalid="ignore", over="ignore"):
+        p = np.ceil(np.minimum(turn[idx] / m[idx], MAX_PARTS * MAX_TURN) / MAX_TURN)
+    parts[idx] = np.where(np.isfinite(p) & (p > 1), p, 1).astype(np.int64)
     return parts
 
 
@@ -134,29 +139,27 @@ def refine_frf_grid(freq_hz, values, parts):
     n, F = y.shape
     parts = np.broadcast_to(np.asarray(parts, np.int64), (n, F - 1))
     extra = parts - 1
-    shift = np.zeros((n, F), np.int64)
-    np.cumsum(extra, axis=1, out=shift[:, 1:])
-    L = int(F + shift[:, -1].max())
-    fs = np.full((n, L), f[-1])
-    ys = np.full((n, L), np.nan + 0j)
-    rows = np.arange(n)[:, None]
-    pos = np.arange(F)[None, :] + shift
-    fs[rows, pos] = f
-    ys[rows, pos] = y
     r, i = np.nonzero(extra)
-    if r.size:
-        cnt = extra[r, i]
-        e = np.repeat(np.arange(r.size), cnt)
-        j = 1 + np.arange(e.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)  # 1 … parts − 1
-        re, ie = r[e], i[e]
-        t = j / parts[re, ie]
-        h = f[ie + 1] - f[ie]
-        h00, h10 = (1 + 2 * t) * (1 - t) ** 2, t * (1 - t) ** 2
-        h01, h11 = t * t * (3 - 2 * t), t * t * (t - 1)
-        d0, d1 = _slopes(f, y, r, i), _slopes(f, y, r, i + 1)
-        out = pos[re, ie] + j
-        fs[re, out] = f[ie] + t * h
-        ys[re, out] = (h00 * y[re, ie] + h10 * h * d0[e] + h01 * y[re, ie + 1] + h11 * h * d1[e])
+    cnt = extra[r, i]
+    per_row = np.bincount(r, weights=cnt, minlength=n).astype(np.int64)
+    L = F + int(per_row.max(initial=0))
+    # new points: after point i of row r, j = 1 … parts − 1; then each row padded to L points
+    e = np.repeat(np.arange(r.size), cnt)
+    j = 1 + np.arange(e.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    re, ie = r[e], i[e]
+    t = j / parts[re, ie]
+    h = f[ie + 1] - f[ie]
+    h00, h10 = (1 + 2 * t) * (1 - t) ** 2, t * (1 - t) ** 2
+    h01, h11 = t * t * (3 - 2 * t), t * t * (t - 1)
+    d0, d1 = _slopes(f, y, r, i), _slopes(f, y, r, i + 1)
+    y_new = h00 * y[re, ie] + h10 * h * d0[e] + h01 * y[re, ie + 1] + h11 * h * d1[e]
+    pad = L - F - per_row
+    rows_pad = np.repeat(np.arange(n), pad)
+    at = np.r_[re * F + ie + 1, rows_pad * F + F]  # insertion points in the flattened (n, F) arrays
+    order = np.argsort(at, kind="stable")
+    at = at[order]
+    ys = np.insert(y.reshape(-1), at, np.r_[y_new, np.full(rows_pad.size, np.nan + 0j)][order]).reshape(n, L)
+    fs = np.insert(np.tile(f, n), at, np.r_[f[ie] + t * h, np.full(rows_pad.size, f[-1])][order]).reshape(n, L)
     return fs, ys
 
 
@@ -369,13 +372,6 @@ def zoa_lobes(
     frf_x = _as_receptance(frf_x, "frf_x")
     f, phi = _common_grid(frf_x, {"frf_y": frf_y, "frf_xy": frf_xy, "frf_yx": frf_yx})
     _check_not_zero(phi, f)
-    names = [k for k in ("xx", "yy", "xy", "yx") if phi[k] is not None]
-    stack = np.stack([phi[k] for k in names])
-    parts = interval_parts(f, stack).max(axis=0)
-    if np.any(parts > 1):  # Hermite-refined grid where the FRFs turn fast (module docstring)
-        fs, ys = refine_frf_grid(f, stack, parts)
-        f = fs[0]
-        phi = dict(phi, **dict(zip(names, ys)))
     phi_st, phi_ex = cut.immersion_angles
     h0 = average_directional_matrix(cut.teeth, cut.tangential_coeff, cut.radial_ratio, phi_st, phi_ex)
 
@@ -387,7 +383,18 @@ def zoa_lobes(
     c = 60.0 * f / cut.teeth  # rpm·(waves per tooth period)
     frac = eps / (2 * np.pi)
 
-    limit, chatter, knum = _envelope(grid, 60.0 / cut.teeth, f, mu, valid)
+    # The limit on the grid refined where the FRFs turn fast (module docstring); the lobes' own points and the
+    # absolute minimum's parabola stay at the FRF points (where Φ is known, not interpolated).
+    fe, mue, valide = f, mu, valid
+    names = [k for k in ("xx", "yy", "xy", "yx") if phi[k] is not None]
+    stack = np.stack([phi[k] for k in names])
+    parts = interval_parts(f, stack).max(axis=0)
+    if np.any(parts > 1):
+        fs, ys = refine_frf_grid(f, stack, parts)
+        fe, dense = fs[0], dict(zip(names, ys))
+        mue = oriented_eigenvalues(h0, dense["xx"], dense["yy"], dense.get("xy"), dense.get("yx"))
+        valide = _negative(mue) & (fe[None, :] > 0)
+    limit, chatter, knum = _envelope(grid, 60.0 / cut.teeth, fe, mue, valide)
     lobes, best = _lobe_points(grid, c, frac, depth, valid, f)
     min_d, min_r, min_f = _absolute_minimum(grid, limit, chatter, best, c, frac, depth, valid, f)
     params = dict(cut.as_dict(), cutting=cut, phi_st=phi_st, phi_ex=phi_ex, h0=h0,

@@ -15,9 +15,9 @@ over frequency is needed. As in :mod:`~toolpoint.stability.zoa`,
 
 Each FRF interval is first split where the sample's Φ turns fast, exactly as in ``zoa_lobes``
 (:func:`~toolpoint.stability.zoa.interval_parts`, :func:`~toolpoint.stability.zoa.refine_frf_grid`:
-⌈|Φ_{i+1} − Φ_i| / min(|Φ_i|, |Φ_{i+1}|) / 0.05⌉ parts, cubic Hermite Φ at the new points) — per sample, depending on its FRF only; the samples' refined
-grids are padded to one length with invalid points. μ is interpolated linearly between the points of that grid,
-so 1/a_lim is linear there;
+⌈|Φ_{i+1} − Φ_i| / min(|Φ_i|, |Φ_{i+1}|) / 0.05⌉ parts, cubic Hermite Φ at the new points) — per sample,
+depending on its FRF only; the samples' refined grids are padded to one length with invalid points. μ is
+interpolated linearly between the points of that grid, so 1/a_lim is linear there;
 where Re μ changes sign the piece runs to the crossing (1/a_lim = 0, ε = 0 or
 2π), so a lobe flank rises to its asymptote instead of being cut. Unlike
 ``zoa_lobes``, which solves for the exact point of each grid speed on a piece
