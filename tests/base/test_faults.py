@@ -380,9 +380,6 @@ COMMANDS = ["tap --out", "tap --plot", "modal --out", "modal --plot", "identify 
 @pytest.mark.parametrize("name", COMMANDS)
 def test_a_full_disk_is_one_line_naming_the_file_and_nothing_is_left(seeds, heavy, disk, name,  # noqa: F811
                                                                       request):
-    if name == "modal --plot":
-        request.applymarker(pytest.mark.xfail(strict=True, reason=(
-            "cli/modal.py writes --out, then --plot: a figure that cannot be written leaves the CSV behind (exit 2)")))
     argv, named = _commands(seeds, heavy, disk.path)[name]
     inputs = _snapshot_inputs([a for a in argv if isinstance(a, Path) and not a.is_relative_to(disk.path)]
                               + [p for p in (heavy / "libout").rglob("*")])

@@ -130,9 +130,15 @@ def run(args) -> int:
             raise InputError(e.message, file="command line", field=flag) from None
     if plot:  # render first: a plotting failure must not leave a CSV without its figure
         fig = _figure(frfs, fit, args.frf)
-    _write_modes(out, fit)
+    # all or none: the figure first (the likelier to fail), then the table; a failed table removes the figure
     if plot:
         save_figure(fig, plot)
+    try:
+        _write_modes(out, fit)
+    except BaseException:
+        if plot:
+            plot.unlink(missing_ok=True)
+        raise
     print(fit.table())
     print(f"{fit.n_modes} modes, {fit.band_hz[0]:g}–{fit.band_hz[1]:g} Hz, {len(frfs)} FRFs → {out}")
     for note in notes + list(fit.notes):
