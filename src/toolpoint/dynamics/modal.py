@@ -494,14 +494,15 @@ class _Problem:
                 p, r, cost = p_new, r_new, cost_new
                 if done or cost == 0.0:
                     break
-                if np.any(p[:n] < self.plim[0]):
-                    break  # a damping ran to 0 (ln σ below its clip): that pole is removed anyway
-                wn = np.hypot(np.exp(np.clip(p[:n], *self.plim)), np.exp(np.clip(p[n:], *self.plim)))
-                if np.any((wn < self.wstop[0]) | (wn > self.wstop[1])):
-                    break  # a pole ran far out of the range where poles are kept: it is removed anyway
-                x = np.clip(p, *self.plim)
-                if stop is not None and stop(-np.exp(x[:n]) + 1j * np.exp(x[n:])):
-                    break
+                if stop is not None:  # a trial only: the final refinement converges every pole it keeps
+                    if np.any(p[:n] < self.plim[0]):
+                        break  # a damping ran to 0 (ln σ below its clip): that pole is removed anyway
+                    wn = np.hypot(np.exp(np.clip(p[:n], *self.plim)), np.exp(np.clip(p[n:], *self.plim)))
+                    if np.any((wn < self.wstop[0]) | (wn > self.wstop[1])):
+                        break  # a pole ran far out of the range where poles are kept: it is removed anyway
+                    x = np.clip(p, *self.plim)
+                    if stop(-np.exp(x[:n]) + 1j * np.exp(x[n:])):
+                        break
                 J = self.jac(p)
                 mu = max(mu / 3.0, 1e-12)
             else:
@@ -684,16 +685,12 @@ def _add_residual_poles(prob, poles, f_lo, f_hi, most: int = 4):
     def n_in(p):
         return int(np.sum((np.abs(p) >= 2 * np.pi * f_lo) & (np.abs(p) <= 2 * np.pi * f_hi)))
 
-    def inside(lam):  # the new (last) pole is well inside the band: the trial will be rejected, stop refining
-        return lam.size == k + 1 and 2 * np.pi * 1.1 * f_lo < abs(lam[-1]) < 2 * np.pi * f_hi / 1.1
-
     rss = prob.rss(poles)
     for _ in range(most):
         best = None
-        k = poles.size
         for fs in (1.5 * f_hi, 0.5 * f_lo):
             trial = np.r_[poles, 2 * np.pi * fs * (-0.3 + 1j * np.sqrt(0.91))]  # |λ| = ω_s, ζ = 0.3
-            trial = _refine_clean(prob, trial, f_lo, f_hi, stop=inside)
+            trial = _refine_clean(prob, trial, f_lo, f_hi)
             if n_in(trial) > n_in(poles):  # it ran into the band: a mode, which only the forward step adds
                 continue
             b = prob.bic(prob.rss(trial), trial.size)
