@@ -136,7 +136,8 @@ class ParameterUncertainty:
     centre_log10 : float
         ``spread``: the campaign's median of log10 p (``model``: NaN, the model gives m(x)).
     clip_log10 : (float, float)
-        Search bounds of the identification, log10 SI: medians and samples are clipped to them.
+        The physically plausible range, log10 SI (the paper's search bounds widened to every value the campaign
+        found; ``library`` narrows it to the campaign's own bounds): medians and samples are clipped to it.
     X_train : list of [D mm, L mm]
         Training inputs of the saved model (for d_k).
     lo, hi : list of float
@@ -193,8 +194,12 @@ class ParameterUncertainty:
         return np.maximum(1.0, d / max(self.d_ref, 1e-12)) * (1.0 + WIDEN_PER_RANGE * outside(X, lo, hi))
 
     def sigma(self, X) -> np.ndarray:
-        """σ s(x) per row of X, decades."""
-        return self.sigma_log10 * self.scale(X)
+        """σ s(x) per row of X, decades; for ``neighbours`` at most the campaign's spread (its median never
+        leaves the values seen, so far from the tools that identified it, it is the campaign's value)."""
+        out = self.sigma_log10 * self.scale(X)
+        if self.kind == "neighbours":
+            out = np.minimum(out, max(self.cv.get("spread_rms_log10", np.inf), self.sigma_log10))
+        return out
 
 
 def fit_power_law(X, log10_y) -> np.ndarray:

@@ -44,7 +44,7 @@ import numpy as np
 
 from ..blas import single_thread_blas
 from ..errors import InputError
-from ..identification.params import IDENTIFIED_RATIO, PARAMS, UNITS
+from ..identification.params import IDENTIFIED_RATIO, PAPER_BOUNDS, PARAMS, UNITS
 from ..io.atomic import atomic_open
 from ..learning.anfis import ANFIS, predict_quietly
 from ..learning.figures import membership_figure, per_sample_figure, regression_figure, save_png
@@ -478,14 +478,16 @@ def _fit_target(t: str, data: _Data, train_idx, test_idx, anfis: dict, *, baseli
 
 # ------------------------------------------------------------- uncertainty
 def _clip_log10(data: _Data, t: str) -> tuple[float, float]:
-    """log10 of the range the identification explored for ``t``: values and their 95 % intervals (inside the
-    search bounds by construction)."""
-    v = [data.all_values.get(t, np.array([]))]
+    """log10 of the physically plausible range of ``t``: the paper's search bounds, widened to every value and
+    interval the campaign found (a campaign may search wider). ``library`` narrows it to the campaign's own search
+    bounds. Not the range of the values found: a tool beyond the campaign's tools may lie beyond them too."""
+    lo, hi = PAPER_BOUNDS[t]
+    v = [data.all_values.get(t, np.array([])), np.array([lo, hi], float)]
     if t in data.intervals:
         v += list(data.intervals[t])
     v = np.concatenate(v)
     v = v[np.isfinite(v) & (v > 0)]
-    return (float(np.log10(v.min())), float(np.log10(v.max()))) if v.size else (-np.inf, np.inf)
+    return float(np.log10(v.min())), float(np.log10(v.max()))
 
 
 def _cross_validate(t: str, data: _Data, anfis: dict, folds: int, seed: int):
@@ -628,8 +630,8 @@ def _uncertainty(data: _Data, fits: dict, train_idx, anfis: dict, folds: int, se
             if cv is not None:
                 X, r, fold, trained, keep = cv
                 Xk = data.X[keep]
-                out[t] = calibration.fit_uncertainty(
-                    t, X, r, fold, trained, Xk, data.X.min(axis=0), data.X.max(axis=0), clip, values,
+                out[t] = calibration.fit_uncertainty(  # edge and outside: of the tools that identified it
+                    t, X, r, fold, trained, Xk, Xk.min(axis=0), Xk.max(axis=0), clip, values,
                     kind="neighbours", y_log10=np.log10(values[keep]),
                     what=f"local campaign value (median of the {calibration.K_LOCAL} nearest of the "
                          f"{int(keep.sum())} tools that identified it; {why})")
@@ -824,18 +826,71 @@ def learn(
     candidates = explicit if explicit is not None else list(PARAMS)
 
     data = _read(path, candidates, explicit is not None, test_size)
-    test_size = data.test_size
-    train_idx, test_idx = _split(len(data.ids), test_size, seed)
-    Xtr, Xte = data.X[train_idx], data.X[test_idx]
-    for i, name in enumerate(INPUTS):
-        if np.ptp(Xtr[:, i]) == 0:
-            raise InputError("constant in the training data; a grid partition needs a range", file=path, field=name)
+    train_idx, test_idx = _split(len(data.ids), data.test_size, seed)
+    _check_inputs(data, train_idx, explicit)
     _check_folders(models_dir, plots_dir)
+    fitted = _fit_all(data, candidates, train_idx, test_idx, anfis, baselines=baselines, seed=int(seed))
+    with single_thread_blas():
+        unc = _uncertainty(data, fitted.fits, train_idx, anfis, int(cv_folds), int(seed))
+    settings = {"test_size": data.test_size, "mfs": list(np.broadcast_to(anfis["n_mfs"], (len(INPUTS),)).tolist()),
+                "mf": mf, "order": anfis["order"], "epochs": anfis["epochs"], "step_size": anfis["step_size"],
+                "seed": int(seed), "log_target": anfis["log_target"], "baselines": bool(baselines),
+                "identifiable_ratio": IDENTIFIED_RATIO, "identifiable_share": IDENTIFIABLE_SHARE,
+                "cv_folds": int(cv_folds)}
+    result = _result(data, candidates, train_idx, test_idx, fitted, unc, settings, models_dir, plots_dir)
+    # everything is fitted: only now write, so that a failure above leaves the folder as it was
+    _write_all(result, data, test_idx, fitted.fits, unc, models_dir, plots_dir)
+    return result
+
+
+@dataclass(frozen=True)
+class _Fitted:
+    """Every target's fit, by what learn() reports of it."""
+
+    fits: dict  # target → _Fit (learned only)
+    target_notes: dict
+    excluded: dict
+    metrics: dict
+    baseline_settings: dict
+    best: dict
+
+
+def _check_inputs(data: _Data, train_idx, explicit) -> None:
+    for i, name in enumerate(INPUTS):
+        if np.ptp(data.X[train_idx, i]) == 0:
+            raise InputError("constant in the training data; a grid partition needs a range", file=data.path,
+                             field=name)
     if explicit is not None and REQUIRED_FOR_PREDICT not in explicit:
         raise InputError(f"must include {REQUIRED_FOR_PREDICT}: `toolpoint predict` needs a {REQUIRED_FOR_PREDICT} "
                          f"model (got {', '.join(explicit)})", field="targets")
-    files = {"split": str(models_dir / "split.csv")}
 
+
+def _fit_all(data: _Data, candidates, train_idx, test_idx, anfis: dict, *, baselines: bool, seed: int) -> _Fitted:
+    """ANFIS (and baselines) of every candidate target; InputError when kt cannot be learned."""
+    out = _Fitted({}, {}, {}, {}, {}, {})
+    for t in candidates:
+        fit = _fit_target(t, data, train_idx, test_idx, anfis, baselines=baselines, seed=seed)
+        out.target_notes[t] = fit.notes
+        if fit.excluded is not None:
+            out.excluded[t] = fit.excluded
+            continue
+        out.fits[t] = fit
+        if fit.baseline_settings is not None:
+            out.baseline_settings[t] = fit.baseline_settings
+        out.metrics[t] = fit.metrics
+        if _best_model(fit.metrics) is not None:
+            out.best[t] = _best_model(fit.metrics)
+    if REQUIRED_FOR_PREDICT not in out.fits:
+        why = out.excluded.get(REQUIRED_FOR_PREDICT, "not among the targets")
+        raise InputError(f"no {REQUIRED_FOR_PREDICT} model could be learned ({why}); `toolpoint predict` needs one, "
+                         "so nothing was written", file=data.path, field=REQUIRED_FOR_PREDICT)
+    return out
+
+
+def _result(data: _Data, candidates, train_idx, test_idx, fitted: _Fitted, unc: dict, settings: dict,
+            models_dir: Path, plots_dir: Path | None) -> LearnResult:
+    """The :class:`LearnResult` of a finished fit: notes, files to write, metrics, uncertainty."""
+    Xtr, Xte = data.X[train_idx], data.X[test_idx]
     notes = [f"note: only {100 * data.share[t]:.0f} % of the ok rows have a narrow 95 % interval for {t} "
              "(the FRF hardly depends on it elsewhere); weighted training keeps the rest from dominating, "
              "and the test metrics use the identified rows only"
@@ -844,76 +899,34 @@ def learn(
     if outside:
         notes.append(f"note: {outside} of {len(test_idx)} test samples lie outside the training range of D, L "
                      "(models extrapolate there)")
-
-    target_notes, excluded, metrics, baseline_settings, best = {}, {}, {}, {}, {}
-    fits: dict[str, _Fit] = {}
-    for t in candidates:
-        fit = _fit_target(t, data, train_idx, test_idx, anfis, baselines=baselines, seed=int(seed))
-        target_notes[t] = fit.notes
-        if fit.excluded is not None:
-            excluded[t] = fit.excluded
-            continue
-        fits[t] = fit
+    learned = [t for t in candidates if t in fitted.metrics]
+    files = {"split": str(models_dir / "split.csv")}
+    for t, fit in fitted.fits.items():
         files[t] = str(models_dir / f"{t}.json")
         if fit.gp is not None:
             files[f"gp_{t}"] = str(models_dir / f"gp_{t}.json")
-        if fit.baseline_settings is not None:
-            baseline_settings[t] = fit.baseline_settings
-        metrics[t] = fit.metrics
-        if plots:  # written below, with everything else
+        if plots_dir is not None:
             files[f"{t}_plots"] = [str(p) for p in _plot_paths(t, plots_dir)]
-        if _best_model(fit.metrics) is not None:
-            best[t] = _best_model(fit.metrics)
-
-    learned = [t for t in candidates if t in metrics]
-    if REQUIRED_FOR_PREDICT not in learned:
-        why = excluded.get(REQUIRED_FOR_PREDICT, "not among the targets")
-        raise InputError(f"no {REQUIRED_FOR_PREDICT} model could be learned ({why}); `toolpoint predict` needs one, "
-                         "so nothing was written", file=path, field=REQUIRED_FOR_PREDICT)
-    with single_thread_blas():
-        unc = _uncertainty(data, fits, train_idx, anfis, int(cv_folds), int(seed))
     files["uncertainty"] = str(models_dir / calibration.FILE_NAME)
     files["metrics_json"] = str(models_dir / "metrics.json")
     files["metrics_csv"] = str(models_dir / "metrics.csv")
-    result = LearnResult(
-        source=str(path),
-        settings={
-            "test_size": int(test_size),
-            "mfs": list(np.broadcast_to(anfis["n_mfs"], (len(INPUTS),)).tolist()),
-            "mf": mf,
-            "order": anfis["order"],
-            "epochs": anfis["epochs"],
-            "step_size": anfis["step_size"],
-            "seed": int(seed),
-            "log_target": anfis["log_target"],
-            "baselines": bool(baselines),
-            "identifiable_ratio": IDENTIFIED_RATIO,
-            "identifiable_share": IDENTIFIABLE_SHARE,
-            "cv_folds": int(cv_folds),
-        },
-        inputs=list(INPUTS),
-        n_rows=data.n_rows,
-        n_ok=len(data.ids),
-        n_train=int(len(train_idx)),
-        n_test=int(len(test_idx)),
-        n_test_outside_training_range=outside,
-        targets=learned,
-        excluded=excluded,
-        identifiable_share=data.share,
-        units={t: UNITS[t] for t in learned},
-        metrics=metrics,
-        baseline_settings=baseline_settings,
-        best_test_model=best,
-        paper={t: dict(PAPER[t], n=PAPER_N_TEST) for t in candidates if t in PAPER},
+    return LearnResult(
+        source=str(data.path), settings=settings, inputs=list(INPUTS), n_rows=data.n_rows, n_ok=len(data.ids),
+        n_train=int(len(train_idx)), n_test=int(len(test_idx)), n_test_outside_training_range=outside,
+        targets=learned, excluded=fitted.excluded, identifiable_share=data.share,
+        units={t: UNITS[t] for t in learned}, metrics=fitted.metrics, baseline_settings=fitted.baseline_settings,
+        best_test_model=fitted.best, paper={t: dict(PAPER[t], n=PAPER_N_TEST) for t in candidates if t in PAPER},
         files=files,
         uncertainty={t: {"kind": u.kind, "sigma_log10": u.sigma_log10, "coverage90": u.cv.get("coverage90", math.nan),
                          "n": u.cv.get("n", 0), "reason": u.reason} for t, u in unc.items()},
-        notes=notes,
-        target_notes=target_notes,
-        models_dir=str(models_dir),
+        notes=notes, target_notes=fitted.target_notes, models_dir=str(models_dir),
         plots_dir=None if plots_dir is None else str(plots_dir),
     )
-    # everything is fitted: only now write, so that a failure above leaves the folder as it was
+
+
+def _write_all(result: LearnResult, data: _Data, test_idx, fits: dict, unc: dict, models_dir: Path,
+               plots_dir: Path | None) -> None:
+    """Split, models, GP baselines, plots, uncertainty, metrics and the manifest (each file atomically)."""
     _write_split(models_dir / "split.csv", data.ids, test_idx)
     for t, fit in fits.items():
         _save_model(fit.model, models_dir / f"{t}.json")
@@ -923,12 +936,11 @@ def learn(
                     json.dump(fit.gp, fh, allow_nan=False)
             except OSError as err:
                 raise _writing(models_dir / f"gp_{t}.json")(err) from None
-        if plots:
+        if plots_dir is not None:
             _write_plots(t, fit, plots_dir)
     try:
         calibration.write_uncertainty(models_dir / calibration.FILE_NAME, unc)
     except OSError as err:
         raise _writing(models_dir / calibration.FILE_NAME)(err) from None
     _write_metrics(result, models_dir / "metrics.json", models_dir / "metrics.csv")
-    _write_manifest(models_dir, learned, [t for t, fit in fits.items() if fit.gp is not None])
-    return result
+    _write_manifest(models_dir, result.targets, [t for t, fit in fits.items() if fit.gp is not None])

@@ -7,8 +7,8 @@ For tool i, ``n_samples`` draws of every uncertain input are propagated together
 * the spindle–holder subassembly, as bootstrap replicates of its inverse RCSA
   (:func:`~toolpoint.dynamics.inverse_rcsa.subassembly_replicates`) when it was measured with a blank;
 * the cutting coefficients, log-normal around the library's or the preset's values (:mod:`.materials`):
-  K_t scales the zero-order limit exactly (a_lim ∝ 1/K_t), K_r changes the directional factor and is taken in
-  :data:`KR_BINS` quantile bins, each at its bin's median.
+  each sample's own K_t and K_r set its directional eigenvalues in the zero-order limit
+  (:func:`~toolpoint.stability.zoa_batch.directional_eigenvalues`).
 
 The tool-point receptance of every joint sample is computed at once
 (:meth:`~toolpoint.dynamics.model.ToolPointModel.tool_point` on an (n, 4) array) and the zero-order limit of
@@ -47,7 +47,7 @@ from ..dynamics.subassembly import Subassembly
 from ..identification.params import PARAMS
 from ..stability.cutting import CuttingConditions
 from ..stability.milling import average_directional_matrix
-from ..stability.zoa_batch import zoa_limits
+from ..stability.zoa_batch import directional_eigenvalues, zoa_limits
 
 __all__ = ["CAP_FACTOR", "QUANTILES", "KR_BINS", "POCKET_GAIN", "ToolJob", "ToolEvaluation", "evaluate_tool",
            "pockets", "robust_min"]
@@ -58,8 +58,10 @@ CAP_FACTOR = 20.0
 QUANTILES = (0.05, 0.5, 0.95)
 #: Depth grid points of the probability-of-stability map.
 N_DEPTHS = 100
-#: Quantile bins of the sampled K_r (each bin's limits computed at its median K_r).
+#: Quantile bins of the sampled K_r for its first-order share of the variance (the limits use each sample's K_r).
 KR_BINS = 4
+#: Parts per refined FRF interval in the batched limits (zoa_batch.zoa_limits).
+SUBDIVIDE = 2
 #: A pocket is recommended only where its robust 5 % limit exceeds the everywhere-stable depth by this factor.
 POCKET_GAIN = 1.25
 
@@ -224,20 +226,18 @@ def _samples(job: ToolJob, rng: np.random.Generator):
 
 
 def _limits(job: ToolJob, H: np.ndarray, kt_factor: np.ndarray, kr: np.ndarray, cap: float):
-    """Limits (m) of the median (G,) and of every sample (n, G), and each sample's K_r bin."""
+    """Limits (m) of the median (G,) and of every sample with its own K_t, K_r (n, G), and each sample's K_r
+    quartile (for the variance shares)."""
     cut = job.cutting
-    nominal = zoa_limits(job.freq_hz, H[0], cut, job.rpm, cap_m=cap)
+    # each sample its own cutting coefficients, exactly; row 0 the median joint with the nominal ones; one call
+    lam = np.vstack([directional_eigenvalues(cut), directional_eigenvalues(cut, kt_factor, kr)])
+    limits = zoa_limits(job.freq_hz, H, cut, job.rpm, cap_m=cap, directional=lam, subdivide=SUBDIVIDE)
+    nominal, samples = limits[0], limits[1:]
     n = len(kr)
     bins = min(KR_BINS, n) if job.cutting_sigma_ln[1] > 0 else 1
-    order = np.argsort(kr, kind="stable")
     bin_of = np.empty(n, int)
-    samples = np.empty((n, job.rpm.size))
-    for b, idx in enumerate(np.array_split(order, bins)):
+    for b, idx in enumerate(np.array_split(np.argsort(kr, kind="stable"), bins)):
         bin_of[idx] = b
-        c = replace(cut, radial_ratio=float(np.median(kr[idx]))) if bins > 1 else cut
-        # computed to cap × the largest K_t factor, so that a capped value divided by its factor stays ≥ cap
-        lim = zoa_limits(job.freq_hz, H[1 + idx], c, job.rpm, cap_m=cap * float(kt_factor[idx].max()))
-        samples[idx] = np.minimum(lim / kt_factor[idx, None], cap)  # a_lim ∝ 1/K_t exactly
     return nominal, samples, bin_of
 
 

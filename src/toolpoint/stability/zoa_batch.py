@@ -35,14 +35,14 @@ from .cutting import CuttingConditions
 from .milling import average_directional_matrix, check_rpm
 from .zoa import interval_parts, refine_frf_grid
 
-__all__ = ["zoa_limits"]
+__all__ = ["zoa_limits", "directional_eigenvalues"]
 
 # (sample, piece, lobe, speed) entries handled per block: bounds memory (~100 B each).
 _BLOCK_ENTRIES = 2_000_000
 
 
 def zoa_limits(freq_hz, receptance, cutting: CuttingConditions, rpm, *, cap_m: float = np.inf,
-               subdivide: int = 4) -> np.ndarray:
+               subdivide: int = 4, directional=None) -> np.ndarray:
     """Zero-order stability limits (axial depth, m) of a symmetric tool for many receptances.
 
     Parameters
@@ -62,6 +62,10 @@ def zoa_limits(freq_hz, receptance, cutting: CuttingConditions, rpm, *, cap_m: f
     subdivide : int, default 4
         Each piece between FRF points is split in this many parts, each
         interpolated linearly in the tooth period (error ∝ 1/subdivide²).
+    directional : array_like, shape (N, 2), optional
+        Per receptance, the two eigenvalues of the average directional matrix (N/m², with K_t;
+        :func:`directional_eigenvalues`) — each sample its own cutting coefficients; default: those of
+        ``cutting`` for all.
 
     Returns
     -------
@@ -93,11 +97,12 @@ def zoa_limits(freq_hz, receptance, cutting: CuttingConditions, rpm, *, cap_m: f
     single = H.ndim == 1
     H = np.atleast_2d(H)
     grid = check_rpm(rpm)
-    phi_st, phi_ex = cutting.immersion_angles
-    h0 = average_directional_matrix(cutting.teeth, cutting.tangential_coeff, cutting.radial_ratio, phi_st, phi_ex)
-    tr, det = np.trace(h0), np.linalg.det(h0)
-    root = np.sqrt(complex(tr * tr / 4 - det))
-    lam = np.array([tr / 2 + root, tr / 2 - root])
+    if directional is None:
+        lam = np.broadcast_to(directional_eigenvalues(cutting), (H.shape[0], 2))
+    else:
+        lam = np.asarray(directional, complex)
+        if lam.shape != (H.shape[0], 2):
+            raise ValueError(f"directional must have shape ({H.shape[0]}, 2), got {lam.shape}")
     period = 1.0 / grid[::-1]  # ascending, 1/rpm
     G = grid.size
     qmax = np.zeros((H.shape[0], G))  # 1/a_lim, 1/m; 0 = no lobe
@@ -108,12 +113,56 @@ def zoa_limits(freq_hz, receptance, cutting: CuttingConditions, rpm, *, cap_m: f
     chunk = max(1, int(_BLOCK_ENTRIES // max(1, 4 * G)))
     for s0 in range(0, H.shape[0], chunk):
         fs, Hs = _refined(f, H[s0:s0 + chunk])  # (n, F') each: the samples' own refined grids, padded
-        mu = lam[None, :, None] * Hs[:, None, :]  # (n, 2, F')
+        mu = lam[s0:s0 + chunk, :, None] * Hs[:, None, :]  # (n, 2, F')
         _accumulate(qmax[s0:s0 + chunk], mu, fs, 60.0 / cutting.teeth, period, rmin, rmax, q_cap, subdivide, step)
     with np.errstate(divide="ignore"):
         limit = np.where(qmax > 0, 1.0 / np.where(qmax > 0, qmax, 1.0), np.inf)[:, ::-1]
     limit = np.minimum(limit, cap_m)
     return limit[0] if single else limit
+
+
+def directional_eigenvalues(cutting: CuttingConditions, kt_factor=None, radial_ratio=None) -> np.ndarray:
+    """The two eigenvalues of the average directional matrix (N/m²), for one cut or per sample.
+
+    Parameters
+    ----------
+    cutting : CuttingConditions
+        Teeth, K_t, K_r, immersion, milling.
+    kt_factor, radial_ratio : array_like, shape (N,), optional
+        Per sample: K_t as a multiple of ``cutting``'s, and K_r (default ``cutting``'s).
+
+    Returns
+    -------
+    ndarray, shape (2,) or (N, 2)
+        Complex eigenvalues λ of A₀ = N K_t/(2π) [α]; the zero-order eigenvalues are λ Φ(ω).
+
+    Examples
+    --------
+    >>> from toolpoint.stability import CuttingConditions
+    >>> cut = CuttingConditions(teeth=2, tangential_coeff=6e8, radial_ratio=0.3, radial_immersion=1.0)
+    >>> lam = directional_eigenvalues(cut, [1.0, 2.0], [0.3, 0.3])
+    >>> bool(np.allclose(lam[1], 2 * lam[0])) and bool(np.allclose(lam[0], directional_eigenvalues(cut)))
+    True
+    """
+    phi_st, phi_ex = cutting.immersion_angles
+
+    def eig(kt, kr):
+        h0 = average_directional_matrix(cutting.teeth, kt, kr, phi_st, phi_ex)
+        tr, det = np.trace(h0), np.linalg.det(h0)
+        root = np.sqrt(complex(tr * tr / 4 - det))
+        return np.array([tr / 2 + root, tr / 2 - root])
+
+    if kt_factor is None and radial_ratio is None:
+        return eig(cutting.tangential_coeff, cutting.radial_ratio)
+    n = np.size(kt_factor if kt_factor is not None else radial_ratio)
+    ktf = np.broadcast_to(np.ones(n) if kt_factor is None else np.asarray(kt_factor, float), (n,))
+    kr = np.broadcast_to(np.full(n, cutting.radial_ratio) if radial_ratio is None else
+                         np.asarray(radial_ratio, float), (n,))
+    # λ ∝ K_t: one eigen-solve per distinct K_r, scaled by each sample's K_t
+    out = np.empty((n, 2), complex)
+    for i in range(n):
+        out[i] = eig(cutting.tangential_coeff, kr[i]) * ktf[i]
+    return out
 
 
 def _refined(f, H):
