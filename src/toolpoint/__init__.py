@@ -2,7 +2,8 @@
 
 Data flow, one sub-package per step (imports go one way, no cycle inside a sub-package; checked in CI)::
 
-    frf, errors → trust → io → dynamics → identification → learning → campaign → stability → simulation → recommend → shop → cli
+    frf, errors → trust → io → dynamics → identification → learning → campaign → stability → simulation
+    → recommend → shop → cli
 
 measured FRFs enter through ``io`` and the trusted band (``trust``), test cuts through ``io`` and ``shop``.
 

@@ -87,7 +87,7 @@ def test_figures_drawn_when_a_tool_is_opened(report, tmp_path):
 @pytest.mark.skipif(CHROMIUM is None, reason="Chromium is not installed (apt-get install chromium); CI installs it")
 def test_screenshot(report, tmp_path):
     shot = tmp_path / "shot.png"
-    run = subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--window-size=1200,900",
+    run = subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--window-size=1200,1400",
                           f"--screenshot={shot}", report.as_uri()], capture_output=True, text=True, timeout=60)
     assert run.returncode == 0, run.stderr[-300:]
     from matplotlib.image import imread

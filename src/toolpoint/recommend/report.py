@@ -39,8 +39,9 @@ __all__ = ["write_report", "SHOWN", "FRF_BINS", "RPM_BINS", "MAP_SHAPE"]
 #: Columns of recommendations.csv shown in the overview table, with their headings.
 SHOWN = {"id": "tool", "status": "status", "diameter_mm": "D mm", "overhang_mm": "L mm", "teeth": "N",
          "material": "material", "rpm": "rpm", "depth_mm": "depth mm (recommended)",
-         "limit_p05_mm": "5 % limit mm", "limit_p50_mm": "50 % limit mm", "min_limit_p05_mm": "stable everywhere mm",
-         "kind": "point", "outside_range": "outside learned (D, L) range", "error": "error / notes"}
+         "p_stable": "P(stable)", "limit_p05_mm": "5 % limit mm", "limit_p50_mm": "50 % limit mm",
+         "min_limit_p05_mm": "stable everywhere mm", "kind": "point", "dominant_uncertainty": "dominant uncertainty",
+         "outside_range": "outside learned (D, L) range", "error": "error / notes"}
 
 #: Frequency bins of the FRF band in the report (max of the 95 % and median, min of the 5 % curve per bin).
 FRF_BINS = 240
@@ -272,7 +273,8 @@ def write_report(out_dir, path=None) -> Path:
                     v = v if k in ("id", "teeth") else (f"{float(v):.0f}" if k == "rpm" else f"{float(v):.4g}")
                 except ValueError:
                     v = v.replace(">=", "≥ ")
-                cells.append(f'<td class="t">{html.escape(v)}</td>' if k in ("error", "material", "kind", "status")
+                cells.append(f'<td class="t">{html.escape(v)}</td>' if k in ("error", "material", "kind", "status",
+                                                                                 "dominant_uncertainty")
                              else f"<td>{html.escape(v)}</td>")
         body.append(f'<tr class="{html.escape(r.get("status", ""))}">{"".join(cells)}</tr>')
         if r.get("status") != "ok":

@@ -247,9 +247,7 @@ def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_
         sub = subs[t.holder]
         keep = sub.freq_hz > 0
         rep_R, rep_note = reps[t.holder]
-        if rep_note:
-            notes.append(rep_note)
-        notes_of[t.id] = (t, notes, delta)
+        notes_of[t.id] = (t, notes, delta, [rep_note] if rep_note else [])  # the holder's note: in the tool file
         jobs.append(ToolJob(t.id, c.family, t.diameter_mm, t.overhang_mm, t.flute_length_mm, sub.freq_hz[keep],
                             sub.R[keep], t.holder, t.cutting, np.linspace(t.rpm_min, t.rpm_max, rpm_points),
                             dist.log10_median[k], dist.sigma_log10[k], n_samples, _seed(seed, t.id), margin,
@@ -280,14 +278,14 @@ def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_
                 report(f"error: {row['error']}")
                 append(row)
             for job, result in _execute(jobs, workers, client):
-                t, notes, delta = notes_of[job.id]
+                t, notes, delta, holder_notes = notes_of[job.id]
                 if isinstance(result, Exception):
                     msg = f"{t.id}: {' '.join(f'{type(result).__name__}: {result}'.split())}"
                     report(f"error: {msg}")
                     append(_row(t, "failed", error=msg))
                     continue
                 notes = notes + result.summary.get("engine_notes", [])
-                _write_tool(tools_dir, t.id, result, {"notes": notes, "outside_range": delta,
+                _write_tool(tools_dir, t.id, result, {"notes": holder_notes + notes, "outside_range": delta,
                                                       "cutting": {"teeth": t.cutting.teeth,
                                                                   "tangential_coeff": t.cutting.tangential_coeff,
                                                                   "radial_ratio": t.cutting.radial_ratio,
