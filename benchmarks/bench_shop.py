@@ -1,6 +1,11 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
+        [--only update] [--shops zoa,noisy,sim] [--cases cornelius,example] [--max-cuts 10] [--verbose]
+        [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm", "boundary_width": 0.1}']
+
+Prints the machine, date and load first; per case and shop the median cuts to converge, the fraction converged,
+the median (max) chattering cuts and the CPU per update (median, max); ``--verbose`` one line per seed.
 
 CPU time (time.process_time), not wall time: the machine is shared.
 
@@ -165,28 +170,40 @@ def noisy_shop(prior, rng_blur=0.03, f_noise=0.005):
     return shop
 
 
-def bench_update(seeds, quick, shops=("zoa", "noisy", "sim")):
-    print("\n## update: virtual campaigns (info rule, risk 0.3, SMC 1000 samples)")
-    cases = (cornelius_2024(0.1), example_tool(0.15))
-    for prior in cases:
+def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius", "example"), update_kw=None,
+                 max_cuts=10, verbose=False):
+    update_kw = dict(update_kw or {})
+    n_s = update_kw.pop("n_samples", 600 if quick else 1000)
+    n_l = update_kw.pop("lobe_samples", 300 if quick else 400)
+    print(f"\n## update: virtual campaigns (info rule, SMC {n_s} samples, {n_l} lobe samples, {seeds} seeds 0…"
+          f"{seeds - 1}, at most {max_cuts} cuts; update options {update_kw or 'default'})")
+    priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
+    for case in cases:
+        prior = priors[case]
         for shop_name in shops:
-            if shop_name == "sim" and prior is not cases[0]:
+            if shop_name == "sim" and case != "cornelius":
                 continue  # the simulated shop on the Cornelius case only (its cuts cost ~1 s each)
-            conv, chat, cpu_max, fails = [], [], 0.0, 0
+            conv, chat, cpu, fails = [], [], [], 0
             for seed in range(seeds):
                 shop = {"zoa": None, "noisy": noisy_shop(prior), "sim": sim_shop(prior)}[shop_name]
                 truth = sdm_truth(prior) if shop_name == "sim" else None
-                r = virtual_campaign(prior, rng=np.random.default_rng(seed), shop=shop, max_cuts=10, true_limit=truth,
-                                     n_samples=600 if quick else 1000, lobe_samples=300 if quick else 400)
+                r = virtual_campaign(prior, rng=np.random.default_rng(seed), shop=shop, max_cuts=max_cuts,
+                                     true_limit=truth, n_samples=n_s, lobe_samples=n_l, **update_kw)
                 conv.append(r.converged_after if r.converged_after is not None else np.inf)
                 made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
                 chat.append(sum(not c.stable for c in made))
-                cpu_max = max(cpu_max, max(r.update_cpu_s))
+                cpu.extend(r.update_cpu_s)
                 fails += r.converged_after is None
+                if verbose:
+                    print(f"   seed {seed}: converged after {r.converged_after}, {chat[-1]} chattering; cuts "
+                          + " ".join(f"{c.rpm:.0f}/{1e3 * c.depth_m:.2f}{'s' if c.stable else 'C'}" for c in r.cuts)
+                          + f"; width {np.round(r.width, 2).tolist()}", flush=True)
             conv = np.array(conv)
+            p90 = np.sort(conv)[int(np.ceil(0.9 * conv.size)) - 1]  # inf where a tenth did not converge
             print(f"{prior.name[:40]:40s} shop {shop_name:5s}: cuts to converge median {np.median(conv):.1f} "
-                  f"(p90 {np.quantile(conv, 0.9):.1f}; {fails}/{seeds} not within 10), chattering cuts median "
-                  f"{np.median(chat):.1f} (max {max(chat)}), slowest update {cpu_max:.1f} s CPU")
+                  f"(p90 {p90:.1f}), converged {seeds - fails}/{seeds} within {max_cuts}; "
+                  f"chattering cuts median {np.median(chat):.1f} (max {max(chat)}); CPU per update median "
+                  f"{np.median(cpu):.1f} s, max {max(cpu):.1f} s", flush=True)
 
 
 def bench_sampler():
@@ -215,6 +232,10 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", choices=("cut", "update", "sampler"))
     ap.add_argument("--shops", default="zoa,noisy,sim", help="comma-separated shops of the update benchmark")
+    ap.add_argument("--cases", default="cornelius,example", help="comma-separated priors: cornelius, example")
+    ap.add_argument("--update", default="{}", help="JSON of extra update() options, e.g. '{\"n_samples\": 500}'")
+    ap.add_argument("--max-cuts", type=int, default=10)
+    ap.add_argument("--verbose", action="store_true", help="one line per campaign")
     a = ap.parse_args()
     header()
     if a.only in (None, "cut"):
@@ -223,7 +244,10 @@ def main():
     if a.only in (None, "sampler"):
         bench_sampler()
     if a.only in (None, "update"):
-        bench_update(a.seeds, a.quick, a.shops.split(","))
+        import json
+
+        bench_update(a.seeds, a.quick, a.shops.split(","), a.cases.split(","), json.loads(a.update), a.max_cuts,
+                     a.verbose)
 
 
 if __name__ == "__main__":

@@ -196,3 +196,50 @@ def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
     p.write_text("rpm,depth_mm,result,record\n12000,0.8,stable,c1.wav\n")
     with pytest.raises(InputError, match="line 2: the table says stable, its record c1.wav says chatter"):
         read_test_cuts(p, teeth=4)
+
+
+@pytest.mark.slow
+def test_virtual_campaigns_on_the_example_tool_meet_the_targets():
+    """The loop on the example tool (3 lightly damped modes, σ 0.15), its own forward model, seeds 0–4 with the
+    settings of ``benchmarks/bench_shop.py``: median cuts to converge ≤ 6 and median chattering cuts ≤ 1 (issue
+    25's targets). Measured on these seeds (2026-11-25): cuts 6, 5, 4, not within 8, 4 (median 5: margin one cut);
+    chattering cuts 1, 1, 1, 6, 1 (median 1: no margin); 4/5 converged (no margin). Seed 3 is a truth in the prior's
+    tail (K_t 3.3 σ above its median). ~2.5 min CPU."""
+    from toolpoint.shop.model import example_tool
+
+    pr = example_tool(0.15)
+    cuts, chat = [], []
+    for seed in range(5):
+        r = virtual_campaign(pr, rng=np.random.default_rng(seed), max_cuts=8, n_samples=500, lobe_samples=200)
+        cuts.append(np.inf if r.converged_after is None else r.converged_after)
+        made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
+        chat.append(sum(not c.stable for c in made))
+    assert np.median(cuts) <= 6, cuts
+    assert np.median(chat) <= 1, chat
+    assert sum(np.isfinite(cuts)) >= 4, cuts
+
+
+@pytest.mark.slow
+def test_sdm_forward_model_follows_cuts_that_follow_the_sdm():
+    """A narrow prior (σ 0.02: the posterior stays near the SDM references) and cuts labelled by the SDM limit of
+    its median tool at speeds where the ZOA is ~35 % too low (flip lobes, 50 % immersion): the ``forward="sdm"``
+    posterior's band holds the SDM limit and its median is within 10 %; the zero-order posterior's is not.
+    (With a wide prior the zero-order posterior moves its parameters to explain such cuts and the references'
+    ratio no longer fits the corrected posterior: docs/design/shop.md.)"""
+    from toolpoint.stability import ModalModel, sdm_lobes
+
+    pr = cornelius_2024(0.02)
+    th = pr.theta(np.zeros((1, pr.sigma.size)))[0]
+    mm = ModalModel(th[:2], th[4:6], th[2:4] / (2 * np.pi * th[:2]) ** 2)
+    rpm = np.array([7000.0, 7500.0])
+    a_sdm = sdm_lobes(mm, mm, pr.cutting, rpm=rpm).depth_m
+    cuts = [TestCut(float(r), float(a * q), bool(q < 1)) for r, a in zip(rpm, a_sdm) for q in (0.93, 1.07)]
+    med = {}
+    for fw in ("zoa", "sdm"):
+        post = update(pr, cuts, rng=np.random.default_rng(0), n_samples=300, lobe_samples=150, forward=fw,
+                      sdm_refs=2, rpm_grid=rpm)
+        med[fw] = post.limit_q_m[1] / a_sdm
+        if fw == "sdm":
+            assert np.all(post.limit_q_m[0] <= a_sdm) and np.all(a_sdm <= post.limit_q_m[2])
+    assert np.all(np.abs(med["sdm"] - 1) < 0.1), med
+    assert np.all(np.abs(med["zoa"] - 1) > 0.15), med

@@ -33,6 +33,10 @@ def register(sub) -> None:
                    help="next-cut rule: info = most reduction of the limit's band at the recommended speed with "
                    "P(chatter) ≤ risk (default); risk = most productive cut with P(chatter) ≤ risk")
     p.add_argument("--risk", help="largest P(chatter) of the next cut (default 0.3 for info, 0.1 for risk)")
+    p.add_argument("--forward", choices=("zoa", "sdm"), default="zoa",
+                   help="forward model: zoa = zero-order limit (default); sdm = zero-order corrected by the "
+                   "semi-discretisation at posterior samples (cuts that follow the SDM, low radial immersion; "
+                   "slower)")
     p.set_defaults(func=run)
 
 
@@ -58,7 +62,7 @@ def run(args) -> int:
     cuts = read_test_cuts(args.cuts, teeth=prior.cutting.teeth) if args.cuts else []
     use_agg()
     post = update(prior, cuts, rng=np.random.default_rng(int(seed)), n_samples=int(n), method=args.method,
-                  rule=args.rule, risk=risk)
+                  rule=args.rule, risk=risk, forward=args.forward)
     write_update(post, out)
     rc, nc = post.recommended, post.next_cut
     print(f"{len(cuts)} test cuts; recommended {rc['rpm']:.0f} rpm at {1e3 * rc['depth_m']:.3f} mm "
