@@ -84,7 +84,7 @@ MAX_PARTS = 16
 
 def interval_parts(freq_hz, values) -> np.ndarray:
     """Parts (1 … :data:`MAX_PARTS`) to split each FRF interval into: ⌈δ_i / :data:`MAX_TURN`⌉, with
-    δ_i = |Φ_{i+1} − Φ_i| / min(|Φ_i|, |Φ_{i+1}|); 1 from 0 Hz and where Φ is 0 or not finite.
+    δ_i = abs(Φ_(i+1) − Φ_i) / min(abs(Φ_i), abs(Φ_(i+1))); 1 from 0 Hz and where Φ is 0 or not finite.
 
     Parameters
     ----------
