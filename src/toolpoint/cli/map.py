@@ -101,8 +101,8 @@ def _figure(res, lobes):
     fig = Figure(figsize=(11, 4.5), constrained_layout=True)
     ax = fig.subplots(1, 2)
     R, A = np.meshgrid(res.rpm, 1e3 * res.depth_m)
-    ax[0].plot(R[res.stable], A[res.stable], "o", ms=2, color="C2", label="simulated stable")
-    ax[0].plot(R[~res.stable], A[~res.stable], "x", ms=2, color="C3", label="simulated chatter")
+    ax[0].plot(R[res.stable], A[res.stable], "o", ms=2, color="#0072B2", label="simulated stable")
+    ax[0].plot(R[~res.stable], A[~res.stable], "x", ms=2, color="#E69F00", label="simulated chatter")
     if lobes is not None:
         ax[0].plot(lobes.rpm, np.minimum(lobes.depth_mm, 1e3 * res.depth_m.max() * 1.1), "k-", lw=1, label="SDM")
     ax[0].set(xlabel="spindle speed (rpm)", ylabel="axial depth (mm)", title="stability")
