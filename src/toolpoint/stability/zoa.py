@@ -31,7 +31,7 @@ speed is the minimum over lobes and over both eigenvalue branches.
 Near a sharp resonance Φ turns by up to ~0.25 rad between 1 Hz points, and one
 such interval spans hundreds of rpm at low lobe numbers: with μ linear between
 the FRF points the limit would be drawn as straight chords. So each FRF
-interval is first split into ⌈δ/:data:`MAX_TURN`⌉ equal parts (at most
+interval is first split into ceil(δ / :data:`MAX_TURN`) equal parts (at most
 :data:`MAX_PARTS`), δ = |Φ_{i+1} − Φ_i| / min(|Φ_i|, |Φ_{i+1}|) (≈ the phase
 turn plus the relative change of |Φ|; the largest over Φ_xx, Φ_yy, Φ_xy, Φ_yx),
 and Φ is interpolated at the new frequencies by cubic Hermite polynomials
@@ -83,7 +83,7 @@ MAX_PARTS = 16
 
 
 def interval_parts(freq_hz, values) -> np.ndarray:
-    """Parts (1 … :data:`MAX_PARTS`) to split each FRF interval into: ⌈δ_i / :data:`MAX_TURN`⌉, with
+    """Parts (1 … :data:`MAX_PARTS`) to split each FRF interval into: ceil(δ_i / t), t = :data:`MAX_TURN`, with
     δ_i = abs(Φ_(i+1) − Φ_i) / min(abs(Φ_i), abs(Φ_(i+1))); 1 from 0 Hz and where Φ is 0 or not finite.
 
     Parameters
