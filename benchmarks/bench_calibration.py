@@ -43,6 +43,7 @@ from toolpoint.dynamics.assembly import load_assembly
 from toolpoint.dynamics.model import ToolPointModel
 from toolpoint.dynamics.subassembly import Subassembly
 from toolpoint.recommend.engine import robust_min
+from toolpoint.recommend.library import read_library, tool_file_stem
 from toolpoint.recommend.materials import PRESETS, UNCERTAINTY
 from toolpoint.recommend.run import run_library
 from toolpoint.stability import CuttingConditions
@@ -82,8 +83,6 @@ def tools(camp: Path, n: int, seed: int, sigma_pct=None) -> list[dict]:
 
 def library_tools(path: Path) -> list[dict]:
     """The tools of a library CSV (e.g. ``examples/tool_library.csv``) as :func:`tools` gives them."""
-    from toolpoint.recommend.library import read_library
-
     good, _ = read_library(path)
     return [dict(id=t.id, diameter_mm=t.diameter_mm, overhang_mm=t.overhang_mm, teeth=t.cutting.teeth,
                  holder=t.holder, material=t.material, radial_immersion=t.cutting.radial_immersion,
@@ -117,8 +116,6 @@ def campaign(camp: Path, n: int, seed: int, true_cutting: str, workers: int, lib
     rng = np.random.default_rng(seed + 1000)
     above, ratio, pred, obs, cpu, kinds = [], [], [], [], [], []
     for t in ts:
-        from toolpoint.recommend.library import tool_file_stem
-
         stem = tool_file_stem(t["id"])
         js = json.loads((tmp / "out" / "tools" / f"{stem}.json").read_text())
         arr = np.load(tmp / "out" / "tools" / f"{stem}.npz")

@@ -282,3 +282,17 @@ def test_limit_between_frf_points_follows_the_fine_frf():
     assert parts.max() > 1 and parts.max() <= 16
     sub = zoa_lobes(FRF(coarse, _two_mode(coarse)), None, c, rpm=rpm[::7])  # another speed grid: the same curve
     assert np.allclose(sub.depth_m, res.depth_m[::7], rtol=1e-12)
+
+
+def test_directional_eigenvalues_per_sample_are_those_of_each_samples_matrix():
+    """Each sample's own K_t, K_r: the eigenvalues of its average directional matrix (numpy.linalg.eigvals)."""
+    from toolpoint.stability.milling import average_directional_matrix
+    from toolpoint.stability.zoa_batch import directional_eigenvalues
+
+    rng = np.random.default_rng(3)
+    for cut in (CuttingConditions(3, 796e6, 0.212, 0.4, "up"), CuttingConditions(2, 6e8, 1 / 3, 1.0, "down")):
+        ktf, kr = np.exp(0.1 * rng.standard_normal(40)), cut.radial_ratio * np.exp(0.15 * rng.standard_normal(40))
+        lam = np.sort_complex(directional_eigenvalues(cut, ktf, kr))
+        ref = np.sort_complex(np.array([np.linalg.eigvals(average_directional_matrix(
+            cut.teeth, cut.tangential_coeff * k, r, *cut.immersion_angles)) for k, r in zip(ktf, kr)]))
+        assert np.allclose(lam, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())

@@ -145,24 +145,20 @@ def directional_eigenvalues(cutting: CuttingConditions, kt_factor=None, radial_r
     True
     """
     phi_st, phi_ex = cutting.immersion_angles
-
-    def eig(kt, kr):
-        h0 = average_directional_matrix(cutting.teeth, kt, kr, phi_st, phi_ex)
-        tr, det = np.trace(h0), np.linalg.det(h0)
-        root = np.sqrt(complex(tr * tr / 4 - det))
-        return np.array([tr / 2 + root, tr / 2 - root])
-
-    if kt_factor is None and radial_ratio is None:
-        return eig(cutting.tangential_coeff, cutting.radial_ratio)
-    n = np.size(kt_factor if kt_factor is not None else radial_ratio)
-    ktf = np.broadcast_to(np.ones(n) if kt_factor is None else np.asarray(kt_factor, float), (n,))
-    kr = np.broadcast_to(np.full(n, cutting.radial_ratio) if radial_ratio is None else
-                         np.asarray(radial_ratio, float), (n,))
-    # λ ∝ K_t: one eigen-solve per distinct K_r, scaled by each sample's K_t
-    out = np.empty((n, 2), complex)
-    for i in range(n):
-        out[i] = eig(cutting.tangential_coeff, kr[i]) * ktf[i]
-    return out
+    n = None if kt_factor is None and radial_ratio is None else np.size(
+        kt_factor if kt_factor is not None else radial_ratio)
+    ktf = np.ones(1 if n is None else n) if kt_factor is None else np.asarray(kt_factor, float).reshape(-1)
+    kr = (np.full(ktf.size, cutting.radial_ratio) if radial_ratio is None else
+          np.asarray(radial_ratio, float).reshape(-1))
+    # H₀ is linear in K_r (and ∝ K_t): H₀(K_r) = A + K_r B, so every sample's 2×2 at once, no loop over samples
+    a = average_directional_matrix(cutting.teeth, cutting.tangential_coeff, 0.0, phi_st, phi_ex)
+    b = average_directional_matrix(cutting.teeth, cutting.tangential_coeff, 1.0, phi_st, phi_ex) - a
+    h0 = ktf[:, None, None] * (a[None] + kr[:, None, None] * b[None])
+    tr = h0[:, 0, 0] + h0[:, 1, 1]
+    det = h0[:, 0, 0] * h0[:, 1, 1] - h0[:, 0, 1] * h0[:, 1, 0]
+    root = np.sqrt((tr * tr / 4 - det).astype(complex))
+    out = np.stack([tr / 2 + root, tr / 2 - root], axis=-1)
+    return out[0] if n is None else out
 
 
 def _refined(f, H):
