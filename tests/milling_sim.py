@@ -100,39 +100,3 @@ def microphone(sim, *, rpm, teeth, rate=44100.0, air_s=0.7, noise=0.02, fans=(61
     seg = out[n0:n0 + sig.size]
     seg += 0.5 * sig[:seg.size] / np.max(np.abs(sig))
     return out / (1.2 * np.max(np.abs(out))), rate, t0, t1
-
-
-def sim_shop(prior, *, record_seed=0):
-    """A shop for :func:`toolpoint.shop.campaign.virtual_campaign`: the true tool cut in the simulation, heard by
-    the microphone above, judged by :func:`toolpoint.shop.analyse_cut` (its verdict and chatter frequency)."""
-    from toolpoint.shop import analyse_cut
-    from toolpoint.shop.update import TestCut
-
-    c = prior.cutting
-    m = prior.modes
-    phi_st, phi_ex = c.immersion_angles
-
-    def shop(theta, rpm, depth_m, rng):
-        fn, k, z = theta[:m], theta[m:2 * m], theta[2 * m:3 * m]
-        kt, kr = theta[3 * m], theta[3 * m + 1]
-        sim = simulate(fn, k, z, teeth=c.teeth, kt=kt, kr=kr, phi_st=phi_st, phi_ex=phi_ex, rpm=[rpm],
-                       depth_m=[depth_m], revolutions=max(60, int(rpm / 100)), seed=int(rng.integers(1 << 30)))[0]
-        x, rate, *_ = microphone(sim, rpm=rpm, teeth=c.teeth, seed=int(rng.integers(1 << 30)))
-        r = analyse_cut(x, rate, rpm=rpm, teeth=c.teeth, full_scale=1.0)
-        return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz)
-    return shop
-
-
-def sdm_truth(prior):
-    """``true_limit`` for :func:`toolpoint.shop.campaign.virtual_campaign` with :func:`sim_shop`: the SDM limit."""
-    from toolpoint.stability import ModalModel, sdm_lobes
-
-    m = prior.modes
-
-    def limit(theta, rpm):
-        fn, k, z = theta[:m], theta[m:2 * m], theta[2 * m:3 * m]
-        mm = ModalModel(np.asarray(fn), np.asarray(z), np.asarray(k) / (2 * np.pi * np.asarray(fn)) ** 2)
-        from dataclasses import replace
-        cut = replace(prior.cutting, tangential_coeff=float(theta[3 * m]), radial_ratio=float(theta[3 * m + 1]))
-        return sdm_lobes(mm, mm, cut, rpm=rpm).depth_m
-    return limit

@@ -144,3 +144,41 @@ def test_bad_uncertainty_file_is_one_line(tmp_path):
     assert "campaign learn" in str(err.value) and err.value.file == str(p)
     with pytest.raises(InputError):
         learn(write_identified(tmp_path / "x", identified_rows(n=60, n_failed=0)), cv_folds=1, **QUIET)
+
+
+def test_samples_stay_where_the_nearby_frfs_bound_a_parameter(tmp_path):
+    """kr identified only by the small tools (D ≤ 18 mm); the large tools' intervals run into the search bound
+    above (their FRFs hardly depend on a stiff joint) and bound kr below only. A new large tool's kr samples stay
+    above those bounds — below the truth, which the unbounded distribution spilled far under."""
+    from toolpoint.campaign.distribution import JointPredictor
+
+    rows = identified_rows(n=90, n_failed=0, seed=4)
+    top = 1e9  # the search bound the open intervals run into
+    for r in rows:
+        if float(r["diameter_mm"]) > 18:
+            v = float(r["kr"])
+            r["kr"], r["kr_lo"], r["kr_hi"] = repr(float(3 * v)), repr(float(0.6 * v)), repr(top)  # value: anywhere
+    res = write_identified(tmp_path / "r", rows)
+    learn(res, mfs=(2, 2), epochs=30, **QUIET)
+    doc = json.loads((res / "models" / calibration.FILE_NAME).read_text())["parameters"]["kr"]
+    assert sum(v is not None for v in doc["window_lo"]) == sum(float(r["diameter_mm"]) > 18 for r in rows)
+    pred = JointPredictor(res / "models")
+    u = pred.parameters["kr"]
+    D, L = np.array([26.0, 12.0]), np.array([50.0, 50.0])
+    lo, hi = u.window(np.column_stack([D, L]))
+    truth = np.log10(1.4e6 * (D / 16) ** 2.5)
+    assert lo[0] < truth[0] and lo[0] > truth[0] - 0.3 and np.isneginf(lo[1]) and np.all(np.isposinf(hi))
+    dist = pred.predict(D, L)
+    s = np.log10(dist.sample(0, 4000, np.random.default_rng(1))[:, 2])
+    assert s.min() >= lo[0] - 1e-12
+    untruncated = dist.log10_median[0, 2] + dist.sigma_log10[0, 2] * np.random.default_rng(1).standard_normal(4000)
+    assert np.mean(untruncated < lo[0]) > 0.2  # where the FRFs say kr cannot be
+    q = np.log10(dist.quantiles([0.05, 0.5])[:, 0, 2])
+    assert q[0] >= lo[0] - 1e-12 and q[1] >= dist.log10_median[0, 2]
+    # the small tool, identified by its neighbours: not truncated
+    s_small = np.log10(dist.sample(1, 4000, np.random.default_rng(1))[:, 2])
+    z = (s_small - dist.log10_median[1, 2]) / dist.sigma_log10[1, 2]
+    assert abs(np.mean(z)) < 0.1 and abs(np.std(z) - 1) < 0.1
+    # written and read back as they were
+    again = calibration.read_uncertainty(res / "models" / calibration.FILE_NAME)["kr"]
+    assert np.allclose(again.window(np.column_stack([D, L]))[0][:1], lo[:1])

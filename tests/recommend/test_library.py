@@ -351,14 +351,31 @@ def test_a_limit_at_the_depth_cap_is_shown_as_at_least_the_cap():
     lq = np.array([[cap, 4e-3], [cap, 5e-3], [cap, 6e-3]])
     samples = np.full((10, 2), cap)
     job = SimpleNamespace(rpm=rpm, margin=0.1)
-    p = _point(job, nominal, lq, lq[0], samples, cap, 0, "pocket", lq[0][0])
+    p = _point(job, nominal, lq, lq[0], samples, cap, 1.0, 0, "pocket", lq[0][0])
     assert p["capped"] == ["limit_nominal_mm", "limit_p05_mm", "limit_p50_mm", "limit_robust_p05_mm"]
-    assert _point(job, nominal, lq, lq[0], samples, cap, 1, "pocket", lq[0][1])["capped"] == []
+    assert _point(job, nominal, lq, lq[0], samples, cap, 1.0, 1, "pocket", lq[0][1])["capped"] == []
     joint = {k: {"p05": 1.0, "p50": 1.0, "p95": 1.0} for k in ("kt", "ct", "kr", "cr")}
     summary = {"points": [p], "joint": joint, "min_limit_mm": {"p05": 4.0}, "cap_mm": 1e3 * cap}
     row = _ok_row(SimpleNamespace(id="EM28-80"), summary, 0.0, [])
     assert row["limit_p05_mm"] == row["limit_p50_mm"] == row["limit_nominal_mm"] == ">=9.68"
     assert row["rpm"] == "1000"
+
+
+def test_a_depth_past_the_flutes_is_the_flute_length():
+    """bench_calibration found 417 mm recommended for a D 8.7 / L 15.5 mm tool whose limit lies above the depth cap:
+    no recommendation is deeper than the modelled flutes, and it says so."""
+    from types import SimpleNamespace
+
+    from toolpoint.recommend.engine import _point
+
+    rpm = np.array([1000.0, 2000.0])
+    lim = np.array([[0.4, 0.5], [0.45, 0.55], [0.5, 0.6]])  # m: far past any flute
+    samples = np.full((10, 2), 0.5)
+    job = SimpleNamespace(rpm=rpm, margin=0.1)
+    p = _point(job, lim[1], lim, lim[0], samples, np.inf, 0.02, 1, "pocket", lim[0][1])
+    assert p["depth_mm"] == pytest.approx(20.0) and p["flute_limited"] and p["p_stable"] == 1.0
+    q = _point(job, lim[1], lim, lim[0], samples, np.inf, 1.0, 1, "pocket", lim[0][1])
+    assert q["depth_mm"] == pytest.approx(450.0) and not q["flute_limited"]
 
 
 def test_tool_ids_from_the_file_never_become_paths_and_csv_cells_never_formulas(tmp_path):

@@ -122,6 +122,10 @@ def test_cli_cut_writes_json_and_plot(tmp_path, capsys):
     assert doc["verdict"] == "chatter" and abs(doc["chatter_hz"] / 1234 - 1) < 0.01
     assert {"start_s", "end_s", "verdict", "chatter_hz"} <= set(doc["segments"][0])
     assert doc["recommended_rpm"] > 0 and png.stat().st_size > 10_000
+    # --dominance reaches the criterion: a chatter line of a few % of the harmonic's power is not "strong" at 100
+    assert main(["cut", str(wav), "--rpm", "6000", "--teeth", "4", "--dominance", "100", "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["criterion"]["dominance"] == 100 and doc["verdict"] == "stable"
 
 
 def _write_wav(path, x, rate=44100):
@@ -133,7 +137,7 @@ def _write_wav(path, x, rate=44100):
 
 @pytest.mark.parametrize("case,field", [
     ("silent", "samples"), ("clipped", "samples"), ("short", "samples"), ("rpm", "--rpm"), ("teeth", "teeth"),
-    ("teeth_word", "--teeth"), ("rpm_huge", "rpm")])
+    ("teeth_word", "--teeth"), ("rpm_huge", "rpm"), ("dominance", "--dominance")])
 def test_bad_input_is_one_line_exit_2(case, field, tmp_path, capsys):
     x, rate, *_ = shop_record(rpm=6000, teeth=4, air_s=0.3, cut_s=0.6, seed=5)
     args = ["--rpm", "6000", "--teeth", "4"]
@@ -151,6 +155,8 @@ def test_bad_input_is_one_line_exit_2(case, field, tmp_path, capsys):
         args = ["--rpm", "6000", "--teeth", "four"]
     elif case == "rpm_huge":
         args = ["--rpm", "6e6", "--teeth", "4"]
+    elif case == "dominance":
+        args = ["--rpm", "6000", "--teeth", "4", "--dominance", "nan"]
     wav = _write_wav(tmp_path / "r.wav", x)
     out = tmp_path / "o.json"
     assert main(["cut", str(wav), *args, "--out", str(out)]) == 2

@@ -1,4 +1,5 @@
-"""``cut`` on records of simulated cuts (tests/milling_sim.py: time-domain, nonlinear chip), truth from the SDM."""
+"""``cut`` on records of simulated cuts (tests/milling_sim.py, and toolpoint.simulation through the package's
+simulated shop), truth from the SDM."""
 
 import numpy as np
 import pytest
@@ -38,3 +39,22 @@ def test_verdicts_on_simulated_records_follow_the_sdm_limit():
                 f_true = f[np.argmax(p)]
                 alias = f_true + 4 * rpm / 60 * np.arange(-3, 4)
                 assert np.min(np.abs(r.chatter_hz - alias)) / f_true < 0.01
+
+
+@pytest.mark.slow
+def test_the_simulated_shop_labels_cuts_by_the_sdm_limit():
+    """The whole loop's shop (toolpoint.simulation → microphone → analyse_cut) against the semi-discretisation
+    limit, an independent method: 0.7 × the limit stable, 1.4 × chatter near a mode, at two speeds."""
+    from toolpoint.shop.campaign import sdm_limit, simulated_shop
+
+    pr = cornelius_2024(0.1)
+    shop, limit = simulated_shop(pr, revolutions=200), sdm_limit(pr)
+    theta = pr.theta(np.zeros((1, pr.sigma.size)))[0]
+    for rpm in (14000.0, 20000.0):
+        a = float(limit(theta, [rpm])[0])
+        assert shop(theta, rpm, 0.7 * a, np.random.default_rng(1)).stable
+        cut = shop(theta, rpm, 1.4 * a, np.random.default_rng(2))
+        assert not cut.stable
+        f_t = 4 * rpm / 60  # chatter is seen at f_c + j f_t; some alias lies near one of the two modes
+        alias = cut.chatter_hz + f_t * np.arange(-3, 4)
+        assert np.min(np.abs(alias[:, None] / np.array(pr.freq_hz)[None, :] - 1)) < 0.15

@@ -28,6 +28,15 @@ residuals calibrate as above, or, where that predicts no better, the whole campa
 deviation of log10 p over the ok rows. Every sample and every median is clipped to the identification's search
 bounds, the physically plausible range the campaign used.
 
+**Where the nearby FRFs bound a parameter on one side only**, samples stay on that side. A tool whose 95 %
+interval of p runs into the search bound above (the FRF hardly changes however large p is) still bounds it
+below: p ≥ lo. When at least :data:`WINDOW_MAJORITY` of the :data:`K_LOCAL` tools nearest a new tool have such an
+interval, the median of their lo is a lower bound of the new tool's p: the predictive log-normal is truncated
+there (likewise above, from intervals that run into the lower search bound). The side the FRFs leave open stays
+open. Measured on the synthetic campaigns: kr, identified only by tools of D ≤ 18 mm, was sampled 0.3–0.6
+decades below the truth for the larger tools — where their FRFs say it cannot be; their lower bounds lie below
+the truth in 99 % of new tools (``docs/design/recommend.md``).
+
 Measured effect and calibration: ``docs/design/recommend.md`` and ``benchmarks/bench_calibration.py``.
 """
 
@@ -44,9 +53,9 @@ from ..errors import InputError
 from ..io.atomic import atomic_open
 from ..io.table import check_regular_file
 
-__all__ = ["CV_FOLDS", "K_NEAREST", "WIDEN_PER_RANGE", "COVERAGE", "FILE_NAME", "ParameterUncertainty",
-           "fit_uncertainty", "fit_power_law", "power_law", "spread_uncertainty", "local_median", "write_uncertainty",
-           "read_uncertainty", "fold_ids"]
+__all__ = ["CV_FOLDS", "K_NEAREST", "WIDEN_PER_RANGE", "COVERAGE", "FILE_NAME", "WINDOW_MAJORITY",
+           "ParameterUncertainty", "fit_uncertainty", "fit_power_law", "power_law", "spread_uncertainty",
+           "local_median", "one_sided_bounds", "write_uncertainty", "read_uncertainty", "fold_ids"]
 
 #: Folds of the cross-validation.
 CV_FOLDS = 5
@@ -54,6 +63,8 @@ CV_FOLDS = 5
 K_NEAREST = 3
 #: Identified tools whose median is a rarely identified parameter's local campaign value.
 K_LOCAL = 5
+#: Of the K_LOCAL nearest tools, at least this many must bound a parameter on one side for the bound to hold.
+WINDOW_MAJORITY = 3
 #: s(x) grows by this much per range width outside the training (D, L) box.
 WIDEN_PER_RANGE = 5.0
 #: The interval the σ is calibrated for (two-sided).
@@ -154,6 +165,12 @@ class ParameterUncertainty:
     y_log10 : list of float
         ``neighbours``: log10 p of the identified tools ``X_train`` (m(x) the median of the :data:`K_LOCAL`
         nearest); else empty.
+    window_X : list of [D mm, L mm]
+        Every ok tool of the campaign (for the one-sided bounds); empty: no bounds.
+    window_lo, window_hi : list of float or None
+        Per tool of ``window_X``: log10 of the lower end of its 95 % interval where the interval runs into the
+        upper search bound (a lower bound only), and of the upper end where it runs into the lower one; None
+        (NaN) otherwise.
     """
 
     param: str
@@ -169,6 +186,9 @@ class ParameterUncertainty:
     reason: str
     coef: tuple = ()
     y_log10: tuple = ()
+    window_X: tuple = ()
+    window_lo: tuple = ()
+    window_hi: tuple = ()
 
     def centre(self, X) -> np.ndarray | None:
         """m(x) in log10 SI for ``spread`` and ``powerlaw`` (clipped to the bounds); None for ``model``."""
@@ -192,6 +212,24 @@ class ParameterUncertainty:
         lo, hi = np.asarray(self.lo), np.asarray(self.hi)
         d = sparsity(X, np.asarray(self.X_train), lo, hi)
         return np.maximum(1.0, d / max(self.d_ref, 1e-12)) * (1.0 + WIDEN_PER_RANGE * outside(X, lo, hi))
+
+    def window(self, X) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) bound of log10 p per row of X (D, L mm) from the nearby tools' one-sided intervals
+        (module docstring); −inf / +inf where fewer than :data:`WINDOW_MAJORITY` of the :data:`K_LOCAL` nearest
+        bound that side."""
+        X = np.atleast_2d(np.asarray(X, float))
+        lo, hi = np.full(len(X), -np.inf), np.full(len(X), np.inf)
+        if not len(self.window_X):
+            return lo, hi
+        W = np.asarray(self.window_X, float)
+        a, b = _scaled(X, W.min(axis=0), W.max(axis=0)), _scaled(W, W.min(axis=0), W.max(axis=0))
+        idx = np.argsort(((a[:, None, :] - b[None, :, :]) ** 2).sum(-1), axis=1)[:, :min(K_LOCAL, len(W))]
+        for bounds, out in ((self.window_lo, lo), (self.window_hi, hi)):
+            v = np.asarray(bounds, float)[idx]  # (n, K)
+            ok = np.isfinite(v).sum(axis=1) >= WINDOW_MAJORITY
+            if ok.any():
+                out[ok] = np.nanmedian(v[ok], axis=1)
+        return lo, hi
 
     def sigma(self, X) -> np.ndarray:
         """σ s(x) per row of X, decades; for ``neighbours`` at most the campaign's spread (its median never
@@ -231,6 +269,38 @@ def local_median(X, X_known, y_known, lo, hi, k: int | None = None) -> np.ndarra
     d = np.sqrt(((a[:, None, :] - b[None, :, :]) ** 2).sum(-1))
     idx = np.argsort(d, axis=1)[:, :max(1, min(k, len(b)))]
     return np.median(np.asarray(y_known, float)[idx], axis=1)
+
+
+def one_sided_bounds(lo, hi, rel: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """Per tool, log10 of the side its 95 % interval bounds when the other side runs into the search bound.
+
+    Parameters
+    ----------
+    lo, hi : ndarray
+        The intervals (SI, > 0; NaN where none).
+    rel : float
+        An end within this many decades of the campaign's extreme end is "at the bound" (the search bound is the
+        extreme end that intervals reach; a lone extreme that is not a bound is outvoted by its neighbours).
+
+    Returns
+    -------
+    (lower, upper) : ndarrays
+        log10 lo where only the upper end is at the bound, else NaN; log10 hi where only the lower end is.
+
+    Examples
+    --------
+    >>> lo, hi = np.array([1.0, 2.0, 1.0, 3.0]), np.array([10.0, 100.0, 100.0, 4.0])
+    >>> [np.round(v, 3).tolist() for v in one_sided_bounds(lo, hi)]
+    [[nan, 0.301, nan, nan], [1.0, nan, nan, nan]]
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a, b = np.log10(np.asarray(lo, float)), np.log10(np.asarray(hi, float))
+    ok = np.isfinite(a) & np.isfinite(b)
+    if not ok.any():
+        return np.full(a.shape, np.nan), np.full(a.shape, np.nan)
+    at_lo = ok & (a <= np.min(a[ok]) + rel)
+    at_hi = ok & (b >= np.max(b[ok]) - rel)
+    return np.where(at_hi & ~at_lo, a, np.nan), np.where(at_lo & ~at_hi, b, np.nan)
 
 
 def spread_uncertainty(param: str, values, clip_log10, reason: str, cv: dict | None = None) -> ParameterUncertainty:
@@ -323,9 +393,15 @@ def fit_uncertainty(param: str, X, residual_log10, fold, X_fold_train, X_train, 
 
 def write_uncertainty(path: Path, items: dict) -> None:
     """Write ``uncertainty.json`` (parameter → :class:`ParameterUncertainty`) atomically."""
+    def cell(v):
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        if isinstance(v, (list, tuple)):
+            return [cell(x) for x in v]
+        return v
+
     doc = {"format": FORMAT, "version": 1,
-           "parameters": {p: {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-                              for k, v in asdict(u).items()} for p, u in items.items()}}
+           "parameters": {p: {k: cell(v) for k, v in asdict(u).items()} for p, u in items.items()}}
     with atomic_open(path, "w", encoding="utf-8") as fh:
         json.dump(doc, fh, indent=1, allow_nan=False)
 
@@ -343,6 +419,11 @@ def read_uncertainty(path: Path) -> dict:
             d["clip_log10"] = tuple(d["clip_log10"])
             d["coef"] = tuple(d.get("coef", ()))
             d["y_log10"] = tuple(d.get("y_log10", ()))
+            for k in ("window_lo", "window_hi"):
+                d[k] = tuple(math.nan if v is None else float(v) for v in d.get(k, ()))
+            d["window_X"] = tuple(tuple(map(float, x)) for x in d.get("window_X", ()))
+            if not len(d["window_X"]) == len(d["window_lo"]) == len(d["window_hi"]):
+                raise ValueError(f"{p}: window_X, window_lo and window_hi differ in length")
             out[p] = ParameterUncertainty(**d)
             if not (out[p].sigma_log10 > 0):
                 raise ValueError(f"{p}: sigma_log10 must be > 0")

@@ -9,7 +9,13 @@ made is decided and calibrated by ``campaign learn`` (``models/uncertainty.json`
   larger where the training tools are sparse and at or beyond the edge of the learned (D, L) range;
 * ``powerlaw``: the family's power law in D and L where it predicted held-out tools better than the ANFIS (an
   over-fitted ANFIS), σ as above;
-* ``spread``: a parameter the campaign rarely identifies is not extrapolated: the campaign's median and spread.
+* ``neighbours`` / ``spread``: a parameter the campaign rarely identifies is not extrapolated: the median of the
+  nearest tools that identified it, or the campaign's median and spread.
+
+Where the nearby tools' FRFs bound a parameter on one side only (their intervals run into the search bound on
+the other), the log-normal is **truncated** at that bound (:meth:`ParameterUncertainty.window
+<toolpoint.campaign.calibration.ParameterUncertainty.window>`): quantiles and samples are those of the
+truncated distribution, so a sample never goes where those FRFs say the parameter cannot be.
 
 With ``model="gp"`` a learned parameter takes the GP baseline that ``campaign learn`` saved instead
 (:class:`~toolpoint.campaign.models.GPModel`): m its predictive mean of log10 p and σ its own predictive
@@ -30,10 +36,49 @@ from ..errors import InputError
 from ..identification.params import PARAMS
 from ..learning.anfis import predict_quietly
 
-__all__ = ["MODELS", "JointPredictor", "JointDistribution"]
+__all__ = ["MODELS", "JointPredictor", "JointDistribution", "truncated_log10"]
 
 #: The learned models a predictive distribution can come from.
 MODELS = ("anfis", "gp")
+
+
+def truncated_log10(m, s, window, z) -> np.ndarray:
+    """log10 p at standard-normal scores ``z`` of Normal(m, s²) truncated to ``window``.
+
+    The score z maps to the quantile Φ(z) of the truncated distribution, Φ⁻¹(Φ(a) + Φ(z) (Φ(b) − Φ(a))) with
+    a, b the window's ends in standard units — the untruncated value where the window is (−inf, inf).
+
+    Parameters
+    ----------
+    m, s : array_like
+        Median and σ of log10 p (decades), broadcast with ``z``'s trailing axes.
+    window : array_like, shape (2, ...) or None
+        Lower and upper bound of log10 p (±inf: open).
+    z : array_like
+        Standard-normal scores (samples or quantile levels as scores).
+
+    Examples
+    --------
+    >>> round(float(truncated_log10(0.0, 1.0, np.array([0.0, np.inf]), 0.0)), 4)  # median of a half-normal
+    0.6745
+    >>> float(truncated_log10(2.0, 0.5, None, 1.0))
+    2.5
+    """
+    from scipy.special import ndtr, ndtri
+
+    m, s, z = np.asarray(m, float), np.asarray(s, float), np.asarray(z, float)
+    if window is None:
+        return m + s * z
+    lo, hi = np.asarray(window, float)
+    if not (np.isfinite(lo).any() or np.isfinite(hi).any()):
+        return m + s * z
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = np.where(s > 0, ndtr((lo - m) / s), 0.0)
+        b = np.where(s > 0, ndtr((hi - m) / s), 1.0)
+        u = a + ndtr(z) * (b - a)
+        out = m + s * ndtri(np.clip(u, 1e-300, 1 - 1e-16))
+    # a window the distribution hardly reaches (b − a ≈ 0): its nearer end
+    return np.clip(np.where(np.isfinite(out), out, np.where(m < lo, lo, hi)), lo, hi)
 
 
 @dataclass(frozen=True)
@@ -50,12 +95,21 @@ class JointDistribution:
         δ, the distance outside the training (D, L) range in range widths (0 inside).
     clip_log10 : ndarray, shape (2, 4)
         The identification's range per parameter, log10 SI: samples are clipped to it.
+    window_log10 : ndarray, shape (n, 2, 4), optional
+        Per tool, the one-sided bounds the nearby tools' FRFs give (±inf: none): the log-normal is truncated
+        there (:func:`truncated_log10`). ``log10_median`` is the untruncated m; :meth:`quantiles` (0.5) is the
+        median of what is sampled.
     """
 
     log10_median: np.ndarray
     sigma_log10: np.ndarray
     outside: np.ndarray
     clip_log10: np.ndarray
+    window_log10: np.ndarray | None = None
+
+    def window(self, index: int) -> np.ndarray | None:
+        """(2, 4) bounds of tool ``index`` (None: none)."""
+        return None if self.window_log10 is None else self.window_log10[index]
 
     def quantiles(self, q) -> np.ndarray:
         """Quantiles of each parameter, SI: shape (len(q), n, 4).
@@ -68,12 +122,16 @@ class JointDistribution:
         from scipy.stats import norm
 
         z = norm.ppf(np.asarray(q, float))[:, None, None]
-        return 10.0 ** np.clip(self.log10_median[None] + z * self.sigma_log10[None], *self.clip_log10)
+        w = None if self.window_log10 is None else np.moveaxis(self.window_log10, 1, 0)[:, None]  # (2, 1, n, 4)
+        v = truncated_log10(self.log10_median[None], self.sigma_log10[None], w, z)
+        return 10.0 ** np.clip(v, *self.clip_log10)
 
     def sample(self, index: int, n: int, rng: np.random.Generator) -> np.ndarray:
-        """``n`` joints of tool ``index``, SI, shape (n, 4) (independent log-normal parameters, clipped)."""
+        """``n`` joints of tool ``index``, SI, shape (n, 4) (independent log-normal parameters, truncated to the
+        tool's window, clipped)."""
         z = rng.standard_normal((n, len(PARAMS)))
-        return 10.0 ** np.clip(self.log10_median[index] + z * self.sigma_log10[index], *self.clip_log10)
+        v = truncated_log10(self.log10_median[index], self.sigma_log10[index], self.window(index), z)
+        return 10.0 ** np.clip(v, *self.clip_log10)
 
 
 class JointPredictor:
@@ -154,8 +212,10 @@ class JointPredictor:
         X = np.column_stack([D, L])
         m = np.empty((len(D), len(PARAMS)))
         sig = np.empty_like(m)
+        win = np.empty((len(D), 2, len(PARAMS)))
         for j, p in enumerate(PARAMS):
             u = self.parameters[p]
+            win[:, 0, j], win[:, 1, j] = u.window(X)
             if self.kind == "gp" and p in self.models:
                 m[:, j], sig[:, j] = self.models[p].predict(X)
                 continue
@@ -167,4 +227,5 @@ class JointPredictor:
             else:
                 m[:, j] = u.centre(X)
         m = np.where(np.isfinite(m), np.clip(m, self.clip_log10[0], self.clip_log10[1]), m)
-        return JointDistribution(m, sig, self.outside(D, L), self.clip_log10)
+        return JointDistribution(m, sig, self.outside(D, L), self.clip_log10,
+                                 win if np.isfinite(win).any() else None)

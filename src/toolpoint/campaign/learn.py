@@ -640,6 +640,16 @@ def _uncertainty(data: _Data, fits: dict, train_idx, anfis: dict, folds: int, se
             out[t] = calibration.spread_uncertainty(t, values, clip, f"campaign spread: {why}")
         except InputError as err:
             raise InputError(err.message, file=data.path, field=t) from None
+    for t in out:  # the side the nearby FRFs bound, where they bound only one (calibration module docstring)
+        if t in data.intervals:
+            lower, upper = calibration.one_sided_bounds(*data.intervals[t])
+            if np.isfinite(lower).any() or np.isfinite(upper).any():
+                n_lo, n_hi = int(np.isfinite(lower).sum()), int(np.isfinite(upper).sum())
+                why = (f"; truncated where the nearest tools' FRFs bound it on one side ({n_lo} of {len(lower)} tools "
+                       f"bound it below only, {n_hi} above only)")
+                out[t] = dataclasses.replace(out[t], window_X=tuple(map(tuple, data.X.tolist())),
+                                             window_lo=tuple(lower.tolist()), window_hi=tuple(upper.tolist()),
+                                             reason=out[t].reason + why)
     return out
 
 

@@ -35,6 +35,9 @@ def register(sub) -> None:
     p.add_argument("--rpm-tolerance", default="0.03",
                    help="relative search range around --rpm for the spindle harmonics (default 0.03; 0 = exact)")
     p.add_argument("--window", default="1.0", help="length of the windows the cut is judged in, s (default 1)")
+    p.add_argument("--dominance", default="0.05",
+                   help="least power of a chatter line relative to the strongest spindle harmonic's (default 0.05, "
+                        "-13 dB); lower finds weaker chatter and risks calling a noisy stable cut chatter")
     p.add_argument("--out", help="result JSON (default: print it)")
     p.add_argument("--plot", help="spectrogram with the harmonics marked (.png/.pdf/.svg)")
     p.set_defaults(func=run)
@@ -61,13 +64,14 @@ def run(args) -> int:
     if tol >= 0.5:
         raise InputError(f"must be < 0.5, got {args.rpm_tolerance}", file="command line", field="--rpm-tolerance")
     window = check_number(args.window, "--window", above=0, unit="s")
+    dominance = check_number(args.dominance, "--dominance", above=0)
     from ..io.atomic import atomic_open
     from ..io.records import read_cut_record
     from ..shop import analyse_cut
 
     rec = read_cut_record(rec_path, rate_hz=rate, channel=channel)
     res = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=teeth, rpm_tolerance=tol, window_s=window,
-                      full_scale=rec.full_scale, source=str(rec_path))
+                      dominance=dominance, full_scale=rec.full_scale, source=str(rec_path))
     doc = {"record": str(rec_path), "channel": rec.channel, "rate_hz": rec.rate_hz, **res.to_dict()}
     fig = None
     if plot is not None:

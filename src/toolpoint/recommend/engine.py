@@ -42,6 +42,7 @@ import numpy as np
 
 from ..blas import single_thread_blas
 from ..campaign.config import ToolFamily
+from ..campaign.distribution import truncated_log10
 from ..dynamics.model import ToolPointModel
 from ..dynamics.subassembly import Subassembly
 from ..identification.params import PARAMS
@@ -107,6 +108,9 @@ class ToolJob:
     sub_R_replicates : ndarray, shape (B, F, 2, 2), optional
         Bootstrap replicates of the subassembly (its own measurement uncertainty); sample i uses replicate
         i mod B after a seeded shuffle (None: the subassembly is taken as exact).
+    window_log10 : ndarray, shape (2, 4), optional
+        One-sided bounds of the joint parameters from the nearby tools' FRFs, log10 SI (±inf: none): the
+        log-normal is truncated there (:func:`~toolpoint.campaign.distribution.truncated_log10`).
     """
 
     id: str
@@ -128,6 +132,7 @@ class ToolJob:
     clip_log10: np.ndarray | None = None
     cutting_sigma_ln: tuple = (0.0, 0.0)
     sub_R_replicates: np.ndarray | None = None
+    window_log10: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -138,7 +143,8 @@ class ToolEvaluation:
     ----------
     summary : dict
         JSON-able: ``id``, ``joint`` quantiles (SI), ``points`` (recommended, best first: ``kind``, ``rpm``,
-        limits mm, ``depth_mm``, ``p_stable``, ``capped``), ``min_limit_mm``, ``cap_mm``, ``sources`` (share of
+        limits mm, ``depth_mm``, ``p_stable``, ``capped``, ``flute_limited``: the depth is the modelled flute length
+        min(L, flute ratio × D), the limit lies deeper), ``min_limit_mm``, ``cap_mm``, ``sources`` (share of
         the variance of ln a at the best point per source), ``dominant_source``, ``notes``, settings and
         ``seconds`` / ``cpu_seconds`` of this process.
     arrays : dict
@@ -216,10 +222,10 @@ def pockets(depth: np.ndarray) -> np.ndarray:
 def _samples(job: ToolJob, rng: np.random.Generator):
     """(1 + n, 4) joints (row 0 the median), K_t factors (n,), K_r values (n,)."""
     z = rng.standard_normal((job.n_samples, len(PARAMS)))
-    logj = job.log10_median + z * job.sigma_log10
+    logj = truncated_log10(job.log10_median, job.sigma_log10, job.window_log10, np.vstack([np.zeros(len(PARAMS)), z]))
     if job.clip_log10 is not None:
         logj = np.clip(logj, job.clip_log10[0], job.clip_log10[1])
-    joints = np.vstack([10.0 ** job.log10_median, 10.0 ** logj])
+    joints = 10.0 ** logj  # row 0: the median of what is sampled
     s_kt, s_kr = job.cutting_sigma_ln
     zc = rng.standard_normal((2, job.n_samples))
     return joints, np.exp(s_kt * zc[0]), job.cutting.radial_ratio * np.exp(s_kr * zc[1])
@@ -310,7 +316,10 @@ def evaluate_tool(job: ToolJob) -> ToolEvaluation:
     top = top if top > 0 else 1e-3
     depths = np.linspace(0.0, top, N_DEPTHS + 1)[1:]
     p_stable = (samples[None, :, :] > depths[:, None, None]).mean(axis=1)  # (D, G)
-    ctx = (job, nominal, lq, robust, per_sample_robust, cap)
+    # no depth deeper than the modelled flutes (min(L, flute ratio × D)): the stability limit of a stubby tool
+    # can lie far beyond what the tool can cut at all
+    flutes_m = 1e-3 * min(job.overhang_mm, family.flute_length_ratio * job.diameter_mm)
+    ctx = (job, nominal, lq, robust, per_sample_robust, cap, flutes_m)
     idx = [j for j in pockets(robust) if robust[j] >= POCKET_GAIN * floor]
     notes = []
     points = [_point(*ctx, j, "pocket", robust[j]) for j in idx[:3]]
@@ -323,13 +332,16 @@ def evaluate_tool(job: ToolJob) -> ToolEvaluation:
     elif not points:
         j = int(np.argmax(np.where(np.isfinite(robust), robust, -np.inf)))
         points.append(_point(*ctx, j, "edge", robust[j]))
+    if points[0]["flute_limited"]:
+        notes.append(f"the stability limit lies deeper than the flutes: the depth is the flute length "
+                     f"{1e3 * flutes_m:.3g} mm")
     sources = _sources(samples[:, int(np.searchsorted(job.rpm, points[0]["rpm"]))], bin_of, rep_of,
                        job.cutting_sigma_ln[0])
     sampled = {"joint": True, "cutting K_t": job.cutting_sigma_ln[0] > 0, "cutting K_r": job.cutting_sigma_ln[1] > 0,
                "subassembly": reps is not None and len(reps) > 1}
     sources = {k: v for k, v in sources.items() if sampled[k]}  # a source taken as exact is not named
-    jq = 10.0 ** (job.log10_median[None, :] + np.array([-1.6448536269514729, 0.0, 1.6448536269514729])[:, None]
-                  * job.sigma_log10[None, :])
+    jq = 10.0 ** truncated_log10(job.log10_median, job.sigma_log10, job.window_log10,
+                                 np.array([-1.6448536269514729, 0.0, 1.6448536269514729])[:, None])
     if job.clip_log10 is not None:
         jq = np.clip(jq, 10.0 ** job.clip_log10[0], 10.0 ** job.clip_log10[1])
     hq = np.quantile(np.abs(H[1:]), QUANTILES, axis=0)
@@ -362,8 +374,8 @@ def evaluate_tool(job: ToolJob) -> ToolEvaluation:
     return ToolEvaluation(summary, arrays)
 
 
-def _point(job, nominal, lq, robust, per_sample_robust, cap, j, kind, base) -> dict:
-    depth = base * (1.0 - job.margin)
+def _point(job, nominal, lq, robust, per_sample_robust, cap, flutes_m, j, kind, base) -> dict:
+    depth = min(base * (1.0 - job.margin), flutes_m)
     limits = {"limit_nominal_mm": nominal[j], "limit_p50_mm": lq[1, j], "limit_p05_mm": lq[0, j],
               "limit_robust_p05_mm": robust[j]}
     return {
@@ -373,4 +385,5 @@ def _point(job, nominal, lq, robust, per_sample_robust, cap, j, kind, base) -> d
         "p_stable": float(np.mean(per_sample_robust[:, j] > depth)),
         # a limit at the depth cap was not computed: it lies somewhere above the cap (shown as "≥ cap")
         "capped": sorted(k for k, v in limits.items() if np.isfinite(cap) and v >= cap * (1 - 1e-9)),
+        "flute_limited": bool(base * (1.0 - job.margin) > flutes_m),
     }

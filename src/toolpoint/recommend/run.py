@@ -251,7 +251,7 @@ def _run_locked(tools, bad, c, predictor, client, out, tools_dir, *, workers, n_
         jobs.append(ToolJob(t.id, c.family, t.diameter_mm, t.overhang_mm, t.flute_length_mm, sub.freq_hz[keep],
                             sub.R[keep], t.holder, t.cutting, np.linspace(t.rpm_min, t.rpm_max, rpm_points),
                             dist.log10_median[k], dist.sigma_log10[k], n_samples, _seed(seed, t.id), margin,
-                            rpm_tolerance, dist.clip_log10, tuple(t.cutting_sigma_ln), rep_R))
+                            rpm_tolerance, dist.clip_log10, tuple(t.cutting_sigma_ln), rep_R, dist.window(k)))
     counts = {"ok": 0, "failed": 0, "skipped": len(done)}
     from tqdm import tqdm
 

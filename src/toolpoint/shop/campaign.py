@@ -9,9 +9,10 @@ Loop (seeded by one ``numpy.random.Generator``):
 4. make the proposed cut with ``shop(theta_true, rpm, depth_m, rng) -> TestCut`` and go to 2.
 
 Shops: :func:`zoa_shop` labels a cut by the true zero-order limit (and gives the true chatter frequency) —
-the update's own forward model, a check of the sampler and the rule; a time-domain shop (simulation,
-synthetic microphone record, :func:`toolpoint.shop.analyse_cut`) is :func:`simulated_shop` where the
-simulation package exists.
+the update's own forward model, a check of the sampler and the rule; :func:`simulated_shop` makes the cut in
+the time domain (:func:`toolpoint.simulation.simulate_milling`: the tool leaves the cut, chatter saturates),
+records it with a microphone and judges the record with :func:`toolpoint.shop.analyse_cut` — the whole
+loop; its truth is the semi-discretisation limit (:func:`sdm_limit`), not the zero-order one.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import numpy as np
 from .model import ModalPrior, limit_at_speeds
 from .update import TestCut, _limits, update
 
-__all__ = ["CampaignResult", "virtual_campaign", "zoa_shop"]
+__all__ = ["CampaignResult", "virtual_campaign", "zoa_shop", "simulated_shop", "sdm_limit", "microphone_record"]
 
 
 @dataclass(frozen=True)
@@ -61,6 +62,96 @@ def zoa_shop(prior: ModalPrior):
         a, fc = limit_at_speeds(prior, theta_true[None, :], [rpm])
         stable = bool(depth_m < a[0, 0])
         return TestCut(float(rpm), float(depth_m), stable, None if stable else float(fc[0, 0]))
+    return shop
+
+
+def _tool(prior: ModalPrior, theta):
+    """(ModalModel of the symmetric tool, CuttingConditions with θ's K_t and K_r) of one parameter vector."""
+    from dataclasses import replace
+
+    from ..stability import ModalModel
+
+    m = prior.modes
+    theta = np.asarray(theta, float)
+    fn, k, z = theta[:m], theta[m:2 * m], theta[2 * m:3 * m]
+    cut = replace(prior.cutting, tangential_coeff=float(theta[3 * m]), radial_ratio=float(theta[3 * m + 1]))
+    return ModalModel(fn, z, k / (2 * np.pi * fn) ** 2), cut
+
+
+def sdm_limit(prior: ModalPrior):
+    """``true_limit`` for :func:`virtual_campaign` with a time-domain shop: the semi-discretisation limit of θ*
+    (the same tool in x and y), m."""
+    from ..stability import sdm_lobes
+
+    def limit(theta, rpm):
+        mm, cut = _tool(prior, theta)
+        return sdm_lobes(mm, mm, cut, rpm=np.asarray(rpm, float)).depth_m
+    return limit
+
+
+def microphone_record(velocity, rate: float, rng: np.random.Generator, *, air_s: float = 0.5,
+                      noise: float = 0.05) -> np.ndarray:
+    """A microphone record of a simulated cut: ``air_s`` of air cut, the cut, ``air_s`` of air cut.
+
+    The microphone hears the tool's velocity (x + y) in the cut, over room noise — white, ``noise`` × the
+    cut's RMS, the same in air and in the cut (what the detector's air-cut reference learns) — scaled to a
+    peak of 0.8 full scale. No fans or spindle lines: a richer shop is passed to :func:`simulated_shop` as
+    ``record`` (the tests' ``milling_sim.microphone``: fans, spindle runout, pink room noise).
+    """
+    v = np.asarray(velocity, float)
+    v = v - v.mean()
+    na = int(air_s * rate)
+    x = np.concatenate([np.zeros(na), v, np.zeros(na)])
+    x = x + noise * float(np.std(v)) * rng.standard_normal(x.size)
+    return 0.8 * x / float(np.max(np.abs(x)))
+
+
+def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 44100.0, record=None,
+                   detector: dict | None = None):
+    """A shop whose cuts are simulated in the time domain, recorded and judged by the chatter detector.
+
+    Parameters
+    ----------
+    prior : ModalPrior
+        The tool family (modes per θ, the cut).
+    revolutions : int, default 250
+        Revolutions simulated per cut from the steady cut (a seeded perturbation), all of them recorded:
+        0.6–3 s at 5000–25000 rpm, long enough for the detector's windows.
+    rate : float, default 44100
+        Record sample rate, Hz.
+    record : callable, optional
+        ``record(result, rpm, teeth, rng) -> (samples, rate)`` from the
+        :class:`~toolpoint.simulation.time_domain.SimulationResult` (one point); default
+        :func:`microphone_record` of the tool's velocity.
+    detector : dict, optional
+        Options of :func:`toolpoint.shop.analyse_cut`.
+
+    Returns
+    -------
+    callable
+        ``shop(theta, rpm, depth_m, rng) -> TestCut`` with the detector's verdict and chatter frequency.
+    """
+    from ..simulation import simulate_milling
+    from .detect import analyse_cut
+
+    opts = dict(detector or {})
+
+    def default_record(res, rpm, teeth, rng):
+        d = res.displacement_m[0].sum(axis=1)
+        dt = float(res.dt_s[0])
+        v = np.gradient(d, dt)
+        tn = np.arange(int(d.size * dt * rate)) / rate
+        return microphone_record(np.interp(tn, np.arange(d.size) * dt, v), rate, rng), rate
+
+    make = default_record if record is None else record
+
+    def shop(theta, rpm, depth_m, rng):
+        mm, cut = _tool(prior, theta)
+        res = simulate_milling(mm, mm, cut, rpm=[float(rpm)], depth_m=[float(depth_m)], revolutions=revolutions,
+                               seed=int(rng.integers(1 << 30)))
+        x, fs = make(res, float(rpm), cut.teeth, rng)
+        r = analyse_cut(x, fs, rpm=float(rpm), teeth=cut.teeth, full_scale=1.0, **opts)
+        return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz)
     return shop
 
 
