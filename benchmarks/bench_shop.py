@@ -179,13 +179,21 @@ def shop_microphone(res, rpm, teeth, rng):
 
 
 def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius", "example"), update_kw=None,
-                 max_cuts=10, verbose=False, seed_start=0):
+                 max_cuts=10, verbose=False, seed_start=0, library_prior=None):
     update_kw = dict(update_kw or {})
     n_s = update_kw.pop("n_samples", 600 if quick else 1000)
     n_l = update_kw.pop("lobe_samples", 300 if quick else 400)
     print(f"\n## update: virtual campaigns (info rule, SMC {n_s} samples, {n_l} lobe samples, {seeds} seeds "
           f"{seed_start}…{seed_start + seeds - 1}, at most {max_cuts} cuts; update options {update_kw or 'default'})")
     priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
+    if library_prior:  # OUT:TOOL — a tool of a `toolpoint library` output, its prior as `update --library` makes it
+        from toolpoint.shop.prior import prior_from_library
+
+        out, tool = library_prior.rsplit(":", 1)
+        priors["library"] = prior_from_library(out, tool)
+        print(f"library prior {tool}: modes {np.round(priors['library'].freq_hz, 0).tolist()} Hz, σ stiffness "
+              f"{np.round(priors['library'].sigma_stiffness, 3).tolist()}, σ K_t {priors['library'].sigma_kt}, "
+              f"σ K_r {priors['library'].sigma_kr}, rpm {priors['library'].rpm_range}")
     for case in cases:
         prior = priors[case]
         for shop_name in shops:
@@ -240,7 +248,9 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", choices=("cut", "update", "sampler"))
     ap.add_argument("--shops", default="zoa,noisy,sim", help="comma-separated shops of the update benchmark")
-    ap.add_argument("--cases", default="cornelius,example", help="comma-separated priors: cornelius, example")
+    ap.add_argument("--cases", default="cornelius,example",
+                    help="comma-separated priors: cornelius, example, library (with --library-prior)")
+    ap.add_argument("--library-prior", help="OUT:TOOL, a tool of a `toolpoint library` output folder (case library)")
     ap.add_argument("--update", default="{}", help="JSON of extra update() options, e.g. '{\"n_samples\": 500}'")
     ap.add_argument("--max-cuts", type=int, default=10)
     ap.add_argument("--verbose", action="store_true", help="one line per campaign")
@@ -255,7 +265,7 @@ def main():
         import json
 
         bench_update(a.seeds, a.quick, a.shops.split(","), a.cases.split(","), json.loads(a.update), a.max_cuts,
-                     a.verbose, a.seed_start)
+                     a.verbose, a.seed_start, a.library_prior)
 
 
 if __name__ == "__main__":

@@ -167,6 +167,11 @@ def test_library_adapter_reads_modes_and_cutting(tmp_path):
     assert pr.modes == 2 and pr.cutting.teeth == 3 and pr.cutting.milling == "up"
     np.testing.assert_allclose(sorted(pr.freq_hz), [900, 2100], rtol=2e-3)
     assert abs(pr.sigma_stiffness[0] - np.log(1.25 / 0.8) / 3.29) < 1e-9
+    assert (pr.sigma_kt, pr.sigma_kr) == (0.1, 0.05)  # an output that does not state them
+    doc = json.loads((tools / "T1.json").read_text())
+    (tools / "T1.json").write_text(json.dumps({**doc, "cutting_sigma_ln": {"K_t": 0.15, "K_r": 0.2}}))
+    pr = prior_from_library(tmp_path, "T1")
+    assert (pr.sigma_kt, pr.sigma_kr) == (0.15, 0.2)  # the library's own, as it sampled them
     with pytest.raises(InputError, match="no tool 'T9'"):
         prior_from_library(tmp_path, "T9")
 

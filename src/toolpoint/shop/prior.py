@@ -28,7 +28,8 @@ conditions. :func:`prior_from_library` is the one adapter from that output to a 
 −Im Φ of the nominal FRF (natural frequency at the peak, damping from the half-power band, stiffness
 k = 1 / (2 ζ |Im Φ(f_n)|)), σ of the stiffness from the |Φ| quantiles at the peak
 (ln(q95/q05) / 3.29), σ of frequency and damping given (defaults 0.03 and 0.2: the library's
-quantiles of |Φ| do not say how the peaks move).
+quantiles of |Φ| do not say how the peaks move); σ of K_t and K_r the library's own for that tool
+(``cutting_sigma_ln`` of its JSON: the preset's or the library row's), unless given.
 """
 
 from __future__ import annotations
@@ -153,8 +154,12 @@ def modes_from_frf(freq_hz, frf, *, max_modes: int = 3, min_share: float = 0.1):
 
 
 def prior_from_library(out_dir: str | os.PathLike, tool_id: str, *, sigma_freq: float = 0.03,
-                       sigma_damping: float = 0.2, sigma_kt: float = 0.1, sigma_kr: float = 0.05) -> ModalPrior:
+                       sigma_damping: float = 0.2, sigma_kt: float | None = None,
+                       sigma_kr: float | None = None) -> ModalPrior:
     """A :class:`ModalPrior` of tool ``tool_id`` of a ``library`` output folder (see the module docstring).
+
+    ``sigma_kt``, ``sigma_kr`` (log standard deviations of K_t and K_r): default the library's own for the tool,
+    or 0.1 and 0.05 for an output that does not state them.
 
     Raises
     ------
@@ -173,10 +178,14 @@ def prior_from_library(out_dir: str | os.PathLike, tool_id: str, *, sigma_freq: 
     try:
         arr = np.load(npz)
         f, h, hq = arr["freq_hz"], arr["frf_nominal"], arr["frf_abs_q"]
+        rpm = arr["rpm"] if "rpm" in arr.files else None  # the tool's speed range in the library
         doc = json.loads(js.read_text(encoding="utf-8"))
         c = doc["cutting"]
         cut = CuttingConditions(int(c["teeth"]), float(c["tangential_coeff"]), float(c["radial_ratio"]),
                                 float(c["radial_immersion"]), str(c.get("milling", "down")))
+        stated = doc.get("cutting_sigma_ln") or {}
+        sigma_kt = float(stated.get("K_t", 0.1)) if sigma_kt is None else sigma_kt
+        sigma_kr = float(stated.get("K_r", 0.05)) if sigma_kr is None else sigma_kr
     except (OSError, KeyError, ValueError, TypeError) as err:
         raise InputError(f"cannot read the tool's files ({err})", file=npz, field="tool") from None
     modes = modes_from_frf(f, h)
@@ -190,4 +199,5 @@ def prior_from_library(out_dir: str | os.PathLike, tool_id: str, *, sigma_freq: 
     fn, k, z = zip(*modes)
     m = len(modes)
     return ModalPrior(tuple(fn), tuple(k), tuple(z), (sigma_freq,) * m, tuple(sig_k), (sigma_damping,) * m, cut,
-                      sigma_kt=sigma_kt, sigma_kr=sigma_kr, name=f"library tool {tool_id}")
+                      sigma_kt=sigma_kt, sigma_kr=sigma_kr, name=f"library tool {tool_id}",
+                      rpm_range=None if rpm is None or not rpm.size else (float(rpm.min()), float(rpm.max())))
