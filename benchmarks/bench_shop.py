@@ -131,10 +131,7 @@ def bench_cut_sim(quick, truths=6):
                 if abs(a / lim[gi] - 1) < 0.05:
                     skipped += 1
                     continue
-                t = res.time_s[p] - res.time_s[p][0]
-                d, f = res.displacement_m[p], res.force_n[p]
-                x, rate, *_ = microphone((t, d[:, 0], d[:, 1], f[:, 0], f[:, 1]), rpm=rpm, teeth=c.teeth,
-                                         seed=int(rng.integers(1 << 30)))
+                x, rate = shop_microphone(res, rpm, c.teeth, rng, point=p)
                 chatter = bool(rho[di, gi] > 1)
                 n += 1
                 sim_agree += chatter == (not res.stable[p])
@@ -169,10 +166,10 @@ def noisy_shop(prior, rng_blur=0.03, f_noise=0.005):
     return shop
 
 
-def shop_microphone(res, rpm, teeth, rng):
-    """The tests' shop microphone (fans, spindle lines, pink room noise, air cut) of a simulated cut."""
-    t = res.time_s[0] - res.time_s[0][0]
-    d, f = res.displacement_m[0], res.force_n[0]
+def shop_microphone(res, rpm, teeth, rng, point=0):
+    """The tests' shop microphone (fans, spindle lines, pink room noise, air cut) of one simulated cut."""
+    t = res.time_s[point] - res.time_s[point][0]
+    d, f = res.displacement_m[point], res.force_n[point]
     x, rate, *_ = microphone((t, d[:, 0], d[:, 1], f[:, 0], f[:, 1]), rpm=rpm, teeth=teeth,
                              seed=int(rng.integers(1 << 30)))
     return x, rate

@@ -172,6 +172,9 @@ def test_library_adapter_reads_modes_and_cutting(tmp_path):
     (tools / "T1.json").write_text(json.dumps({**doc, "cutting_sigma_ln": {"K_t": 0.15, "K_r": 0.2}}))
     pr = prior_from_library(tmp_path, "T1")
     assert (pr.sigma_kt, pr.sigma_kr) == (0.15, 0.2)  # the library's own, as it sampled them
+    assert pr.rpm_range is None  # no speed grid in the file: the modes' lobes decide
+    np.savez(tools / "T1.npz", freq_hz=f, frf_nominal=h, frf_abs_q=hq, rpm=np.linspace(4000.0, 24000.0, 50))
+    assert prior_from_library(tmp_path, "T1").rpm_range == (4000.0, 24000.0)  # the library row's speed range
     with pytest.raises(InputError, match="no tool 'T9'"):
         prior_from_library(tmp_path, "T9")
 

@@ -65,26 +65,13 @@ def zoa_shop(prior: ModalPrior):
     return shop
 
 
-def _tool(prior: ModalPrior, theta):
-    """(ModalModel of the symmetric tool, CuttingConditions with θ's K_t and K_r) of one parameter vector."""
-    from dataclasses import replace
-
-    from ..stability import ModalModel
-
-    m = prior.modes
-    theta = np.asarray(theta, float)
-    fn, k, z = theta[:m], theta[m:2 * m], theta[2 * m:3 * m]
-    cut = replace(prior.cutting, tangential_coeff=float(theta[3 * m]), radial_ratio=float(theta[3 * m + 1]))
-    return ModalModel(fn, z, k / (2 * np.pi * fn) ** 2), cut
-
-
 def sdm_limit(prior: ModalPrior):
     """``true_limit`` for :func:`virtual_campaign` with a time-domain shop: the semi-discretisation limit of θ*
     (the same tool in x and y), m."""
     from ..stability import sdm_lobes
 
     def limit(theta, rpm):
-        mm, cut = _tool(prior, theta)
+        mm, cut = prior.tool(theta)
         return sdm_lobes(mm, mm, cut, rpm=np.asarray(rpm, float)).depth_m
     return limit
 
@@ -103,7 +90,8 @@ def microphone_record(velocity, rate: float, rng: np.random.Generator, *, air_s:
     na = int(air_s * rate)
     x = np.concatenate([np.zeros(na), v, np.zeros(na)])
     x = x + noise * float(np.std(v)) * rng.standard_normal(x.size)
-    return 0.8 * x / float(np.max(np.abs(x)))
+    peak = float(np.max(np.abs(x))) if x.size else 0.0
+    return 0.8 * x / peak if peak > 0 else x  # a silent cut stays silent (the detector refuses it)
 
 
 def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 44100.0, record=None,
@@ -131,22 +119,19 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
     callable
         ``shop(theta, rpm, depth_m, rng) -> TestCut`` with the detector's verdict and chatter frequency.
     """
-    from ..simulation import simulate_milling
+    from ..simulation import sensor_signal, simulate_milling
     from .detect import analyse_cut
 
     opts = dict(detector or {})
 
     def default_record(res, rpm, teeth, rng):
-        d = res.displacement_m[0].sum(axis=1)
-        dt = float(res.dt_s[0])
-        v = np.gradient(d, dt)
-        tn = np.arange(int(d.size * dt * rate)) / rate
-        return microphone_record(np.interp(tn, np.arange(d.size) * dt, v), rate, rng), rate
+        _, v = sensor_signal(res, 0, kind="microphone", rate=rate, noise=0.0)  # velocity x + y at the audio rate
+        return microphone_record(v, rate, rng), rate
 
     make = default_record if record is None else record
 
     def shop(theta, rpm, depth_m, rng):
-        mm, cut = _tool(prior, theta)
+        mm, cut = prior.tool(theta)
         res = simulate_milling(mm, mm, cut, rpm=[float(rpm)], depth_m=[float(depth_m)], revolutions=revolutions,
                                seed=int(rng.integers(1 << 30)))
         x, fs = make(res, float(rpm), cut.teeth, rng)

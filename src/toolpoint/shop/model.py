@@ -122,6 +122,16 @@ class ModalPrior:
         return replace(self, freq_hz=tuple(t[:m]), stiffness_n_m=tuple(t[m:2 * m]), damping=tuple(t[2 * m:3 * m]),
                        cutting=cut)
 
+    def tool(self, theta):
+        """(ModalModel, CuttingConditions) of one parameter vector θ: the same M modes in x and y (modal mass
+        k/(2π f)²) and the cut with θ's K_t and K_r — the input of the SDM and the time-domain simulation."""
+        from ..stability import ModalModel
+
+        m = self.modes
+        t = np.asarray(theta, float)
+        cut = replace(self.cutting, tangential_coeff=float(t[3 * m]), radial_ratio=float(t[3 * m + 1]))
+        return ModalModel(t[:m], t[2 * m:3 * m], t[m:2 * m] / (2 * np.pi * t[:m]) ** 2), cut
+
     def freq_grid(self) -> np.ndarray:
         """Frequencies (Hz): 400 points over the modes' ±4σ range (×0.5 … ×1.6), and around each mode ≥ 16
         points per half-power band over its own ±4σ range (lightly damped modes need them, the rest does not)."""

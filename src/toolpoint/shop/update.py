@@ -434,18 +434,14 @@ def _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc):
 
 def _sdm_log_ratio(prior, theta, rpm_cuts, grid, f):
     """ln(a_SDM / a_ZOA) of each sample (R, ·) at the cut speeds and on the grid (both limits of the same θ)."""
-    from dataclasses import replace
+    from ..stability import sdm_lobes
 
-    from ..stability import ModalModel, sdm_lobes
-
-    m = prior.modes
     zc, _ = limit_at_speeds(prior, theta, rpm_cuts, f)
     zg = _limits(prior, theta, f, grid)
     u, inv = np.unique(rpm_cuts, return_inverse=True)
     out_c, out_g = np.zeros((theta.shape[0], rpm_cuts.size)), np.zeros((theta.shape[0], grid.size))
     for i, t in enumerate(theta):
-        mm = ModalModel(t[:m], t[2 * m:3 * m], t[m:2 * m] / (2 * np.pi * t[:m]) ** 2)
-        cut = replace(prior.cutting, tangential_coeff=float(t[3 * m]), radial_ratio=float(t[3 * m + 1]))
+        mm, cut = prior.tool(t)
         sc = sdm_lobes(mm, mm, cut, rpm=u).depth_m[inv]
         sg = sdm_lobes(mm, mm, cut, rpm=grid).depth_m
         with np.errstate(divide="ignore", invalid="ignore"):
