@@ -122,10 +122,34 @@ def test_cli_cut_writes_json_and_plot(tmp_path, capsys):
     assert doc["verdict"] == "chatter" and abs(doc["chatter_hz"] / 1234 - 1) < 0.01
     assert {"start_s", "end_s", "verdict", "chatter_hz"} <= set(doc["segments"][0])
     assert doc["recommended_rpm"] > 0 and png.stat().st_size > 10_000
-    # --dominance reaches the criterion: a chatter line of a few % of the harmonic's power is not "strong" at 100
-    assert main(["cut", str(wav), "--rpm", "6000", "--teeth", "4", "--dominance", "100", "--out", str(out)]) == 0
+    # --dominance and --alias-dominance reach the criterion: a chatter line of a few % of the harmonic's power is
+    # not "strong" at 100 — unless its tooth-passing aliases are there and --alias-dominance lets it through
+    args = ["cut", str(wav), "--rpm", "6000", "--teeth", "4", "--dominance", "100", "--out", str(out)]
+    assert main(args + ["--alias-dominance", "0"]) == 0
     doc = json.loads(out.read_text())
     assert doc["criterion"]["dominance"] == 100 and doc["verdict"] == "stable"
+    assert main(args) == 0
+    doc = json.loads(out.read_text())
+    assert doc["verdict"] == "chatter" and max(sg["n_alias"] for sg in doc["segments"] if sg["kind"] == "cut") >= 1
+
+
+def test_a_weak_line_is_chatter_with_its_tooth_passing_aliases_not_alone():
+    """A line at 1 % of the strongest harmonic's power that appears with the cut: with its aliases f ± f_t it is
+    regenerative chatter; alone (a feed drive, a pump switched on with the cut) it is not."""
+    rpm, teeth = 6000.0, 4
+    x, rate, t0, t1 = shop_record(rpm=rpm, teeth=teeth, chatter_hz=1234.0, chatter_amp=0.1, seed=5)
+    r = analyse_cut(x, rate, rpm=rpm, teeth=teeth, full_scale=1.0)
+    cut = [sg for sg in r.segments if sg.kind == "cut"]
+    assert r.verdict == "chatter" and abs(r.chatter_hz / 1234 - 1) < 0.01
+    assert all(0.005 <= sg.dominance < 0.05 and sg.n_alias >= 1 for sg in cut)  # weak, but a family
+    x, rate, t0, t1 = shop_record(rpm=rpm, teeth=teeth, seed=5)
+    t = np.arange(x.size) / rate
+    ramp = np.clip((t - t0) / 0.05, 0, 1) * np.clip((t1 - t) / 0.05, 0, 1)
+    x = x + 0.025 * ramp * np.sin(2 * np.pi * 1234.0 * t)  # a line alone, about 1 % of the harmonic in power
+    r = analyse_cut(x, rate, rpm=rpm, teeth=teeth, full_scale=1.0)
+    cut = [sg for sg in r.segments if sg.kind == "cut"]
+    assert r.verdict == "stable", [(sg.peak_hz, sg.dominance, sg.n_alias) for sg in cut]
+    assert any(abs(sg.peak_hz / 1234 - 1) < 0.01 and sg.dominance >= 0.005 and sg.n_alias == 0 for sg in cut)
 
 
 def _write_wav(path, x, rate=44100):

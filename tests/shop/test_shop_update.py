@@ -179,6 +179,37 @@ def test_library_adapter_reads_modes_and_cutting(tmp_path):
         prior_from_library(tmp_path, "T9")
 
 
+def test_library_prior_is_not_surer_than_the_library(tmp_path):
+    """A real ``library`` output (the shared small run): the prior update makes of each tool holds the library's
+    own 5–95 % band of the limit at every speed (the adapter may add what the library does not model — the
+    running spindle's frequency shift, the peak-picking — never remove what it sampled), around the same median."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "recommend"))
+    from test_library import small_run
+
+    from toolpoint.recommend.library import tool_file_stem
+    from toolpoint.shop.update import _limits
+
+    out = small_run()
+    for tool in ("A16", "B12"):
+        lib = np.load(out / "tools" / f"{tool_file_stem(tool)}.npz")
+        rpm, q = lib["rpm"], lib["limit_q_mm"] / 1e3
+        pr = prior_from_library(out, tool)
+        z = np.random.default_rng(0).standard_normal((400, pr.sigma.size)) * (pr.sigma > 0)
+        qp = np.quantile(_limits(pr, pr.theta(z), pr.freq_grid(), rpm), [0.05, 0.5, 0.95], axis=0)
+        holds = (qp[0] <= q[0] * 1.01) & (qp[2] >= q[2] * 0.99)
+        assert holds.mean() >= 0.95, (tool, holds.mean())
+        assert np.median(np.abs(np.log(qp[1] / q[1]))) < 0.1, tool
+    # the CLI: --sigma-freq overrides the library prior's σ_f, and only a library prior's
+    assert main(["update", "--library", str(out), "--tool", "B12", "--sigma-freq", "0.02", "--samples", "100",
+                 "--out", str(tmp_path / "u")]) == 0
+    assert (tmp_path / "u" / "report.html").exists()
+    assert main(["update", "--library", str(out), "--tool", "B12", "--sigma-freq", "2", "--out",
+                 str(tmp_path / "v")]) == 2
+
+
 @pytest.mark.slow
 def test_virtual_campaign_converges_with_few_chatters():
     """The loop on the update's own forward model (zero-order shop): converges within 8 cuts, ≤ 2 chatter."""

@@ -23,6 +23,8 @@ def register(sub) -> None:
     src.add_argument("--prior", help="modal-prior TOML (modes with σ, cut with K_t in N/mm²)")
     src.add_argument("--library", help="a library output folder (with --tool)")
     p.add_argument("--tool", help="tool id in the library output")
+    p.add_argument("--sigma-freq", help="with --library: log standard deviation of the natural frequencies "
+                   "(default 0.01: the running spindle's shift, which the library does not model)")
     p.add_argument("--cuts", help="test-cut table CSV (rpm, depth_mm, result[, chatter_hz][, record]); "
                    "without it: the prior's lobes and the first cut")
     p.add_argument("--out", required=True, help="output folder")
@@ -52,13 +54,23 @@ def run(args) -> int:
         raise InputError(f"must be ≤ 0.5, got {args.risk}", file="command line", field="--risk")
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")
+    if args.sigma_freq is not None and not args.library:
+        raise InputError("only with --library (a prior file states its own σ)", file="command line",
+                         field="--sigma-freq")
+    sig_f = None if args.sigma_freq is None else check_number(args.sigma_freq, "--sigma-freq", minimum=0)
+    if sig_f is not None and sig_f > 0.5:
+        raise InputError(f"must be ≤ 0.5 (a log standard deviation), got {args.sigma_freq}", file="command line",
+                         field="--sigma-freq")
     import numpy as np
 
     from ..shop.prior import prior_from_library, read_modal_prior
     from ..shop.report import write_update
     from ..shop.update import read_test_cuts, update
 
-    prior = read_modal_prior(args.prior) if args.prior else prior_from_library(args.library, args.tool)
+    if args.prior:
+        prior = read_modal_prior(args.prior)
+    else:
+        prior = prior_from_library(args.library, args.tool, **({} if sig_f is None else {"sigma_freq": sig_f}))
     cuts = read_test_cuts(args.cuts, teeth=prior.cutting.teeth) if args.cuts else []
     use_agg()
     post = update(prior, cuts, rng=np.random.default_rng(int(seed)), n_samples=int(n), method=args.method,

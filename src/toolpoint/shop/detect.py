@@ -34,9 +34,12 @@ The detector (:func:`analyse_cut`):
      significant new lines the strongest in power is the one judged (a chatter cluster raises its own
      local floor, so the most significant line can be a weak isolated one);
    * *strong*: its power ≥ ``dominance`` (default 0.05, −13 dB) of the strongest spindle harmonic in the
-     band — chatter is the dominant vibration, not a trace (the calibration of this ratio on simulated
-     records over a speed × depth grid is in ``docs/design/shop.md``).
-
+     band — chatter is the dominant vibration, not a trace — or ≥ ``alias_dominance`` (default 0.005,
+     −23 dB) when a tooth-passing alias f ± f_t or f ± 2 f_t is a significant new line too: regenerative
+     chatter is a family f_c + j f_t (the tooth passing modulates it, Insperger et al. 2003), a stray tone
+     (fan, pump, feed drive) is one line. Where the tool spends little of the revolution in the cut,
+     chatter saturates weak (the tool leaves the cut) and spreads into its aliases; the measured effect of
+     both ratios on simulated records over a speed × depth grid is in ``docs/design/shop.md``;
    * *sustained*: over the segment's second half the line keeps ≥ ¼ of its first half's power (a free
      vibration left by the entry decays; chatter holds or grows).
 
@@ -94,6 +97,8 @@ class CutSegment:
         Peak above the air cut at that frequency, dB (None without an air cut).
     dominance : float
         Peak power over the strongest spindle harmonic's power.
+    n_alias : int
+        Tooth-passing aliases of the peak (f ± f_t, f ± 2 f_t) that are significant new lines too (0–4).
     once_per_rev : float or None
         Non-synchronous fraction R of the signal's energy (None when < 10 revolutions).
     """
@@ -107,6 +112,7 @@ class CutSegment:
     significance: float = 0.0
     rise_db: float | None = None
     dominance: float = 0.0
+    n_alias: int = 0
     once_per_rev: float | None = None
 
     def to_dict(self) -> dict:
@@ -116,7 +122,7 @@ class CutSegment:
         return {"kind": self.kind, "start_s": r(self.start_s), "end_s": r(self.end_s), "verdict": self.verdict,
                 "chatter_hz": r(self.chatter_hz, 2), "peak_hz": r(self.peak_hz, 2),
                 "significance": r(self.significance, 3), "rise_db": r(self.rise_db, 2),
-                "dominance": r(self.dominance, 4), "once_per_rev": r(self.once_per_rev, 4)}
+                "dominance": r(self.dominance, 4), "n_alias": self.n_alias, "once_per_rev": r(self.once_per_rev, 4)}
 
 
 @dataclass(frozen=True)
@@ -311,8 +317,8 @@ def _once_per_rev(x, rate, f_s):
 
 def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_tolerance: float = 0.03,
                 band_hz: tuple | None = None, window_s: float = 1.0, activity_db: float = 4.0,
-                rise_db: float = 10.0, dominance: float = 0.05, alpha: float = _ALPHA,
-                full_scale: float | None = None, source: str | None = None) -> CutAnalysis:
+                rise_db: float = 10.0, dominance: float = 0.05, alias_dominance: float = 0.005,
+                alpha: float = _ALPHA, full_scale: float | None = None, source: str | None = None) -> CutAnalysis:
     """Judge a record of a milling cut: stable or chatter, per segment, with the chatter frequency.
 
     Parameters
@@ -337,6 +343,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         Least rise of a chatter peak above the air cut's spectrum, dB.
     dominance : float, default 0.05
         Least power of a chatter peak relative to the strongest spindle harmonic.
+    alias_dominance : float, default 0.005
+        The same for a peak with a tooth-passing alias (a significant new line at f ± f_t or f ± 2 f_t):
+        the regenerative signature that a stray tone does not have (0: never below ``dominance``).
     alpha : float, default 1e-3
         False-alarm probability of the tone test per judged segment.
     full_scale, source
@@ -451,7 +460,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
 
     def judge(ta, tb):
         sel = frames_in(ta, tb)
-        seg = _judge(P[sel], nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s)
+        seg = _judge(P[sel], nu1, freq, keep, harm, ref, rise_db, (dominance, alias_dominance), alpha, df,
+                     f_s, teeth * f_s)
         opr = _once_per_rev(x[int(ta * rate):int(tb * rate)], rate, f_s)
         return CutSegment("cut", ta, tb, **seg, once_per_rev=opr)
 
@@ -485,6 +495,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         chatter_hz = longest.chatter_hz
         rec, alts = harmonizer_rpm(chatter_hz, teeth, 60 * f_s)
     criterion = {"alpha": alpha, "rise_db": rise_db if ref is not None else None, "dominance": dominance,
+                 "alias_dominance": alias_dominance,
                  "mask_hz": f"2*{df:.4g} + {_MASK_REL:g}*f", "frame_s": L / rate, "band_hz": [lo, hi],
                  "spindle_multiples_removed": True}
     return CutAnalysis(verdict, chatter_hz, tuple(segments), float(rpm), 60 * f_s, spindle_found, int(teeth), rec,
@@ -529,8 +540,9 @@ def _leakage(p, freq, harm, f_s, df):
     return 4 * out
 
 
-def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s) -> dict:
-    """The chatter test on the mean of the frames ``Pseg`` (see the module docstring)."""
+def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s, f_t) -> dict:
+    """The chatter test on the mean of the frames ``Pseg`` (see the module docstring); ``dominance`` is the pair
+    (without, with a tooth-passing alias)."""
     n = Pseg.shape[0]
     p = Pseg.mean(axis=0)
     nu = float(nu1(n))
@@ -569,9 +581,16 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s)
         first = float(Pseg[:h, max(0, i - 1):i + 2].sum(axis=1).mean())
         last = float(Pseg[h:, max(0, i - 1):i + 2].sum(axis=1).mean())
         sustained = last >= 0.25 * first
-    chatter = sig > 1 and bool(new[i]) and dom >= dominance and sustained
+    n_alias = 0  # the regenerative family f_c + j f_t (Insperger et al. 2003): significant new lines at j = ±1, ±2
+    if good.any():
+        for j in (-2, -1, 1, 2):
+            a = int(round((f_peak + j * f_t) / df))
+            n_alias += bool(1 <= a < p.size - 1 and good[a - 1:a + 2].any())
+    d_plain, d_alias = dominance
+    strong = dom >= d_plain or (n_alias > 0 and d_alias > 0 and dom >= d_alias)
+    chatter = sig > 1 and bool(new[i]) and strong and sustained
     return dict(verdict="chatter" if chatter else "stable", chatter_hz=f_peak if chatter else None, peak_hz=f_peak,
-                significance=sig, rise_db=rise, dominance=float(min(dom, 1e6)))
+                significance=sig, rise_db=rise, dominance=float(min(dom, 1e6)), n_alias=n_alias)
 
 
 def _merge(windows, judge):

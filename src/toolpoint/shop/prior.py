@@ -27,8 +27,8 @@ conditions. :func:`prior_from_library` is the one adapter from that output to a 
 (a change of how ``library`` represents uncertainty touches only this function): modes picked on
 −Im Φ of the nominal FRF (natural frequency at the peak, damping from the half-power band, stiffness
 k = 1 / (2 ζ |Im Φ(f_n)|)), σ of the stiffness from the |Φ| quantiles at the peak
-(ln(q95/q05) / 3.29), σ of frequency and damping given (defaults 0.03 and 0.2: the library's
-quantiles of |Φ| do not say how the peaks move); σ of K_t and K_r the library's own for that tool
+(ln(q95/q05) / 3.29), σ of frequency and damping given (defaults ``FREQ_SIGMA`` = 0.01, see there, and 0.2: the
+band at the peak does not tell damping from stiffness); σ of K_t and K_r the library's own for that tool
 (``cutting_sigma_ln`` of its JSON: the preset's or the library row's), unless given.
 """
 
@@ -46,7 +46,7 @@ from ..errors import InputError
 from ..stability.cutting import CuttingConditions
 from .model import ModalPrior
 
-__all__ = ["read_modal_prior", "prior_from_library", "modes_from_frf"]
+__all__ = ["read_modal_prior", "prior_from_library", "modes_from_frf", "FREQ_SIGMA"]
 
 
 def read_modal_prior(path: str | os.PathLike) -> ModalPrior:
@@ -153,13 +153,22 @@ def modes_from_frf(freq_hz, frf, *, max_modes: int = 3, min_share: float = 0.1):
     return out
 
 
-def prior_from_library(out_dir: str | os.PathLike, tool_id: str, *, sigma_freq: float = 0.03,
+FREQ_SIGMA = 0.01
+"""Log σ of the natural frequencies of a prior made from a ``library`` output. The library's |Φ| band does not
+say how the peaks move, but it bounds it: on the seed-3 campaign's EM12-60 its 5–95 % band is ±0.4–8 % of |Φ|
+on the peaks' flanks, where a frequency shift σ_f would show as ±1.645 σ_f / (2ζ) (≈ ±70 % for σ_f 0.01, ζ
+0.012): the joint and subassembly it samples move the peaks by about 0.1 %. What it never modelled is the
+running spindle (speed and temperature move tool-point modes by about a percent): 0.01, not less."""
+
+
+def prior_from_library(out_dir: str | os.PathLike, tool_id: str, *, sigma_freq: float = FREQ_SIGMA,
                        sigma_damping: float = 0.2, sigma_kt: float | None = None,
                        sigma_kr: float | None = None) -> ModalPrior:
     """A :class:`ModalPrior` of tool ``tool_id`` of a ``library`` output folder (see the module docstring).
 
     ``sigma_kt``, ``sigma_kr`` (log standard deviations of K_t and K_r): default the library's own for the tool,
-    or 0.1 and 0.05 for an output that does not state them.
+    or 0.1 and 0.05 for an output that does not state them. ``sigma_freq``: log σ of every natural frequency
+    (default ``FREQ_SIGMA``).
 
     Raises
     ------
