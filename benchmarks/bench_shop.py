@@ -2,7 +2,7 @@
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
         [--only update] [--shops zoa,noisy,sim] [--cases cornelius,example] [--max-cuts 10] [--verbose]
-        [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm", "boundary_width": 0.1}']
+        [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
 
 Prints the machine, date and load first; per case and shop the median cuts to converge, the fraction converged,
 the median (max) chattering cuts and the CPU per update (median, max); ``--verbose`` one line per seed.

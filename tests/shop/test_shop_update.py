@@ -282,3 +282,7 @@ def test_sdm_forward_model_follows_cuts_that_follow_the_sdm():
             assert np.all(post.limit_q_m[0] <= a_sdm) and np.all(a_sdm <= post.limit_q_m[2])
     assert np.all(np.abs(med["sdm"] - 1) < 0.1), med
     assert np.all(np.abs(med["zoa"] - 1) > 0.15), med
+    # before any cut the prior's lobes are corrected the same way (the first cut's risk is the SDM's)
+    pri = {fw: update(pr, [], rng=np.random.default_rng(0), n_samples=300, lobe_samples=150, forward=fw, sdm_refs=2,
+                      rpm_grid=rpm).limit_q_m[1] / a_sdm for fw in ("zoa", "sdm")}
+    assert np.all(np.abs(pri["sdm"] - 1) < 0.1) and np.all(np.abs(pri["zoa"] - 1) > 0.15), pri

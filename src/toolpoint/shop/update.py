@@ -307,7 +307,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         with the zero-order limit times the references' mean ratio at each cut speed (their spread added to
         the boundary width), and each lobe sample is multiplied by one reference's ratio. For cuts that
         follow the SDM (time domain, a real machine) where the ZOA is biased (low radial immersion). Without
-        cuts the lobes stay zero-order. Limits: ``docs/design/shop.md``.
+        cuts the prior's lobes are corrected by ``sdm_refs`` prior samples' ratios (so is the first cut's
+        risk). Limits: ``docs/design/shop.md``.
     sdm_refs : int, default 4
         Reference samples of ``forward="sdm"`` (each costs one SDM lobe computation on the grid).
 
@@ -360,6 +361,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
             z = _sample(prior, rng.standard_normal((n_samples, P)) * free, cuts, kw2, method, n_moves, rng,
                         ess_hist, acc)
             log_ratio_grid = lr_g
+    elif forward == "sdm":  # no cuts yet: the prior's lobes (and the first cut's risk) corrected the same way
+        grid0 = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)
+        ref = z[rng.choice(n_samples, sdm_refs, replace=False)]
+        log_ratio_grid = _sdm_log_ratio(prior, prior.theta(ref), np.zeros(0), grid0, f)[1]
     # lobes of the posterior and of the prior
     grid = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)
     m = min(lobe_samples, n_samples)
@@ -433,20 +438,23 @@ def _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc):
 
 
 def _sdm_log_ratio(prior, theta, rpm_cuts, grid, f):
-    """ln(a_SDM / a_ZOA) of each sample (R, ·) at the cut speeds and on the grid (both limits of the same θ)."""
+    """ln(a_SDM / a_ZOA) of each sample (R, ·) at the cut speeds (may be none) and on the grid (both limits of
+    the same θ)."""
     from ..stability import sdm_lobes
 
-    zc, _ = limit_at_speeds(prior, theta, rpm_cuts, f)
     zg = _limits(prior, theta, f, grid)
-    u, inv = np.unique(rpm_cuts, return_inverse=True)
     out_c, out_g = np.zeros((theta.shape[0], rpm_cuts.size)), np.zeros((theta.shape[0], grid.size))
+    if rpm_cuts.size:
+        zc, _ = limit_at_speeds(prior, theta, rpm_cuts, f)
+        u, inv = np.unique(rpm_cuts, return_inverse=True)
     for i, t in enumerate(theta):
         mm, cut = prior.tool(t)
-        sc = sdm_lobes(mm, mm, cut, rpm=u).depth_m[inv]
         sg = sdm_lobes(mm, mm, cut, rpm=grid).depth_m
         with np.errstate(divide="ignore", invalid="ignore"):
-            out_c[i] = np.where(np.isfinite(sc / zc[i]) & (sc > 0), np.log(sc / zc[i]), 0.0)
             out_g[i] = np.where(np.isfinite(sg / zg[i]) & (sg > 0), np.log(sg / zg[i]), 0.0)
+            if rpm_cuts.size:
+                sc = sdm_lobes(mm, mm, cut, rpm=u).depth_m[inv]
+                out_c[i] = np.where(np.isfinite(sc / zc[i]) & (sc > 0), np.log(sc / zc[i]), 0.0)
     return out_c, out_g
 
 
