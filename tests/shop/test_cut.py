@@ -142,6 +142,10 @@ def test_a_weak_line_is_chatter_with_its_tooth_passing_aliases_not_alone():
     cut = [sg for sg in r.segments if sg.kind == "cut"]
     assert r.verdict == "chatter" and abs(r.chatter_hz / 1234 - 1) < 0.01
     assert all(0.005 <= sg.dominance < 0.05 and sg.n_alias >= 1 for sg in cut)  # weak, but a family
+    # without an air cut "new" cannot be told, nor the cut's own on/off sidebands: the alias rule is off
+    x0, rate0, *_ = shop_record(rpm=rpm, teeth=teeth, chatter_hz=1234.0, chatter_amp=0.1, seed=5, air_s=0.0, fans=())
+    r0 = analyse_cut(x0, rate0, rpm=rpm, teeth=teeth, full_scale=1.0)
+    assert r0.verdict == "stable" and all(sg.n_alias == 0 for sg in r0.segments)
     x, rate, t0, t1 = shop_record(rpm=rpm, teeth=teeth, seed=5)
     t = np.arange(x.size) / rate
     ramp = np.clip((t - t0) / 0.05, 0, 1) * np.clip((t1 - t) / 0.05, 0, 1)

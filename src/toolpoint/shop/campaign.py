@@ -76,9 +76,10 @@ def sdm_limit(prior: ModalPrior):
     return limit
 
 
-def microphone_record(velocity, rate: float, rng: np.random.Generator, *, air_s: float = 0.5,
+def microphone_record(velocity, rate: float, rng: np.random.Generator, *, air_s: float = 1.0,
                       noise: float = 0.05) -> np.ndarray:
-    """A microphone record of a simulated cut: ``air_s`` of air cut, the cut, ``air_s`` of air cut.
+    """A microphone record of a simulated cut: ``air_s`` of air cut, the cut, ``air_s`` of air cut (the detector
+    takes a quiet run shorter than 0.5 s for a pause in the cut, not an air cut).
 
     The microphone hears the tool's velocity (x + y) in the cut, over room noise — white, ``noise`` × the
     cut's RMS, the same in air and in the cut (what the detector's air-cut reference learns) — scaled to a

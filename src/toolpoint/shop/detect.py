@@ -37,7 +37,9 @@ The detector (:func:`analyse_cut`):
      band — chatter is the dominant vibration, not a trace — or ≥ ``alias_dominance`` (default 0.005,
      −23 dB) when a tooth-passing alias f ± f_t or f ± 2 f_t is a significant new line too: regenerative
      chatter is a family f_c + j f_t (the tooth passing modulates it, Insperger et al. 2003), a stray tone
-     (fan, pump, feed drive) is one line. Where the tool spends little of the revolution in the cut,
+     (fan, pump, feed drive) is one line. Only where the record holds an air cut (without one, "new" cannot
+     be told, and the on/off of the cut inside the judged part leaves sidebands k f_t ± δ that look like a
+     family). Where the tool spends little of the revolution in the cut,
      chatter saturates weak (the tool leaves the cut) and spreads into its aliases; the measured effect of
      both ratios on simulated records over a speed × depth grid is in ``docs/design/shop.md``;
    * *sustained*: over the segment's second half the line keeps ≥ ¼ of its first half's power (a free
@@ -98,7 +100,8 @@ class CutSegment:
     dominance : float
         Peak power over the strongest spindle harmonic's power.
     n_alias : int
-        Tooth-passing aliases of the peak (f ± f_t, f ± 2 f_t) that are significant new lines too (0–4).
+        Tooth-passing aliases of the peak (f ± f_t, f ± 2 f_t) that are significant new lines too (0–4; 0 when
+        the record holds no air cut).
     once_per_rev : float or None
         Non-synchronous fraction R of the signal's energy (None when < 10 revolutions).
     """
@@ -582,7 +585,7 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s,
         last = float(Pseg[h:, max(0, i - 1):i + 2].sum(axis=1).mean())
         sustained = last >= 0.25 * first
     n_alias = 0  # the regenerative family f_c + j f_t (Insperger et al. 2003): significant new lines at j = ±1, ±2
-    if good.any():
+    if good.any() and ref is not None:  # "new" needs an air cut; without one a machine tone's family is not told
         for j in (-2, -1, 1, 2):
             a = int(round((f_peak + j * f_t) / df))
             n_alias += bool(1 <= a < p.size - 1 and good[a - 1:a + 2].any())
