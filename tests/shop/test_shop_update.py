@@ -132,7 +132,8 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     for name in ("lobes.csv", "p_stable.csv", "parameters.csv", "update.json", "lobes.png", "report.html"):
         assert (out / name).stat().st_size > 100
     doc = json.loads((out / "update.json").read_text())
-    assert doc["next_cut"]["rule"] == "info" and doc["next_cut"]["p_chatter"] <= 0.3
+    nc = doc["next_cut"]
+    assert nc["rule"] == "info" and nc["p_chatter"] <= 0.3 and not nc["stepped"]
     assert 5000 <= doc["recommended"]["rpm"] <= 25000 and len(doc["cuts"]) == 3
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "src='http" not in html and "<script src" not in html
@@ -141,6 +142,18 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     # the stable cut at 20000 rpm, 0.5 mm: the posterior 5 % limit there is near or above it
     k = np.argmin(np.abs(lobes["rpm"] - 20000))
     assert lobes["p05_mm"][k] > 0.45 and lobes["p95_mm"][k] < 0.95
+    # --min-step: past the risk bound only as the step above a stable cut; a bad step is refused naming it
+    out2 = tmp_path / "out2"
+    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(out2), "--samples", "300",
+                 "--min-step", "0.1"]) == 0
+    nc2 = json.loads((out2 / "update.json").read_text())["next_cut"]
+    assert nc2["p_chatter"] <= 0.3 or nc2["stepped"]
+    if nc2["stepped"]:  # ×e^{0.1} above the highest stable cut at that speed (20000 or 12000 rpm)
+        assert any(abs(nc2["depth_mm"] / d - np.exp(0.1)) < 1e-3 for d in (0.5, 0.3)), nc2
+    capsys.readouterr()
+    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o3"),
+                 "--min-step", "-1"]) == 2
+    assert "--min-step" in capsys.readouterr().err and not (tmp_path / "o3").exists()
 
 
 def test_modal_prior_file_errors_name_the_field(tmp_path):
@@ -219,6 +232,23 @@ def test_virtual_campaign_converges_with_few_chatters():
     assert r.chatter_cuts <= 2
     assert r.width[-1] <= 0.2 and r.coverage[-1] >= 0.9
     assert isinstance(ModalPrior, type)
+
+
+def test_stable_cuts_climb_by_the_boundary_width_not_by_the_risk_quantile():
+    """A truth above the prior's median (K_t / 1.4: the limit 40 % up): with the risk bound alone each stable cut
+    sits at the posterior's 30 % quantile, a few % above the last one, and the band creeps (measured: +4–7 % a
+    cut, not converged in 7); with ``min_step`` 2 w the cuts climb ×1.105 and the band closes sooner."""
+    pr = cornelius_2024(0.1)
+    truth = pr.theta(np.zeros((1, pr.sigma.size)))[0]
+    truth[3 * pr.modes] /= 1.4
+    top, conv = {}, {}
+    for ms in (0.0, 0.1):
+        r = virtual_campaign(pr, rng=np.random.default_rng(3), theta_true=truth, max_cuts=7, n_samples=300,
+                             lobe_samples=150, min_step=ms)
+        top[ms] = max(c.depth_m for c in r.cuts[:5] if c.stable)
+        conv[ms] = np.inf if r.converged_after is None else r.converged_after
+    assert top[0.1] >= 1.1 * top[0.0], top
+    assert conv[0.1] < conv[0.0], conv
 
 
 def test_table_records_are_analysed_and_contradictions_reported(tmp_path):

@@ -35,6 +35,9 @@ def register(sub) -> None:
                    help="next-cut rule: info = most reduction of the limit's band at the recommended speed with "
                    "P(chatter) ≤ risk (default); risk = most productive cut with P(chatter) ≤ risk")
     p.add_argument("--risk", help="largest P(chatter) of the next cut (default 0.3 for info, 0.1 for risk)")
+    p.add_argument("--min-step", default="0", help="info rule: a cut this much (log) above the highest stable cut at a speed "
+                   "may be proposed even past --risk, so stable cuts do not creep (default 0: never; 0.1 = 2 × "
+                   "the boundary width saves cuts and costs chattering ones: docs/design/shop.md)")
     p.add_argument("--forward", choices=("zoa", "sdm"), default="zoa",
                    help="forward model: zoa = zero-order limit (default); sdm = zero-order corrected by the "
                    "semi-discretisation at posterior samples (cuts that follow the SDM, low radial immersion; "
@@ -52,6 +55,10 @@ def run(args) -> int:
     risk = None if args.risk is None else check_number(args.risk, "--risk", above=0)
     if risk is not None and risk > 0.5:
         raise InputError(f"must be ≤ 0.5, got {args.risk}", file="command line", field="--risk")
+    min_step = check_number(args.min_step, "--min-step", minimum=0)
+    if min_step > 0.5:
+        raise InputError(f"must be ≤ 0.5 (a log step: ×1.65), got {args.min_step}", file="command line",
+                         field="--min-step")
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")
     if args.sigma_freq is not None and not args.library:
@@ -74,10 +81,11 @@ def run(args) -> int:
     cuts = read_test_cuts(args.cuts, teeth=prior.cutting.teeth) if args.cuts else []
     use_agg()
     post = update(prior, cuts, rng=np.random.default_rng(int(seed)), n_samples=int(n), method=args.method,
-                  rule=args.rule, risk=risk, forward=args.forward)
+                  rule=args.rule, risk=risk, forward=args.forward, min_step=min_step)
     write_update(post, out)
     rc, nc = post.recommended, post.next_cut
     print(f"{len(cuts)} test cuts; recommended {rc['rpm']:.0f} rpm at {1e3 * rc['depth_m']:.3f} mm "
           f"(P(stable) {rc['p_stable']:.2f}); next test cut ({nc['rule']}) {nc['rpm']:.0f} rpm at "
-          f"{1e3 * nc['depth_m']:.3f} mm, P(chatter) {nc['p_chatter']:.2f}; wrote {out}/report.html")
+          f"{1e3 * nc['depth_m']:.3f} mm, P(chatter) {nc['p_chatter']:.2f}"
+          f"{' (a step above the stable cut there)' if nc.get('stepped') else ''}; wrote {out}/report.html")
     return 0
