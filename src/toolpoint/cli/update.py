@@ -35,9 +35,10 @@ def register(sub) -> None:
                    help="next-cut rule: info = most reduction of the limit's band at the recommended speed with "
                    "P(chatter) ≤ risk (default); risk = most productive cut with P(chatter) ≤ risk")
     p.add_argument("--risk", help="largest P(chatter) of the next cut (default 0.3 for info, 0.1 for risk)")
-    p.add_argument("--min-step", default="0", help="info rule: a cut this much (log) above the highest stable cut at a speed "
-                   "may be proposed even past --risk, so stable cuts do not creep (default 0: never; 0.1 = 2 × "
-                   "the boundary width saves cuts and costs chattering ones: docs/design/shop.md)")
+    p.add_argument("--min-step", default="0",
+                   help="info rule: a cut this much (log) above the highest stable cut at a speed may be "
+                   "proposed even past --risk, so stable cuts do not creep (default 0: never; 0.1 = 2 × the "
+                   "boundary width saves cuts and costs chattering ones: docs/design/shop.md)")
     p.add_argument("--forward", choices=("zoa", "sdm"), default="zoa",
                    help="forward model: zoa = zero-order limit (default); sdm = zero-order corrected by the "
                    "semi-discretisation at posterior samples (cuts that follow the SDM, low radial immersion; "
