@@ -154,6 +154,9 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o3"),
                  "--min-step", "-1"]) == 2
     assert "--min-step" in capsys.readouterr().err and not (tmp_path / "o3").exists()
+    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o4"),
+                 "--min-step", "0.1", "--rule", "risk"]) == 2
+    assert "min_step" in capsys.readouterr().err and not (tmp_path / "o4").exists()
 
 
 def test_modal_prior_file_errors_name_the_field(tmp_path):

@@ -351,6 +351,11 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     risk = (0.1 if rule == "risk" else 0.3) if risk is None else risk
     if not 0 < risk <= 0.5:
         raise InputError(f"must be in (0, 0.5], got {risk}", field="risk")
+    if not 0 <= min_step <= 0.5:
+        raise InputError(f"must be in [0, 0.5] (a log step), got {min_step}", field="min_step")
+    if min_step > 0 and rule != "info":
+        raise InputError("the step above stable cuts belongs to the info rule; the risk rule has none",
+                         field="min_step")
     cuts = tuple(cuts)
     f = prior.freq_grid()
     P = prior.sigma.size
