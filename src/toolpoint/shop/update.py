@@ -364,15 +364,15 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     z = rng.standard_normal((n_samples, P)) * free
     ess_hist, acc = [], []
     log_ratio_grid = None
+    grid = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)  # speeds of the lobes
     if cuts:
         z = _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc)
         if forward == "sdm":
             # the SDM/ZOA ratio of the limit at reference posterior samples: at the cut speeds it corrects the
             # likelihood (its spread over the references widens the boundary), on the grid the lobes
             rpm_c = np.array([c.rpm for c in cuts])
-            grid0 = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)
             ref = z[rng.choice(n_samples, sdm_refs, replace=False)]
-            lr_c, lr_g = _sdm_log_ratio(prior, prior.theta(ref), rpm_c, grid0, f)
+            lr_c, lr_g = _sdm_log_ratio(prior, prior.theta(ref), rpm_c, grid, f)
             spread = lr_c.std(axis=0) if sdm_refs > 1 else np.zeros(rpm_c.size)
             kw2 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + spread ** 2),
                        log_ratio=lr_c.mean(axis=0))
@@ -380,11 +380,9 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                         ess_hist, acc)
             log_ratio_grid = lr_g
     elif forward == "sdm":  # no cuts yet: the prior's lobes (and the first cut's risk) corrected the same way
-        grid0 = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)
         ref = z[rng.choice(n_samples, sdm_refs, replace=False)]
-        log_ratio_grid = _sdm_log_ratio(prior, prior.theta(ref), np.zeros(0), grid0, f)[1]
+        log_ratio_grid = _sdm_log_ratio(prior, prior.theta(ref), np.zeros(0), grid, f)[1]
     # lobes of the posterior and of the prior
-    grid = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)
     m = min(lobe_samples, n_samples)
     pick = rng.choice(n_samples, m, replace=False)
     lim = _limits(prior, prior.theta(z[pick]), f, grid)
