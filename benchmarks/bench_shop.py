@@ -111,6 +111,71 @@ def bench_cut(quick):
           f"scale): false chatter {fa[0.005]}/{n} with the alias rule (alias_dominance 0.005), {fa[0.0]}/{n} without")
 
 
+# (dominance, alias_dominance): the default first; without the alias rule; either ratio halved or lowered
+THRESHOLDS = ((0.05, 0.005), (0.05, 0.0), (0.05, 0.0025), (0.05, 0.01), (0.01, 0.005), (0.003, 0.003))
+
+
+class _Score:
+    """Verdicts of ``cut`` on simulated records against the SDM (and the simulation's own verdict), per threshold."""
+
+    def __init__(self):
+        self.right = dict.fromkeys(THRESHOLDS, 0)
+        self.right_sim = dict.fromkeys(THRESHOLDS, 0)
+        self.false_alarm = dict.fromkeys(THRESHOLDS, 0)
+        self.n = self.skipped = self.sim_agree = 0
+        self.ferr, self.cpu_cut, self.audio_s = [], 0.0, 0.0
+
+    def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
+        """Simulate the points (rpm, depth) (their SDM limit ``lim`` and ρ), hear and judge them."""
+        from toolpoint.simulation import simulate_milling
+
+        res = simulate_milling(mm, mm, c, rpm=rpm, depth_m=depth, revolutions=250, seed=seed, seed_level=seed_level)
+        for p in range(rpm.size):
+            if abs(depth[p] / lim[p] - 1) < 0.05:
+                self.skipped += 1
+                continue
+            x, rate = shop_microphone(res, float(rpm[p]), c.teeth, rng, point=p)
+            chatter = bool(rho[p] > 1)
+            self.n += 1
+            self.sim_agree += chatter == (not res.stable[p])
+            for thr in THRESHOLDS:
+                t0 = time.process_time()
+                r = analyse_cut(x, rate, rpm=float(rpm[p]), teeth=c.teeth, full_scale=1.0, dominance=thr[0],
+                                alias_dominance=thr[1])
+                if thr == THRESHOLDS[0]:
+                    self.cpu_cut += time.process_time() - t0
+                    self.audio_s += x.size / rate
+                    if chatter and r.chatter_hz and np.isfinite(res.chatter_hz[p]):
+                        alias = res.chatter_hz[p] + c.teeth * rpm[p] / 60 * np.arange(-3, 4)
+                        self.ferr.append(float(np.min(np.abs(r.chatter_hz - alias)) / r.chatter_hz))
+                self.right[thr] += (r.verdict == "chatter") == chatter
+                self.right_sim[thr] += (r.verdict == "chatter") == (not res.stable[p])
+                self.false_alarm[thr] += r.verdict == "chatter" and not chatter
+
+    def report(self, what):
+        n = self.n
+        print(f"{what}; {self.skipped} within ±5 % of the SDM limit left out; the simulation agrees with the SDM on "
+              f"{self.sim_agree}/{n}):")
+        for thr in THRESHOLDS:
+            print(f"   dominance {thr[0]:g}, with an alias {thr[1]:g}{' (default)' if thr == THRESHOLDS[0] else ''}: "
+                  f"{self.right[thr]}/{n} verdicts right "
+                  f"({self.right[thr] / n:.1%}), {self.false_alarm[thr]} false chatter; against the simulation's own "
+                  f"verdict {self.right_sim[thr]}/{n} ({self.right_sim[thr] / n:.1%})")
+        ferr = np.array(self.ferr)
+        print(f"   chatter frequency (modulo tooth-passing aliases) vs the simulation's: median {np.median(ferr):.2%}, "
+              f"{np.mean(ferr < 0.01):.0%} within 1 % (n {ferr.size}); cut {self.cpu_cut / self.audio_s:.3f} s CPU "
+              f"per s of audio")
+
+
+def _truth(pr, rng):
+    """A truth θ* drawn from the prior: (ModalModel, CuttingConditions) with a random immersion and direction."""
+    import dataclasses
+
+    mm, c = pr.tool(pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None, :])[0])
+    return mm, dataclasses.replace(c, radial_immersion=float(rng.choice([0.1, 0.25, 0.5, 1.0])),
+                                   milling=str(rng.choice(["down", "up"])))
+
+
 def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01):
     """Verdicts of ``cut`` on microphone records of cuts simulated by ``toolpoint.simulation``; truth: the SDM.
 
@@ -123,71 +188,58 @@ def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01):
     (0.2–3 × the median SDM limit), 250 revolutions from the steady cut, heard by tests/milling_sim.py's
     microphone (room noise, fans, spindle lines). Points within ±5 % of the SDM limit left out.
     """
-    import dataclasses
+    from toolpoint.stability import sdm_lobes, sdm_spectral_radius
 
-    from toolpoint.simulation import simulate_milling
-    from toolpoint.stability import ModalModel, sdm_lobes, sdm_spectral_radius
-
-    # (dominance, alias_dominance): the default first; without the alias rule; either ratio halved or lowered
-    thresholds = ((0.05, 0.005), (0.05, 0.0), (0.05, 0.0025), (0.05, 0.01), (0.01, 0.005), (0.003, 0.003))
-    right = dict.fromkeys(thresholds, 0)
-    right_sim = dict.fromkeys(thresholds, 0)  # against the simulated cut's own verdict (what the record holds)
-    false_alarm = dict.fromkeys(thresholds, 0)
-    n = skipped = sim_agree = 0
-    ferr, cpu_cut, audio_s = [], 0.0, 0.0
+    sc = _Score()
     for case in ("cornelius", "example"):
         for seed in range(seed_start, seed_start + (2 if quick else truths)):
             rng = np.random.default_rng(seed)
             pr = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}[case]
-            th = pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None, :])[0]
-            m = pr.modes
-            fn, k, z = th[:m], th[m:2 * m], th[2 * m:3 * m]
-            c = dataclasses.replace(pr.cutting, tangential_coeff=th[3 * m], radial_ratio=th[3 * m + 1],
-                                    radial_immersion=float(rng.choice([0.1, 0.25, 0.5, 1.0])),
-                                    milling=str(rng.choice(["down", "up"])))
-            mm = ModalModel(fn, z, k / (2 * np.pi * fn) ** 2)
+            mm, c = _truth(pr, rng)
             speeds = np.geomspace(5000, 25000, 7)
             lim = sdm_lobes(mm, mm, c, rpm=speeds).depth_m
             depths = np.linspace(0.2, 3.0, 7) * np.median(lim)
             rho = sdm_spectral_radius(mm, mm, c, rpm=speeds[None, :], depth=depths[:, None])
             R, A = np.meshgrid(speeds, depths)
-            res = simulate_milling(mm, mm, c, rpm=R.ravel(), depth_m=A.ravel(), revolutions=250, seed=seed,
-                                   seed_level=seed_level)
-            for p in range(R.size):
-                gi, di = p % speeds.size, p // speeds.size
-                rpm, a = float(R.ravel()[p]), float(A.ravel()[p])
-                if abs(a / lim[gi] - 1) < 0.05:
-                    skipped += 1
-                    continue
-                x, rate = shop_microphone(res, rpm, c.teeth, rng, point=p)
-                chatter = bool(rho[di, gi] > 1)
-                n += 1
-                sim_agree += chatter == (not res.stable[p])
-                for thr in thresholds:
-                    t0 = time.process_time()
-                    r = analyse_cut(x, rate, rpm=rpm, teeth=c.teeth, full_scale=1.0, dominance=thr[0],
-                                    alias_dominance=thr[1])
-                    if thr == thresholds[0]:
-                        cpu_cut += time.process_time() - t0
-                        audio_s += x.size / rate
-                        if chatter and r.chatter_hz and np.isfinite(res.chatter_hz[p]):
-                            alias = res.chatter_hz[p] + c.teeth * rpm / 60 * np.arange(-3, 4)
-                            ferr.append(float(np.min(np.abs(r.chatter_hz - alias)) / r.chatter_hz))
-                    right[thr] += (r.verdict == "chatter") == chatter
-                    right_sim[thr] += (r.verdict == "chatter") == (not res.stable[p])
-                    false_alarm[thr] += r.verdict == "chatter" and not chatter
-    ferr = np.array(ferr)
-    print(f"simulated records (toolpoint.simulation, seed level {seed_level:g}, {2 * (2 if quick else truths)} random "
-          f"truths (seeds {seed_start}…) of the Cornelius "
-          f"and example-tool priors, random immersion and up/down, 7 speeds x 7 depths; {skipped} within ±5 % of "
-          f"the SDM limit left out; the simulation agrees with the SDM on {sim_agree}/{n}):")
-    for thr in thresholds:
-        print(f"   dominance {thr[0]:g}, with an alias {thr[1]:g}{' (default)' if thr == thresholds[0] else ''}: "
-              f"{right[thr]}/{n} verdicts right "
-              f"({right[thr] / n:.1%}), {false_alarm[thr]} false chatter; against the simulation's own verdict "
-              f"{right_sim[thr]}/{n} ({right_sim[thr] / n:.1%})")
-    print(f"   chatter frequency (modulo tooth-passing aliases) vs the simulation's: median {np.median(ferr):.2%}, "
-          f"{np.mean(ferr < 0.01):.0%} within 1 % (n {ferr.size}); cut {cpu_cut / audio_s:.3f} s CPU per s of audio")
+            sc.add(mm, c, R.ravel(), A.ravel(), np.broadcast_to(lim, R.shape).ravel(), rho.ravel(), seed, seed_level,
+                   rng)
+    sc.report(f"simulated records (toolpoint.simulation, seed level {seed_level:g}, {2 * (2 if quick else truths)} "
+              f"random truths (seeds {seed_start}…) of the Cornelius and example-tool priors, random immersion and "
+              f"up/down, 7 speeds x 7 depths")
+
+
+def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01):
+    """``cut`` at the speeds a chatter-avoiding choice lands on: a tooth-passing harmonic j f_t on a mode.
+
+    For each truth (drawn from each prior, its immersion and direction, seeds
+    ``seed_start``…) and each of its modes, the speeds 60 f_n / (N j) × (0.97, 1, 1.03), j = 1…4, inside the
+    prior's speed range (else 5000–25000 rpm), at most 8 of them (the slowest dropped), and the depths (0.6, 0.8,
+    1.15, 1.4, 2) × the SDM limit there. The grid of :func:`bench_cut_sim` samples speeds at random; the virtual
+    campaigns' cuts sit in these pockets, where the resonant harmonic is 20–30 dB above the rest.
+    """
+    from toolpoint.stability import sdm_lobes, sdm_spectral_radius
+
+    sc = _Score()
+    for name, pr in priors.items():
+        lo, hi = pr.rpm_range if pr.rpm_range is not None else (5000.0, 25000.0)
+        for seed in range(seed_start, seed_start + (1 if quick else truths)):
+            rng = np.random.default_rng(seed)
+            mm, c = pr.tool(pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None, :])[0])
+            sp = (60 * np.asarray(mm.fn_hz)[:, None, None] / (c.teeth * np.arange(1, 5)[None, :, None])
+                  * np.array([0.97, 1.0, 1.03])[None, None, :]).ravel()
+            sp = np.sort(sp[(sp >= lo) & (sp <= hi)])[-8:]
+            if sp.size == 0:
+                continue
+            lim = sdm_lobes(mm, mm, c, rpm=sp).depth_m
+            ok = np.isfinite(lim)
+            sp, lim = sp[ok], lim[ok]
+            R = np.repeat(sp, 5)
+            L = np.repeat(lim, 5)
+            A = L * np.tile([0.6, 0.8, 1.15, 1.4, 2.0], sp.size)
+            rho = sdm_spectral_radius(mm, mm, c, rpm=R, depth=A)
+            sc.add(mm, c, R, A, L, rho, seed, seed_level, rng)
+    sc.report(f"simulated records at pocket speeds (a tooth-passing harmonic on a mode; {', '.join(priors)}; "
+              f"{1 if quick else truths} truths each, seeds {seed_start}…; 5 depths 0.6–2 × the SDM limit")
 
 
 def noisy_shop(prior, rng_blur=0.03, f_noise=0.005):
@@ -195,6 +247,20 @@ def noisy_shop(prior, rng_blur=0.03, f_noise=0.005):
         a, fc = limit_at_speeds(prior, theta[None, :], [rpm])
         stable = bool(depth < a[0, 0] * np.exp(rng.normal(0, rng_blur)))
         f_meas = None if stable else float(fc[0, 0] * (1 + rng.normal(0, f_noise)))
+        return TestCut(float(rpm), float(depth), stable, f_meas)
+    return shop
+
+
+def sdm_shop(prior, rng_blur=0.03, f_noise=0.005):
+    """Labels by the SDM limit of θ* at the cut's speed (its chatter frequency), blurred like :func:`noisy_shop`:
+    the whole loop's forward model (the SDM truth) without the simulation and the detector."""
+    from toolpoint.stability import sdm_lobes
+
+    def shop(theta, rpm, depth, rng):
+        mm, cut = prior.tool(theta)
+        res = sdm_lobes(mm, mm, cut, rpm=[float(rpm)])
+        stable = bool(depth < res.depth_m[0] * np.exp(rng.normal(0, rng_blur)))
+        f_meas = None if stable else float(res.chatter_hz[0] * (1 + rng.normal(0, f_noise)))
         return TestCut(float(rpm), float(depth), stable, f_meas)
     return shop
 
@@ -229,9 +295,9 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
         for shop_name in shops:
             conv, chat, cpu, fails = [], [], [], 0
             for seed in range(seed_start, seed_start + seeds):
-                shop = {"zoa": None, "noisy": noisy_shop(prior),
+                shop = {"zoa": None, "noisy": noisy_shop(prior), "sdm": sdm_shop(prior),
                         "sim": simulated_shop(prior, record=shop_microphone)}[shop_name]
-                truth = sdm_limit(prior) if shop_name == "sim" else None
+                truth = sdm_limit(prior) if shop_name in ("sim", "sdm") else None
                 r = virtual_campaign(prior, rng=np.random.default_rng(seed), shop=shop, max_cuts=max_cuts,
                                      true_limit=truth, n_samples=n_s, lobe_samples=n_l, **update_kw)
                 conv.append(r.converged_after if r.converged_after is not None else np.inf)
@@ -278,13 +344,15 @@ def main():
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", choices=("cut", "update", "sampler"))
-    ap.add_argument("--shops", default="zoa,noisy,sim", help="comma-separated shops of the update benchmark")
+    ap.add_argument("--shops", default="zoa,noisy,sim",
+                    help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
                     help="comma-separated priors: cornelius, example, library (with --library-prior)")
     ap.add_argument("--library-prior", help="OUT:TOOL, a tool of a `toolpoint library` output folder (case library)")
     ap.add_argument("--update", default="{}", help="JSON of extra update() options, e.g. '{\"n_samples\": 500}'")
     ap.add_argument("--max-cuts", type=int, default=10)
     ap.add_argument("--cut-truth-seed", type=int, default=10, help="first truth seed of the simulated-record grid")
+    ap.add_argument("--pocket-truth-seed", type=int, default=40, help="first truth seed of the pocket-speed records")
     ap.add_argument("--seed-level", type=float, default=0.01,
                     help="kick of each simulated cut, relative to the forced response (simulate_milling's seed_level)")
     ap.add_argument("--verbose", action="store_true", help="one line per campaign")
@@ -293,6 +361,13 @@ def main():
     if a.only in (None, "cut"):
         bench_cut(a.quick)
         bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level)
+        pockets = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
+        if a.library_prior:
+            from toolpoint.shop.prior import prior_from_library
+
+            out, tool = a.library_prior.rsplit(":", 1)
+            pockets[tool] = prior_from_library(out, tool)
+        bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level)
     if a.only in (None, "sampler"):
         bench_sampler()
     if a.only in (None, "update"):

@@ -8,6 +8,8 @@ The least-squares solves, SVDs and matrix exponentials in toolpoint are small
 
 from __future__ import annotations
 
+import functools
+
 
 def single_thread_blas():
     """Context manager limiting BLAS to one thread (threadpoolctl).
@@ -26,6 +28,13 @@ def single_thread_blas():
     >>> s.tolist()
     [1.0, 1.0, 1.0]
     """
-    from threadpoolctl import threadpool_limits
+    return _controller().limit(limits=1, user_api="blas")
 
-    return threadpool_limits(limits=1, user_api="blas")
+
+@functools.lru_cache(maxsize=1)
+def _controller():
+    # Inspecting the loaded libraries costs ~2 ms (it reads /proc/self/maps): once per process, not per call —
+    # the SDM calls this once per model in the shop update's per-particle loop.
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()

@@ -10,6 +10,7 @@ from toolpoint.stability import (
     CuttingConditions,
     ModalModel,
     average_directional_matrix,
+    sdm_limit_near,
     sdm_lobes,
     sdm_spectral_radius,
     zoa_lobes,
@@ -145,6 +146,23 @@ def test_bad_input(args, kw):
     base = dict(cutting=cut(0.5), rpm=[5000.0, 6000.0]) | kw
     with pytest.raises(InputError):
         sdm_lobes(*args, **base)
+
+
+@pytest.mark.parametrize("ri", [1.0, 0.05])
+def test_limit_near_a_guess_finds_the_searched_limit(ri):
+    """The bracket-and-bisect search from a guess 0.6× or 1.7× the limit lands on :func:`sdm_lobes`' upward
+    search (rtol 1e-5) within its final bracket (h/16 = 1.25 % in ln a, interpolated: < 0.5 % measured);
+    a guess beyond the steps is reported unbracketed, at the last depth tried, on the right side."""
+    rpm = np.array(SPEEDS[ri])
+    ref = sdm_lobes(MODE, None, cut(ri), rpm=rpm, rtol=1e-5).depth_m
+    for fac in (0.6, 1.7):
+        lim, ok = sdm_limit_near(MODE, None, cut(ri), rpm=rpm, depth_m=ref * fac)
+        assert ok.all()
+        assert lim == pytest.approx(ref, rel=0.005)
+    lim, ok = sdm_limit_near(MODE, None, cut(ri), rpm=rpm, depth_m=ref * 0.2, max_steps=2)
+    assert not ok.any() and np.all(lim < ref) and lim == pytest.approx(ref * 0.2 * np.exp(0.4))
+    with pytest.raises(InputError, match="guesses"):
+        sdm_limit_near(MODE, None, cut(ri), rpm=rpm, depth_m=ref[:1])
 
 
 def test_old_loose_keywords_are_refused():

@@ -178,15 +178,16 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
                    freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
-    ``log_ratio`` (per cut, optional): ln of a factor on the zero-order limit at the cut's speed (the SDM
-    correction of :func:`update`'s ``forward="sdm"``); ``boundary_width`` may be one value per cut."""
+    ``log_ratio`` (per cut (C,), or per sample and cut (S, C), optional): ln of a factor on the zero-order limit
+    at the cut's speed (the SDM correction of :func:`update`'s ``forward="sdm"``); ``boundary_width`` may be one
+    value per cut."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
     a_lim, f_c = limit_at_speeds(prior, theta, rpm, freq_hz)
     lr = np.zeros(len(cuts)) if log_ratio is None else np.asarray(log_ratio, float)
     with np.errstate(divide="ignore"):
-        x = (np.log(a_lim) + lr[None, :] - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
+        x = (np.log(a_lim) + np.atleast_2d(lr) - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
     x = np.where(np.isfinite(x), x, 50.0)  # no lobe reaches the speed: stable at any depth in the grid
     eps = label_noise
     ls = np.logaddexp(np.log(eps), np.log1p(-2 * eps) + log_ndtr(x))  # ln P(stable)
@@ -281,7 +282,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            rpm_grid=None, n_moves: int = 3, boundary_width: float = 0.05, label_noise: float = 0.002,
            freq_sigma: float = 0.02, rule: str = "info", risk: float | None = None, lobe_samples: int = 400,
            n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "zoa", sdm_refs: int = 4,
-           min_step: float = 0.0) -> Posterior:
+           min_step: float = 0.0, sdm_train: int = 0) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -320,6 +321,15 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         risk). Limits: ``docs/design/shop.md``.
     sdm_refs : int, default 4
         Reference samples of ``forward="sdm"`` (each costs one SDM lobe computation on the grid).
+    sdm_train : int, default 0
+        ``forward="sdm"`` with cuts: samples of the corrected posterior whose own SDM limits at the cut speeds
+        (:func:`~toolpoint.stability.sdm_limit_near`) replace the references' ratio there — its mean in the
+        likelihood, its spread added to the boundary width — before a third sampling; the lobe samples' ratio
+        is moved to that mean within a few % of the cut speeds (0: the references only). The references come
+        from the zero-order posterior, which moved its parameters to explain the cuts; their ratio at the
+        cut speeds was measured 0.1–0.2 (ln) off the corrected samples' own. 60 brings the median limit at the
+        cut speeds closer to the SDM's but did not make campaigns converge more often, at 3–6 s more per update:
+        off by default (``docs/design/shop.md``).
     min_step : float, default 0
         ``"info"`` rule: a cut ``min_step`` (log) above the highest stable cut at a speed is a candidate even
         where it exceeds ``risk`` (0: never; 2 × ``boundary_width`` = 0.1 trades chatters for cuts: module
@@ -379,6 +389,24 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
             z = _sample(prior, rng.standard_normal((n_samples, P)) * free, cuts, kw2, method, n_moves, rng,
                         ess_hist, acc)
             log_ratio_grid = lr_g
+            if sdm_train > 0:
+                # the references' ratio is that of the zero-order posterior, not of the corrected one: the
+                # corrected samples' own SDM limits at the cut speeds (sdm_train of them) give the ratio there,
+                # its mean in the likelihood and its spread in the boundary width, and the posterior is sampled
+                # a third time; each lobe sample keeps one reference's ratio, moved to that mean near the cuts
+                u, inv = np.unique(rpm_c, return_inverse=True)
+                first = np.zeros(u.size, int)
+                first[inv[::-1]] = np.arange(rpm_c.size)[::-1]
+                lr_ref_u = lr_c[:, first]  # (R, U)
+                z_tr = z[rng.choice(n_samples, min(sdm_train, n_samples), replace=False)]
+                lr_tr = _sdm_own_log_ratio(prior, z_tr, u, f, lr_ref_u.mean(axis=0))  # (T, U)
+                mean_u = lr_tr.mean(axis=0)
+                sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
+                kw3 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + sd_u[inv] ** 2),
+                           log_ratio=mean_u[inv])
+                z = _sample(prior, rng.standard_normal((n_samples, P)) * free, cuts, kw3, method, n_moves, rng,
+                            ess_hist, acc)
+                log_ratio_grid = lr_g + _carry(mean_u[None, :] - lr_ref_u, grid, u)
     elif forward == "sdm":  # no cuts yet: the prior's lobes (and the first cut's risk) corrected the same way
         ref = z[rng.choice(n_samples, sdm_refs, replace=False)]
         log_ratio_grid = _sdm_log_ratio(prior, prior.theta(ref), np.zeros(0), grid, f)[1]
@@ -472,6 +500,33 @@ def _sdm_log_ratio(prior, theta, rpm_cuts, grid, f):
                 sc = sdm_lobes(mm, mm, cut, rpm=u).depth_m[inv]
                 out_c[i] = np.where(np.isfinite(sc / zc[i]) & (sc > 0), np.log(sc / zc[i]), 0.0)
     return out_c, out_g
+
+
+def _sdm_own_log_ratio(prior, z, u, f, lr_guess):
+    """ln(a_SDM / a_ZOA) of each sample (S, U) at the speeds u: its own SDM limit
+    (:func:`~toolpoint.stability.sdm_limit_near`, from its zero-order limit times e^lr_guess); 0 where no lobe
+    reaches the speed."""
+    from ..stability import sdm_limit_near
+
+    th = prior.theta(z)
+    a_zoa, fc = limit_at_speeds(prior, th, u, f)  # (S, U)
+    guess = a_zoa * np.exp(np.broadcast_to(lr_guess, a_zoa.shape))
+    own = np.full(a_zoa.shape, np.nan)
+    for i in range(th.shape[0]):  # one model per sample: vectorised over its speeds
+        ok = np.isfinite(guess[i]) & (guess[i] > 0)
+        if ok.any():
+            mm, cut = prior.tool(th[i])
+            own[i, ok], _ = sdm_limit_near(mm, mm, cut, rpm=u[ok], depth_m=guess[i, ok], chatter_hz=fc[i, ok])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(np.isfinite(own / a_zoa) & (own > 0), np.log(own / a_zoa), 0.0)
+
+
+def _carry(resid, grid, u, kernel=0.02):
+    """Residuals at the speeds u (·, U) carried to the grid (·, G): Gaussian weights in the relative speed
+    difference (width ``kernel``), normalised where they add up to more than one — the residual itself at a
+    lone cut speed, fading to 0 a few ``kernel`` away."""
+    k = np.exp(-0.5 * ((grid[:, None] / u[None, :] - 1) / kernel) ** 2)  # (G, U)
+    return resid @ k.T / np.maximum(1.0, k.sum(axis=1))[None, :]
 
 
 def _default_grid(prior: ModalPrior) -> np.ndarray:

@@ -19,7 +19,7 @@ Geometry and sign conventions: :mod:`toolpoint.stability.milling`.
 from .cutting import CuttingConditions
 from .cutting import immersion_angles
 from .milling import Lobe, LobeResult, Pocket, average_directional_matrix, directional_coefficients
-from .sdm import sdm_lobes, sdm_spectral_radius
+from .sdm import sdm_limit_near, sdm_lobes, sdm_spectral_radius
 from .statespace import ModalModel, StateSpaceModel, from_modal_fit
 from .zoa import zoa_lobes
 
@@ -34,6 +34,7 @@ __all__ = [
     "directional_coefficients",
     "from_modal_fit",
     "immersion_angles",
+    "sdm_limit_near",
     "sdm_lobes",
     "sdm_spectral_radius",
     "zoa_lobes",
