@@ -75,6 +75,30 @@ def test_bands_are_calibrated_out_of_sample():
     assert 0.78 <= np.mean(inside) <= 0.99
 
 
+def test_a_missed_chatter_rate_weakens_stable_labels_only():
+    """``miss_rate`` m: a stable label far above a sample's limit keeps likelihood ε + m(1 − ε) (closed form), a
+    chatter label there (1 − m)(1 − ε), a stable label far below 1 − ε + m ε. One stable cut at 1.3 × the prior's
+    median limit lifts the posterior's band less with m = 0.2 than without; a bad m is refused."""
+    pr = cornelius_2024(0.1)
+    rpm = 12000.0
+    th = pr.theta(np.zeros((1, pr.sigma.size)))
+    a0 = float(limit_at_speeds(pr, th, [rpm])[0][0, 0])
+    eps, m = 0.002, 0.2
+    far_above = [TestCut(rpm, 3 * a0, True)], [TestCut(rpm, 3 * a0, False)]
+    ls = log_likelihood(pr, th, far_above[0], label_noise=eps, miss_rate=m)
+    lc = log_likelihood(pr, th, far_above[1], label_noise=eps, miss_rate=m)
+    assert np.exp(ls) == pytest.approx(eps + m * (1 - eps), rel=1e-6)
+    assert np.exp(lc) == pytest.approx((1 - m) * (1 - eps), rel=1e-6)
+    far_below = log_likelihood(pr, th, [TestCut(rpm, a0 / 3, True)], label_noise=eps, miss_rate=m)
+    assert np.exp(far_below) == pytest.approx(1 - eps + m * eps, rel=1e-6)
+    cut = [TestCut(rpm, 1.3 * a0, True)]
+    q = {mr: update(pr, cut, rng=np.random.default_rng(0), n_samples=400, lobe_samples=200, rpm_grid=[rpm],
+                    miss_rate=mr).limit_q_m[:, 0] for mr in (0.0, m)}
+    assert q[0.0][0] > 1.2 * a0 and q[m][0] < q[0.0][0] and q[m][1] < q[0.0][1], q
+    with pytest.raises(InputError, match="miss_rate|0, 1"):
+        update(pr, cut, rng=np.random.default_rng(0), n_samples=50, miss_rate=1.0)
+
+
 def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):
     p = tmp_path / "cuts.csv"
     p.write_text("rpm,depth_mm,result\n12000,1.0,stable\n12000,0.5,chatter\n15000,0.4,stable\n")

@@ -11,7 +11,10 @@ a label is simply wrong, whatever the distance to the limit. ε sets how tight a
 the samples outside a bracket [stable a_s, chatter a_c] keep a weight ε against ~1 inside, so with a bracket
 holding 15 % of the prior's mass ε = 0.02 left ~10 % of the posterior outside it and the 5–95 % band could
 not close without more cuts (measured: ``docs/design/shop.md``). Labels that are wrong *near* the limit (a
-detector, a forward model that is not the shop's) belong in w, not in ε. A chattering cut with a measured
+detector, a forward model that is not the shop's) belong in w, not in ε. A detector that misses chatter (a
+microphone at a pocket speed, where a resonant tooth-passing harmonic hides it) is ``miss_rate`` m: P(label
+stable) = p_s + m p_c, P(label chatter) = (1 − m) p_c (off by default: measured in ``docs/design/shop.md``).
+A chattering cut with a measured
 chatter frequency f adds
 
     p(f | θ) = (1 − ε_f) N(d; 0, (σ_f f)²) + ε_f / f,   d = min_j |f − (f_c(θ, n) + j N n/60)|, j = −2…2,
@@ -175,12 +178,14 @@ def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, s
 
 
 def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.05, label_noise: float = 0.002,
-                   freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None) -> np.ndarray:
+                   freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None,
+                   miss_rate: float = 0.0) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
     ``log_ratio`` (per cut (C,), or per sample and cut (S, C), optional): ln of a factor on the zero-order limit
     at the cut's speed (the SDM correction of :func:`update`'s ``forward="sdm"``); ``boundary_width`` may be one
-    value per cut."""
+    value per cut. ``miss_rate``: probability that a chattering cut is labelled stable (a detector's missed
+    chatter), on top of ε: P(label stable) = p_s + m p_c, P(label chatter) = (1 − m) p_c."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
@@ -192,6 +197,9 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     eps = label_noise
     ls = np.logaddexp(np.log(eps), np.log1p(-2 * eps) + log_ndtr(x))  # ln P(stable)
     lc = np.logaddexp(np.log(eps), np.log1p(-2 * eps) + log_ndtr(-x))  # ln P(chatter)
+    if miss_rate > 0:  # a chattering cut heard as stable
+        ls = np.logaddexp(ls, math.log(miss_rate) + lc)
+        lc = lc + math.log1p(-miss_rate)
     ll = np.where(stable[None, :], ls, lc).sum(axis=1)
     N = prior.cutting.teeth
     for r, c in enumerate(cuts):
@@ -282,7 +290,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            rpm_grid=None, n_moves: int = 3, boundary_width: float = 0.05, label_noise: float = 0.002,
            freq_sigma: float = 0.02, rule: str = "info", risk: float | None = None, lobe_samples: int = 400,
            n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "zoa", sdm_refs: int = 4,
-           min_step: float = 0.0, sdm_train: int = 0) -> Posterior:
+           min_step: float = 0.0, sdm_train: int = 0, miss_rate: float = 0.0) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -321,6 +329,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         risk). Limits: ``docs/design/shop.md``.
     sdm_refs : int, default 4
         Reference samples of ``forward="sdm"`` (each costs one SDM lobe computation on the grid).
+    miss_rate : float, default 0
+        Probability that a chattering cut is labelled stable (a detector's missed chatter; module docstring):
+        a stable label then never rules out a limit below it by more than ε + m. The risk of the next cut stays
+        the cut's own P(chatter).
     sdm_train : int, default 0
         ``forward="sdm"`` with cuts: samples of the corrected posterior whose own SDM limits at the cut speeds
         (:func:`~toolpoint.stability.sdm_limit_near`) replace the references' ratio there — its mean in the
@@ -361,6 +373,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     risk = (0.1 if rule == "risk" else 0.3) if risk is None else risk
     if not 0 < risk <= 0.5:
         raise InputError(f"must be in (0, 0.5], got {risk}", field="risk")
+    if not 0 <= miss_rate < 1:
+        raise InputError(f"must be in [0, 1), got {miss_rate}", field="miss_rate")
     if not 0 <= min_step <= 0.5:
         raise InputError(f"must be in [0, 0.5] (a log step), got {min_step}", field="min_step")
     if min_step > 0 and rule != "info":
@@ -370,7 +384,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     f = prior.freq_grid()
     P = prior.sigma.size
     free = prior.sigma > 0
-    kw = dict(boundary_width=boundary_width, label_noise=label_noise, freq_sigma=freq_sigma, freq_hz=f)
+    kw = dict(boundary_width=boundary_width, label_noise=label_noise, freq_sigma=freq_sigma, freq_hz=f,
+              miss_rate=miss_rate)
     z = rng.standard_normal((n_samples, P)) * free
     ess_hist, acc = [], []
     log_ratio_grid = None
@@ -436,7 +451,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                "p_chatter": float(np.mean(lim[:, k] <= qr[k])),
                "description": f"most productive cut (max rpm × depth) with P(chatter) ≤ {risk:g}"}
     else:
-        nxt = _next_info(lim, grid, j, risk, boundary_width, label_noise, chatter_cost, cuts, min_step)
+        nxt = _next_info(lim, grid, j, risk, boundary_width, label_noise, chatter_cost, cuts, min_step, miss_rate)
     return Posterior(prior, cuts, method, z, tuple(ess_hist), float(np.mean(acc)) if acc else float("nan"), grid, q,
                      depths, p_st, qp, rec, nxt, time.process_time() - c0)
 
@@ -569,7 +584,7 @@ def _wquantile_width(vals_sorted, w):
     return np.log(hi / lo)
 
 
-def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), min_step=0.0):
+def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), min_step=0.0, miss_rate=0.0):
     """The ``"info"`` rule: min expected relative band width at the recommended speed, P(chatter) ≤ risk —
     or a step of ``min_step`` (log) above the highest stable cut at that speed (±0.5 %), when the risk bound
     stops short of it (module docstring)."""
@@ -599,9 +614,11 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
         with np.errstate(divide="ignore"):
             x = (np.log(lim[None, :, k]) - np.log(depths[:, None])) / width  # (C, S)
         ps = eps + (1 - 2 * eps) * ndtr(np.where(np.isfinite(x), x, 50.0))
-        p_stable = ps.mean(axis=1)
-        ws, wc = ps[:, order], (1 - ps)[:, order]
-        exp_w = p_stable * _wquantile_width(ts, ws) + (1 - p_stable) * _wquantile_width(ts, wc)
+        p_stable = ps.mean(axis=1)  # the risk is the cut's, not the label's
+        ph = ps + miss_rate * (1 - ps)  # P(heard stable): the outcomes the posterior will see
+        p_heard = ph.mean(axis=1)
+        ws, wc = ph[:, order], (1 - ph)[:, order]
+        exp_w = p_heard * _wquantile_width(ts, ws) + (1 - p_heard) * _wquantile_width(ts, wc)
         for i, (d, pst, e) in enumerate(zip(depths, p_stable, exp_w)):
             cand.append((float(e + chatter_cost * (1 - pst)), -float(grid[k] * d), int(k), float(d), float(1 - pst),
                          i >= n_capped))
