@@ -28,13 +28,16 @@ def single_thread_blas():
     >>> s.tolist()
     [1.0, 1.0, 1.0]
     """
-    return _controller().limit(limits=1, user_api="blas")
+    import sys
+
+    return _controller(len(sys.modules)).limit(limits=1, user_api="blas")
 
 
 @functools.lru_cache(maxsize=1)
-def _controller():
-    # Inspecting the loaded libraries costs ~2 ms (it reads /proc/self/maps): once per process, not per call —
-    # the SDM calls this once per model in the shop update's per-particle loop.
+def _controller(n_modules):
+    # Inspecting the loaded libraries costs ~2 ms (it reads /proc/self/maps): not at every call — the SDM calls
+    # this once per model in the shop update's per-sample loop. Built again when modules were imported since
+    # (``n_modules``), which is when a new BLAS can have been loaded.
     from threadpoolctl import ThreadpoolController
 
     return ThreadpoolController()

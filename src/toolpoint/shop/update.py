@@ -182,17 +182,17 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
                    miss_rate: float = 0.0) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
-    ``log_ratio`` (per cut (C,), or per sample and cut (S, C), optional): ln of a factor on the zero-order limit
-    at the cut's speed (the SDM correction of :func:`update`'s ``forward="sdm"``); ``boundary_width`` may be one
-    value per cut. ``miss_rate``: probability that a chattering cut is labelled stable (a detector's missed
-    chatter), on top of ε: P(label stable) = p_s + m p_c, P(label chatter) = (1 − m) p_c."""
+    ``log_ratio`` (per cut, optional): ln of a factor on the zero-order limit at the cut's speed (the SDM
+    correction of :func:`update`'s ``forward="sdm"``); ``boundary_width`` may be one value per cut.
+    ``miss_rate``: probability that a chattering cut is labelled stable (a detector's missed chatter), on top
+    of ε: P(label stable) = p_s + m p_c, P(label chatter) = (1 − m) p_c."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
     a_lim, f_c = limit_at_speeds(prior, theta, rpm, freq_hz)
     lr = np.zeros(len(cuts)) if log_ratio is None else np.asarray(log_ratio, float)
     with np.errstate(divide="ignore"):
-        x = (np.log(a_lim) + np.atleast_2d(lr) - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
+        x = (np.log(a_lim) + lr[None, :] - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
     x = np.where(np.isfinite(x), x, 50.0)  # no lobe reaches the speed: stable at any depth in the grid
     eps = label_noise
     ls = np.logaddexp(np.log(eps), np.log1p(-2 * eps) + log_ndtr(x))  # ln P(stable)
@@ -373,6 +373,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     risk = (0.1 if rule == "risk" else 0.3) if risk is None else risk
     if not 0 < risk <= 0.5:
         raise InputError(f"must be in (0, 0.5], got {risk}", field="risk")
+    if int(sdm_train) != sdm_train or sdm_train < 0:
+        raise InputError(f"must be a whole number ≥ 0, got {sdm_train}", field="sdm_train")
     if not 0 <= miss_rate < 1:
         raise InputError(f"must be in [0, 1), got {miss_rate}", field="miss_rate")
     if not 0 <= min_step <= 0.5:
@@ -413,7 +415,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 first = np.zeros(u.size, int)
                 first[inv[::-1]] = np.arange(rpm_c.size)[::-1]
                 lr_ref_u = lr_c[:, first]  # (R, U)
-                z_tr = z[rng.choice(n_samples, min(sdm_train, n_samples), replace=False)]
+                z_tr = z[rng.choice(n_samples, min(int(sdm_train), n_samples), replace=False)]
                 lr_tr = _sdm_own_log_ratio(prior, z_tr, u, f, lr_ref_u.mean(axis=0))  # (T, U)
                 mean_u = lr_tr.mean(axis=0)
                 sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)

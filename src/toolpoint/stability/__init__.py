@@ -5,6 +5,8 @@
 * :func:`sdm_lobes` — semi-discretisation (Insperger & Stépán 2002/2004) of a
   state-space model of the tool point (:class:`StateSpaceModel`: real or
   complex modes, cross terms); needed at low radial immersion.
+* :func:`sdm_limit_near` — the SDM limit near a guess per speed (many models,
+  few speeds each); :func:`sdm_spectral_radius` — ρ at (speed, depth) points.
 * :func:`from_modal_fit` builds the SDM's model from common-pole modal fits
   (:func:`toolpoint.dynamics.modal.fit_frfs`: complex modes, cross FRFs);
   :class:`ModalModel` holds real modes per direction given by hand.

@@ -564,7 +564,7 @@ def sdm_limit_near(
     From the guess a₀ the depth steps by e^{±h} (h = ``log_step``) towards ρ = 1 until the verdict changes
     (at most ``max_steps`` steps), then the bracket is bisected ``bisections`` times in ln a and the limit
     interpolated linearly in ρ between its ends. ρ is no distance to the limit (below it, the slowest
-    free vibration sets ρ and it hardly moves with depth; islands of stability are common at low immersion),
+    free vibration sets ρ and it hardly moves with depth; unstable islands occur above and below the limit),
     so only its verdict is trusted. Cost: 1 + steps + bisections spectral radii per speed, vectorised over
     speeds — for many models at few speeds each (the shop update's particles), where :func:`sdm_lobes`
     searches upwards from half the zero-order limit. An unstable band thinner than e^h can be stepped over,
