@@ -167,11 +167,14 @@ class _Score:
               f"per s of audio")
 
 
-def _truth(pr, rng):
-    """A truth θ* drawn from the prior: (ModalModel, CuttingConditions) with a random immersion and direction."""
+def _truth(pr, rng, random_cut=True):
+    """A truth θ* drawn from the prior: (ModalModel, CuttingConditions), with a random immersion and direction
+    unless ``random_cut`` is false (the prior's own)."""
     import dataclasses
 
     mm, c = pr.tool(pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None, :])[0])
+    if not random_cut:
+        return mm, c
     return mm, dataclasses.replace(c, radial_immersion=float(rng.choice([0.1, 0.25, 0.5, 1.0])),
                                    milling=str(rng.choice(["down", "up"])))
 
@@ -224,7 +227,7 @@ def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01):
         lo, hi = pr.rpm_range if pr.rpm_range is not None else (5000.0, 25000.0)
         for seed in range(seed_start, seed_start + (1 if quick else truths)):
             rng = np.random.default_rng(seed)
-            mm, c = pr.tool(pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None, :])[0])
+            mm, c = _truth(pr, rng, random_cut=False)
             sp = (60 * np.asarray(mm.fn_hz)[:, None, None] / (c.teeth * np.arange(1, 5)[None, :, None])
                   * np.array([0.97, 1.0, 1.03])[None, None, :]).ravel()
             sp = np.sort(sp[(sp >= lo) & (sp <= hi)])[-8:]
