@@ -8,8 +8,6 @@ The least-squares solves, SVDs and matrix exponentials in toolpoint are small
 
 from __future__ import annotations
 
-import functools
-
 
 def single_thread_blas():
     """Context manager limiting BLAS to one thread (threadpoolctl).
@@ -28,16 +26,6 @@ def single_thread_blas():
     >>> s.tolist()
     [1.0, 1.0, 1.0]
     """
-    import sys
+    from threadpoolctl import threadpool_limits
 
-    return _controller(len(sys.modules)).limit(limits=1, user_api="blas")
-
-
-@functools.lru_cache(maxsize=1)
-def _controller(n_modules):
-    # Inspecting the loaded libraries costs ~2 ms (it reads /proc/self/maps): not at every call — the SDM calls
-    # this once per model in the shop update's per-sample loop. Built again when modules were imported since
-    # (``n_modules``), which is when a new BLAS can have been loaded.
-    from threadpoolctl import ThreadpoolController
-
-    return ThreadpoolController()
+    return threadpool_limits(limits=1, user_api="blas")
