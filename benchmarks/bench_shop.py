@@ -112,7 +112,7 @@ def bench_cut(quick):
 
 
 # (dominance, alias_dominance): the default first; without the alias rule; either ratio halved or lowered
-THRESHOLDS = ((0.05, 0.005), (0.05, 0.0), (0.05, 0.0025), (0.05, 0.01), (0.01, 0.005), (0.003, 0.003))
+THRESHOLDS = ((0.05, 0.005), (0.05, 0.001), (0.05, 0.0005), (0.01, 0.001), (0.001, 0.0001))
 
 
 class _Score:

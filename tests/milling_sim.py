@@ -10,8 +10,9 @@ held over the step (zero-order hold), ``steps`` steps per tooth period (the dela
 Points are simulated one after another with a Python loop over time: a test helper, not a fast simulator.
 
 ``microphone`` turns a simulated cut into a shop record: the tool's velocity (x' + y') plus 0.3 × the force's
-derivative, resampled to 44.1 kHz, between air cuts, with the room noise, fan tones and spindle lines of
-``shop_synth`` (tests/shop_synth.py).
+derivative, resampled to 44.1 kHz behind an anti-aliasing filter (as a sound card: spindle harmonics above
+22 kHz do not fold into the band; ``toolpoint.simulation.to_audio_rate``), between air cuts, with the room noise,
+fan tones and spindle lines of ``shop_synth`` (tests/shop_synth.py).
 """
 
 import numpy as np
@@ -83,15 +84,16 @@ def microphone(sim, *, rpm, teeth, rate=44100.0, air_s=0.7, noise=0.02, fans=(61
     """A shop microphone record of a simulated cut (module docstring): (samples, rate, cut start, cut end)."""
     from shop_synth import shop_record
 
+    from toolpoint.simulation import to_audio_rate
+
     t, x, y, fx, fy = sim
     rng = np.random.default_rng(seed)
     dt = t[1] - t[0]
     vel = np.gradient(x + y, dt)
     df = np.gradient(fx + fy, dt)
-    # drop the first 20 % (the tool starting at rest) is the detector's job (entry); resample to the audio rate
-    tn = np.arange(int(t[-1] * rate)) / rate
-    sig = np.interp(tn, t, vel / (np.std(vel) + 1e-30) + 0.3 * df / (np.std(df) + 1e-30))
-    cut_s = tn[-1]
+    # drop the first 20 % (the tool starting at rest) is the detector's job (entry); record at the audio rate
+    sig = to_audio_rate(vel / (np.std(vel) + 1e-30) + 0.3 * df / (np.std(df) + 1e-30), 1.0 / dt, rate)
+    cut_s = (sig.size - 1) / rate
     base, _, t0, t1 = shop_record(rpm=rpm, teeth=teeth, rate=rate, air_s=air_s, cut_s=cut_s, fans=fans,
                                   fan_amp=0.05, noise=noise, seed=int(rng.integers(1 << 30)))
     # the record's spindle lines and noise stay; its synthetic cut harmonics are replaced by the simulation

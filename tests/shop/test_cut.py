@@ -45,6 +45,27 @@ def test_chatter_found_at_its_frequency(rpm, teeth, fc):
     assert abs(j - round(j)) < 1e-9
 
 
+@pytest.mark.parametrize("teeth", [4, 3])
+def test_chatter_on_a_spindle_harmonic_is_found_by_its_excess_over_the_runout_lines(teeth):
+    # 1000 Hz at 6000 rpm is the spindle harmonic 10 f_s: with 4 teeth a period doubling (flip, f_c = 2.5 f_t),
+    # with 3 a chatter at a rotation of 1/3 per tooth period (f_c = (3 + 1/3) f_t); its aliases 1000 ∓ f_t are
+    # harmonics of the same residue. Masked from the main test. shop_synth's runout raises every multiple of f_s
+    # alike (non-tooth lines 0.1 (k/N)^-1.2 of the tooth line): the chatter line stands out of them.
+    x, rate, *_ = shop_record(rpm=6000, teeth=teeth, chatter_hz=1000.0, chatter_amp=1.0, seed=5)
+    res = analyse_cut(x, rate, rpm=6000, teeth=teeth, full_scale=1.0)
+    assert res.verdict == "chatter" and abs(res.chatter_hz - 1000.0) < 1.0
+    # 8 dB over its neighbours (what a runout line on a sharp mode does) is not chatter
+    x, rate, *_ = shop_record(rpm=6000, teeth=teeth, chatter_hz=1000.0, chatter_amp=0.1, seed=5)
+    assert analyse_cut(x, rate, rpm=6000, teeth=teeth, full_scale=1.0).verdict == "stable"
+
+
+def test_with_two_teeth_chatter_on_a_runout_line_cannot_be_told():
+    # the non-tooth harmonics of a 2-tooth cutter all share one residue: a flip line has no other runout line to
+    # stand out of, and the detector does not guess
+    x, rate, *_ = shop_record(rpm=12000, teeth=2, chatter_hz=1000.0, chatter_amp=1.0, seed=5)
+    assert analyse_cut(x, rate, rpm=12000, teeth=2, full_scale=1.0).verdict == "stable"
+
+
 def test_fan_tone_present_in_air_cut_is_not_chatter():
     # a loud fan line far above the cut's harmonics: there before the cut, so not chatter
     x, rate, *_ = shop_record(rpm=6000, teeth=4, fans=(1317.0,), fan_amp=3.0, seed=3)

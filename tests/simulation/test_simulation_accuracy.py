@@ -59,6 +59,22 @@ def test_verdict_brackets_sdm_limit_fast():
     assert res.stable.tolist() == [True] * 3 + [False] * 3
 
 
+def test_period_doubling_of_a_four_tooth_cutter_is_chatter_like_the_sdm():
+    # Cornelius et al. 2024's two modes, 4 teeth, 50 % down milling: at 13150 rpm the SDM's critical multiplier
+    # is -1 (flip, f_c = (j + 1/2) f_t = 10 f_s, a spindle harmonic). The motion then repeats every revolution,
+    # so a verdict against the previous revolution called it stable; against the tooth period it chatters.
+    modes = [(1243.0, 2.92e6, 0.0619), (1747.0, 1.2e7, 0.0288)]
+    mm = ModalModel([f for f, _, _ in modes], [z for _, _, z in modes], [k / (2 * np.pi * f) ** 2 for f, k, _ in modes])
+    cut = CuttingConditions(teeth=4, tangential_coeff=2003e6, radial_ratio=0.404, radial_immersion=0.5)
+    sdm = sdm_lobes(mm, mm, cut, rpm=[13150.0])
+    f_t = 4 * 13150.0 / 60
+    assert abs(sdm.chatter_hz[0] / f_t % 1 - 0.5) < 1e-3  # the case is a flip
+    res = simulate_milling(mm, mm, cut, rpm=[13150.0] * 2, depth_m=sdm.depth_m[0] * np.array([0.9, 1.1]),
+                           revolutions=40, record_revolutions=4)
+    assert res.stable.tolist() == [True, False]
+    assert abs(res.chatter_hz[1] / sdm.chatter_hz[0] - 1) < 0.01
+
+
 @pytest.mark.parametrize("milling,immersion", [("down", 0.25), ("up", 0.25), ("down", 1.0), ("up", 0.6)])
 @pytest.mark.parametrize("helix", [False, True])
 def test_sle_time_domain_matches_frequency_domain(milling, immersion, helix):

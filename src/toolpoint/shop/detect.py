@@ -47,6 +47,16 @@ The detector (:func:`analyse_cut`):
 
    The chatter frequency is the peak's frequency, refined by a parabola through the log power of the
    three bins around it.
+
+   *Chatter on a spindle harmonic.* Period doubling (flip chatter, f_c = (j + ½) f_t: the lobes' flip
+   pockets) of an even-toothed cutter sits on the spindle harmonics k f_s, k ≡ N/2 (mod N), and a chatter
+   near a rotation of r/N per tooth period on k ≡ r (mod N) (the saturated chatter can lock there); step 3
+   masks both. When the main test finds no chatter and the record holds an air cut, a non-tooth harmonic is
+   chatter when it is significant, new (``rise_db`` over the air cut), 20 dB above the nearest non-tooth
+   harmonics of the other residues below and above it (runout raises all multiples of f_s alike; a runout
+   line on a mode of ζ = 3 % stands ~12 dB above its neighbours; chatter raises its own family f_c + j f_t,
+   one residue) and strong and sustained as above (its aliases: the candidates k ± N, k ± 2N). With two teeth
+   every non-tooth harmonic has the same residue and such chatter cannot be told from runout on a spectrum.
 5. **once-per-revolution metric** (where the segment holds ≥ 10 revolutions): the signal resampled at
    64 points per revolution, R = 1 − E_sync/E_total (E_sync: energy of the revolution-synchronous mean,
    with its finite-average bias removed): 0 for a periodic (stable, noiseless) signal, → 1 for chatter
@@ -549,7 +559,8 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s,
     n = Pseg.shape[0]
     p = Pseg.mean(axis=0)
     nu = float(nu1(n))
-    floor = _block_floor(p[None, :], keep)[0] / _chi2_median_ratio(nu) + _leakage(p, freq, harm, f_s, df)
+    floor0 = _block_floor(p[None, :], keep)[0] / _chi2_median_ratio(nu)
+    floor = floor0 + _leakage(p, freq, harm, f_s, df)
     z = np.where(keep, p / floor, 0.0)
     t_a = _threshold(nu, int(keep.sum()), alpha)
     rise_bins = None
@@ -566,24 +577,14 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s,
         zn = np.where(new, z, 0.0)
         i = int(np.argmax(zn)) if zn.max() > 0 else int(np.argmax(z))
     sig = float(z[i] / t_a)
-    delta = 0.0
-    if 0 < i < p.size - 1 and p[i - 1] > 0 and p[i + 1] > 0:  # parabola through the log power
-        a, b, c = np.log(p[i - 1]), np.log(p[i]), np.log(p[i + 1])
-        den = a - 2 * b + c
-        delta = float(np.clip(0.5 * (a - c) / den, -0.5, 0.5)) if den != 0 else 0.0
-    f_peak = float(freq[i] + delta * df)
+    f_peak = float(freq[i] + _parabola(p, i) * df)
     pk_pow = float(p[max(0, i - 1):i + 2].sum())
     hp = np.where(harm, p, 0.0)
     j = int(np.argmax(hp))
     h_pow = float(hp[max(0, j - 1):j + 2].sum()) if hp[j] > 0 else 0.0
     dom = pk_pow / h_pow if h_pow > 0 else np.inf
     rise = None if rise_bins is None else float(rise_bins[i])
-    sustained = True
-    if n >= 4:  # a free vibration left by the entry decays; chatter holds or grows
-        h = n // 2
-        first = float(Pseg[:h, max(0, i - 1):i + 2].sum(axis=1).mean())
-        last = float(Pseg[h:, max(0, i - 1):i + 2].sum(axis=1).mean())
-        sustained = last >= 0.25 * first
+    sustained = _sustained(Pseg, slice(max(0, i - 1), i + 2))
     n_alias = 0  # the regenerative family f_c + j f_t (Insperger et al. 2003): significant new lines at j = ±1, ±2
     if good.any() and ref is not None:  # "new" needs an air cut; without one a machine tone's family is not told
         for j in (-2, -1, 1, 2):
@@ -592,8 +593,95 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s,
     d_plain, d_alias = dominance
     strong = dom >= d_plain or (n_alias > 0 and d_alias > 0 and dom >= d_alias)
     chatter = sig > 1 and bool(new[i]) and strong and sustained
-    return dict(verdict="chatter" if chatter else "stable", chatter_hz=f_peak if chatter else None, peak_hz=f_peak,
-                significance=sig, rise_db=rise, dominance=float(min(dom, 1e6)), n_alias=n_alias)
+    out = dict(verdict="chatter" if chatter else "stable", chatter_hz=f_peak if chatter else None, peak_hz=f_peak,
+               significance=sig, rise_db=rise, dominance=float(min(dom, 1e6)), n_alias=n_alias)
+    if not chatter and ref is not None:
+        locked = _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominance, f_s, f_t)
+        if locked is not None:
+            out = locked
+    return out
+
+
+def _parabola(p, i) -> float:
+    """Offset (bins, |·| ≤ ½) of the peak at bin i from a parabola through the log power of bins i − 1 … i + 1."""
+    if not (0 < i < p.size - 1 and p[i - 1] > 0 and p[i] > 0 and p[i + 1] > 0):
+        return 0.0
+    a, b, c = np.log(p[i - 1]), np.log(p[i]), np.log(p[i + 1])
+    den = a - 2 * b + c
+    return float(np.clip(0.5 * (a - c) / den, -0.5, 0.5)) if den != 0 else 0.0
+
+
+def _sustained(Pseg, bins) -> bool:
+    """Whether the power in ``bins`` keeps over the frames' second half ≥ ¼ of its first half's (a free vibration
+    left by the entry decays; chatter holds or grows); True with fewer than 4 frames."""
+    n = Pseg.shape[0]
+    if n < 4:
+        return True
+    h = n // 2
+    return float(Pseg[h:, bins].sum(axis=1).mean()) >= 0.25 * float(Pseg[:h, bins].sum(axis=1).mean())
+
+
+_LOCK_DB = 20.0
+"""Least excess of a non-tooth spindle harmonic over its neighbouring non-tooth harmonics of the other residues
+for chatter on a spindle harmonic, dB. A runout line on a mode of damping ζ stands about
+20 log10(|H(f_n)| / |H(f_n ± f_s)|) over its neighbours, ≈ 12 dB for ζ = 3 % and f_s = 0.12 f_n; chatter on a
+harmonic stands tens of dB over them."""
+
+
+def _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominance, f_s, f_t) -> dict | None:
+    """Chatter on (or within the mask of) a spindle harmonic k f_s, k ≢ 0 (mod N): period doubling (flip,
+    f_c = (j + ½) f_t, k ≡ N/2) of an even-toothed cutter, or a chatter whose frequency sits at (j + r/N) f_t
+    (the pockets' chatter near a rotation of r/N per tooth period, which the saturated chatter can lock on).
+
+    A non-tooth harmonic k ≡ r (mod N) is a candidate when it is significant over the floor, ``rise_db`` above
+    the air cut (spindle and motor lines are there before the cut) and :data:`_LOCK_DB` above the nearest
+    non-tooth harmonics below and above it of another residue (runout raises every multiple of f_s alike;
+    chatter only its own family f_c + j f_t, all of residue r). The strongest candidate is judged like a chatter
+    line: ``dominance`` over the strongest spindle harmonic (or the alias ratio when k ± N or k ± 2N is a
+    candidate too) and sustained. Needs N ≥ 3 (with two teeth every non-tooth harmonic has the same residue:
+    runout and flip chatter cannot be told apart) and an air cut. None when no harmonic qualifies.
+    """
+    n = int(round(f_t / f_s))
+    if n < 3:
+        return None
+    ks = np.unique(np.round(freq[harm] / f_s).astype(int))
+    df = freq[1] - freq[0]
+    idx = np.round(ks * f_s / df).astype(int)
+    ok = (ks >= 1) & (idx >= 2) & (idx < p.size - 2)
+    ks, idx = ks[ok], idx[ok]
+    if ks.size < 4:
+        return None
+    win = idx[:, None] + np.arange(-2, 3)[None, :]  # the Hann main lobe, ±2 bins
+    H = p[win].sum(axis=1)
+    Hr = ref[win].sum(axis=1)
+    res = ks % n
+    cand = {}
+    for m in np.flatnonzero(res != 0):
+        other = (res != 0) & (res != res[m])
+        below = np.flatnonzero(other[:m])
+        above = m + 1 + np.flatnonzero(other[m + 1:])
+        if below.size == 0 or above.size == 0:
+            continue
+        nb = max(H[below[-1]], H[above[0]], 1e-300)
+        excess = 10 * np.log10(max(H[m], 1e-300) / nb)
+        rise = 10 * np.log10(max(H[m], 1e-300) / max(Hr[m], 1e-300))
+        j = int(win[m][np.argmax(p[win[m]])])
+        sig = float(p[j] / max(floor0[j], 1e-300) / t_a)
+        if excess >= _LOCK_DB and rise >= rise_db and sig > 1:
+            cand[int(ks[m])] = (m, j, rise, sig)
+    if not cand:
+        return None
+    k = max(cand, key=lambda kk: H[cand[kk][0]])
+    m, j, rise, sig = cand[k]
+    n_alias = sum((k + d * n) in cand for d in (-2, -1, 1, 2))
+    dom = float(H[m] / max(H.max(), 1e-300))
+    d_plain, d_alias = dominance
+    strong = dom >= d_plain or (n_alias > 0 and d_alias > 0 and dom >= d_alias)
+    if not (strong and _sustained(Pseg, win[m])):
+        return None
+    f_c = float(freq[j] + _parabola(p, j) * df)
+    return dict(verdict="chatter", chatter_hz=f_c, peak_hz=f_c, significance=sig, rise_db=float(rise),
+                dominance=float(min(dom, 1e6)), n_alias=n_alias)
 
 
 def _merge(windows, judge):

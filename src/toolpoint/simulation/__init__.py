@@ -12,7 +12,8 @@
 * :func:`sle_frequency_domain` — SLE of stable cuts from the FRF and the
   Fourier series of the force (Schmitz & Mann 2006), an independent check.
 * :func:`sensor_signal`, :func:`write_signal` — synthetic microphone or
-  accelerometer records (WAV/CSV).
+  accelerometer records (WAV/CSV); :func:`to_audio_rate` — a recorder's
+  anti-aliased resampling.
 
 Conventions (angles, force directions) are those of
 :mod:`toolpoint.stability.milling`, so the results compare with the SDM and
@@ -21,7 +22,7 @@ zero-order lobes. SI units inside; speeds in rpm.
 
 from .frequency import sle_frequency_domain
 from .maps import SimulationMap, simulate_map, stability_boundary
-from .signals import sensor_signal, write_signal
+from .signals import sensor_signal, to_audio_rate, write_signal
 from .structure import ModalDynamics, as_modal_dynamics
 from .time_domain import SimulationResult, simulate_milling
 from .tool import Tool
@@ -33,6 +34,7 @@ __all__ = [
     "Tool",
     "as_modal_dynamics",
     "sensor_signal",
+    "to_audio_rate",
     "simulate_map",
     "simulate_milling",
     "sle_frequency_domain",

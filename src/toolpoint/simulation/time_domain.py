@@ -93,7 +93,10 @@ class SimulationResult:
     once_per_rev_m : numpy.ndarray
         (P, revolutions + 1, 2) displacement sampled once per revolution (t = k·60/n), m.
     deviation_m : numpy.ndarray
-        (P, revolutions) RMS over each revolution of r(t) − r(t − 60/n), m: zero for a periodic cut.
+        (P, revolutions) RMS over each revolution of r(t) − r(t − T), m, T the period of the forced cut: the
+        tooth period 60/(n N) when the teeth are alike (equal pitch, no runout), else the revolution 60/n. Zero
+        for a stable cut; against the revolution, a period-doubling (flip) chatter of an even-toothed cutter
+        (f_c = (j + ½) f_t, a spindle harmonic) repeats every revolution and would look stable.
     metric : numpy.ndarray
         (P,) Honeycutt & Schmitz (2016) metric: mean |r_k − r_{k−1}| of the once-per-revolution samples over
         the last revolutions over the peak-to-peak displacement of the last revolution (dimensionless).
@@ -103,7 +106,8 @@ class SimulationResult:
     stable : numpy.ndarray
         (P,) bool: the deviation decays and stays below ``SATURATED`` × the displacement scale.
     chatter_hz : numpy.ndarray
-        (P,) peak of the spectrum of the non-synchronous displacement (recorded part), Hz; nan where stable.
+        (P,) peak of the spectrum of the displacement less its part periodic with T (recorded part), Hz; nan
+        where stable.
     sle_m : numpy.ndarray
         (P,) surface location error, m: the tooth tip's deviation from the commanded wall at the surface
         generation angle (exit φ_ex in down-milling, entry φ_st in up-milling), along the wall normal; > 0 is
@@ -239,6 +243,11 @@ class _Cut:
         self.theta = 2 * np.pi * k / M  # rounded to the step grid
         self.feed = feed * N * self.delay / M  # feed per tooth ∝ its pitch
         self.rho = tool.runout(N)
+        # period of the forced (stable) cut, steps: a tooth period when the teeth are alike (equal pitch, no
+        # runout), else a revolution. The verdict compares the motion with itself one period earlier: against
+        # a revolution, a period-doubling (flip) chatter of an even-toothed cutter repeats and looks stable.
+        alike = M % N == 0 and np.all(self.delay == M // N) and not np.any(self.rho)
+        self.period = M // N if alike else M
         psi, L = tool.lag(depth)
         self.L = L
         phase = self.theta[:, None, None] - psi[None, :, :]  # (N, L, P) or (N, 1, P)
@@ -306,7 +315,7 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
     """Simulate one batch with a common S; returns the raw arrays (points last)."""
     P = rpm.size
     geo = _Cut(cut, tool, depth, feed, S)
-    M, R = geo.M, geo.R
+    M, R, Pf = geo.M, geo.R, geo.period
     dt = 60.0 / (rpm * M)
     E, G = dyn.step_maps(dt)
     Eh, Gh = dyn.step_maps(dt / 2)
@@ -346,11 +355,11 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
             x, y = mid_pre[i % M]
             buf[i % R] += s * x + c * y
         eta = eta0.copy()
-        ring = r_pre.copy()
+        ring = r_pre[M - Pf:].copy()  # the period before t = 0
     else:
         buf[:] = 0.0
         eta = np.zeros((m, P), complex)
-        ring = np.zeros((M, 2, P))
+        ring = np.zeros((Pf, 2, P))
         u_prev = np.zeros((m, P), complex)
     rng = np.random.default_rng(seed)
     kick = rng.standard_normal((m, P)) + 1j * rng.standard_normal((m, P))
@@ -367,9 +376,9 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
     for i in range(n):
         if i % M == 0:
             opr[i // M] = r
-        d = r - ring[i % M]
+        d = r - ring[i % Pf]
         dev[i // M] += (d * d).sum(axis=0)
-        ring[i % M] = r
+        ring[i % Pf] = r
         fx, fy = geo.step(i, mid[0], mid[1], buf)
         if i >= i0:
             rec_r[i - i0] = r
@@ -380,7 +389,8 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
         r = (Cout @ eta).real
     opr[-1] = r
     rec_r[-1] = r
-    return dict(dt=dt, M=M, geo=geo, rec_r=rec_r, rec_f=rec_f, opr=opr, dev=np.sqrt(dev / M), scale=scale, i0=i0)
+    return dict(dt=dt, M=M, geo=geo, rec_r=rec_r, rec_f=rec_f, opr=opr, dev=np.sqrt(dev / M), scale=scale, i0=i0,
+                period=Pf)
 
 
 # ----------------------------------------------------------------- metrics
@@ -402,15 +412,16 @@ def _verdict(dev, opr, rec_r, M, scale):
     return metric, growth, stable
 
 
-def _chatter(rec_r, M, dt, stable):
-    """Peak frequency of the non-synchronous part of the recorded displacement, Hz (nan where stable)."""
-    n_rev = (rec_r.shape[0] - 1) // M
+def _chatter(rec_r, period, dt, stable):
+    """Peak frequency of the recorded displacement less its part periodic with the forced cut's ``period``
+    (steps), Hz (nan where stable)."""
+    n_rev = (rec_r.shape[0] - 1) // period
     P = rec_r.shape[2]
     out = np.full(P, np.nan)
     if n_rev < 2 or np.all(stable):
         return out
-    x = rec_r[: n_rev * M]
-    sync = x.reshape(n_rev, M, 2, P).mean(axis=0)
+    x = rec_r[: n_rev * period]
+    sync = x.reshape(n_rev, period, 2, P).mean(axis=0)
     res = x - np.tile(sync, (n_rev, 1, 1))
     res = res - res.mean(axis=0)
     pick = np.argmax((res**2).sum(axis=0), axis=0)  # the direction that moves most, per point
@@ -550,7 +561,7 @@ def _assemble(parts, cut, tool, rpm, depth, feed, revolutions, record, S, start,
     for p in parts:
         metric, growth, stable = _verdict(p["dev"], p["opr"], p["rec_r"], p["M"], p["scale"])
         sle, surface, pv = _surface(p["rec_r"], p["geo"], cut.milling, p["i0"], record)
-        for k, v in zip(cols, (metric, growth, stable, _chatter(p["rec_r"], p["M"], p["dt"], stable), sle,
+        for k, v in zip(cols, (metric, growth, stable, _chatter(p["rec_r"], p["period"], p["dt"], stable), sle,
                                surface, pv)):
             cols[k].append(v)
     cat = np.concatenate
