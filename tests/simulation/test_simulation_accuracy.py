@@ -169,3 +169,23 @@ def test_bad_input_names_the_field():
         with pytest.raises(InputError) as err:
             make()
         assert err.value.field == fieldname and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("rate_in", [52_345.6, 200_000.0, 731_111.1])
+def test_audio_resampling_keeps_the_band_and_drops_what_would_fold(rate_in):
+    # a recorder's anti-aliasing: a 5 kHz line keeps its amplitude and frequency (within 50 ppm, a sound card's
+    # clock), a line at 30 kHz (which linear interpolation folds to 14.1 kHz) is gone, ≥ 60 dB down
+    from toolpoint.simulation import to_audio_rate
+
+    t = np.arange(int(2.0 * rate_in)) / rate_in
+    f_hi = 30_000.0 if rate_in > 60_000 else 0.0
+    x = np.sin(2 * np.pi * 5000.0 * t) + np.sin(2 * np.pi * f_hi * t)
+    y = to_audio_rate(x, rate_in, 44100.0)
+    assert abs(y.size - 2.0 * 44100) <= 1
+    n = y.size - 2000
+    spec = np.abs(np.fft.rfft(y[1000:1000 + n] * np.hanning(n), 16 * n)) * 4 / n  # skip the filter's edges
+    f = np.fft.rfftfreq(16 * n, 1 / 44100.0)
+    k = int(np.argmax(spec * (np.abs(f - 5000) < 50)))
+    assert abs(f[k] / 5000.0 - 1) < 5e-5 and abs(spec[k] - 1) < 0.01
+    if f_hi:
+        assert spec[np.abs(f - (44100.0 - f_hi)) < 20].max() < 1e-3

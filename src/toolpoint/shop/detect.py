@@ -161,7 +161,9 @@ class CutAnalysis:
     alternatives_rpm : tuple of float
         The next speeds of the same rule (the neighbouring harmonics), rpm.
     criterion : dict
-        The thresholds used (α, t_α per segment is in ``significance``), for the record.
+        The thresholds used (α, t_α per segment is in ``significance``), for the record;
+        ``on_harmonic_excess_db`` is the excess over the runout lines that makes a spindle harmonic chatter
+        (None where that test cannot run: fewer than 3 teeth, or no air cut).
     time_s, freq_hz, power : ndarray
         The spectrogram (frame centres s, frequencies Hz, power per bin) for the figure.
     """
@@ -510,7 +512,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     criterion = {"alpha": alpha, "rise_db": rise_db if ref is not None else None, "dominance": dominance,
                  "alias_dominance": alias_dominance,
                  "mask_hz": f"2*{df:.4g} + {_MASK_REL:g}*f", "frame_s": L / rate, "band_hz": [lo, hi],
-                 "spindle_multiples_removed": True}
+                 "spindle_multiples_removed": True,
+                 "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None}
     return CutAnalysis(verdict, chatter_hz, tuple(segments), float(rpm), 60 * f_s, spindle_found, int(teeth), rec,
                        alts, criterion, frame_t, freq, P)
 
