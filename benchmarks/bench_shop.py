@@ -111,8 +111,10 @@ def bench_cut(quick):
           f"scale): false chatter {fa[0.005]}/{n} with the alias rule (alias_dominance 0.005), {fa[0.0]}/{n} without")
 
 
-# (dominance, alias_dominance): the default first; without the alias rule; either ratio halved or lowered
-THRESHOLDS = ((0.05, 0.005), (0.05, 0.001), (0.05, 0.0005), (0.01, 0.001), (0.001, 0.0001))
+# (dominance, alias_dominance, growth_db): the default first; without the growth test; its rise at 3 and 10 dB;
+# lower ratios
+THRESHOLDS = ((0.05, 0.005, 6.0), (0.05, 0.005, 0.0), (0.05, 0.005, 3.0), (0.05, 0.005, 10.0), (0.05, 0.001, 6.0),
+              (0.001, 0.0001, 6.0))
 
 
 class _Score:
@@ -141,7 +143,7 @@ class _Score:
             for thr in THRESHOLDS:
                 t0 = time.process_time()
                 r = analyse_cut(x, rate, rpm=float(rpm[p]), teeth=c.teeth, full_scale=1.0, dominance=thr[0],
-                                alias_dominance=thr[1])
+                                alias_dominance=thr[1], growth_db=thr[2])
                 if thr == THRESHOLDS[0]:
                     self.cpu_cut += time.process_time() - t0
                     self.audio_s += x.size / rate
@@ -157,7 +159,8 @@ class _Score:
         print(f"{what}; {self.skipped} within ±5 % of the SDM limit left out; the simulation agrees with the SDM on "
               f"{self.sim_agree}/{n}):")
         for thr in THRESHOLDS:
-            print(f"   dominance {thr[0]:g}, with an alias {thr[1]:g}{' (default)' if thr == THRESHOLDS[0] else ''}: "
+            print(f"   dominance {thr[0]:g}, with an alias {thr[1]:g}, growth {thr[2]:g} dB"
+                  f"{' (default)' if thr == THRESHOLDS[0] else ''}: "
                   f"{self.right[thr]}/{n} verdicts right "
                   f"({self.right[thr] / n:.1%}), {self.false_alarm[thr]} false chatter; against the simulation's own "
                   f"verdict {self.right_sim[thr]}/{n} ({self.right_sim[thr] / n:.1%})")

@@ -238,3 +238,25 @@ def test_records_one_column_needs_rate_and_uff58(tmp_path):
     with pytest.raises(InputError, match="channel"):
         read_cut_record(two)
     assert read_cut_record(two, channel=1).samples[5] == pytest.approx(-x[5])
+
+
+def test_a_weak_growing_line_is_chatter_a_steady_or_decaying_one_is_not():
+    """Instability is growth: a lone line under the tooth-passing harmonic (< 5 % of its power, no alias)
+    that grows 20 dB over the cut is chatter barely past the limit; the same line steady (a tone switched on
+    with the cut) or decaying (the entry's free vibration) is not."""
+    rpm, teeth = 6000.0, 4
+    x, rate, t0, t1 = shop_record(rpm=rpm, teeth=teeth, seed=5)
+    t = np.arange(x.size) / rate
+    ramp = np.clip((t - t0) / 0.05, 0, 1) * np.clip((t1 - t) / 0.05, 0, 1)
+    rise = 10 ** ((t - t0) / (t1 - t0))  # × 10 in amplitude over the cut: 20 dB
+    line = np.sin(2 * np.pi * 1234.0 * t)
+    for amp, want in ((0.01 * rise, "chatter"), (0.03, "stable"), (0.1 / rise, "stable")):
+        r = analyse_cut(x + amp * ramp * line, rate, rpm=rpm, teeth=teeth, full_scale=1.0)
+        cut = [sg for sg in r.segments if sg.kind == "cut"]
+        assert r.verdict == want, [(sg.peak_hz, sg.dominance, sg.growth_db) for sg in cut]
+        assert all(sg.dominance < 0.05 and sg.n_alias == 0 for sg in cut)  # neither ratio would call it
+        if want == "chatter":
+            assert abs(r.chatter_hz / 1234 - 1) < 0.01 and all(sg.growth_db >= 6 for sg in cut)
+            # without the growth test it is missed
+            assert analyse_cut(x + amp * ramp * line, rate, rpm=rpm, teeth=teeth, full_scale=1.0,
+                               growth_db=0).verdict == "stable"

@@ -41,6 +41,9 @@ def register(sub) -> None:
     p.add_argument("--alias-dominance", default="0.005",
                    help="the same for a line whose tooth-passing alias (f +- f_t, f +- 2 f_t) is a new line too "
                         "(default 0.005, -23 dB; 0: never below --dominance)")
+    p.add_argument("--growth-db", default="6",
+                   help="a new line whose power rises steadily by this much over a judged part is chatter, however "
+                        "weak (default 6 dB, with t >= 4; 0: no growth test)")
     p.add_argument("--out", help="result JSON (default: print it)")
     p.add_argument("--plot", help="spectrogram with the harmonics marked (.png/.pdf/.svg)")
     p.set_defaults(func=run)
@@ -69,13 +72,15 @@ def run(args) -> int:
     window = check_number(args.window, "--window", above=0, unit="s")
     dominance = check_number(args.dominance, "--dominance", above=0)
     alias_dominance = check_number(args.alias_dominance, "--alias-dominance", minimum=0)
+    growth_db = check_number(args.growth_db, "--growth-db", minimum=0, unit="dB")
     from ..io.atomic import atomic_open
     from ..io.records import read_cut_record
     from ..shop import analyse_cut
 
     rec = read_cut_record(rec_path, rate_hz=rate, channel=channel)
     res = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=teeth, rpm_tolerance=tol, window_s=window,
-                      dominance=dominance, alias_dominance=alias_dominance, full_scale=rec.full_scale,
+                      dominance=dominance, alias_dominance=alias_dominance, growth_db=growth_db,
+                      full_scale=rec.full_scale,
                       source=str(rec_path))
     doc = {"record": str(rec_path), "channel": rec.channel, "rate_hz": rec.rate_hz, **res.to_dict()}
     fig = None

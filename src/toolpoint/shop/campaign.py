@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import ModalPrior, limit_at_speeds
+from .model import ModalPrior, limit_at_speeds, sdm_limits
 from .update import TestCut, _limits, update
 
 __all__ = ["CampaignResult", "virtual_campaign", "zoa_shop", "simulated_shop", "sdm_limit", "microphone_record"]
@@ -67,12 +67,9 @@ def zoa_shop(prior: ModalPrior):
 
 def sdm_limit(prior: ModalPrior):
     """``true_limit`` for :func:`virtual_campaign` with a time-domain shop: the semi-discretisation limit of θ*
-    (the same tool in x and y), m."""
-    from ..stability import sdm_lobes
-
+    (the same tool in x and y), m, searched as deep as the pockets go (:func:`~toolpoint.shop.model.sdm_limits`)."""
     def limit(theta, rpm):
-        mm, cut = prior.tool(theta)
-        return sdm_lobes(mm, mm, cut, rpm=np.asarray(rpm, float)).depth_m
+        return sdm_limits(prior, theta, rpm)[0]
     return limit
 
 

@@ -45,6 +45,14 @@ The detector (:func:`analyse_cut`):
    * *sustained*: over the segment's second half the line keeps ≥ ¼ of its first half's power (a free
      vibration left by the entry decays; chatter holds or grows).
 
+   *Growing lines.* Instability is growth: a forced line is steady, a free vibration left by the entry decays,
+   chatter grows until the tool leaves the cut. When the main test finds no chatter, a significant new line
+   (up to the 8 strongest local peaks among them) whose power rises over the judged part by ≥ ``growth_db``
+   (6 dB) along a least-squares line in dB per frame, with a t-statistic ≥ 4 (its standard error from the
+   residuals, doubled for the 75 % overlap of the frames: about n/4 independent frames), is chatter whatever
+   its strength: chatter barely past the limit (spectral radius 1.002–1.01 per tooth period) grows slowly and
+   stays far under a harmonic that sits on a mode. Needs ≥ 6 frames.
+
    The chatter frequency is the peak's frequency, refined by a parabola through the log power of the
    three bins around it.
 
@@ -112,6 +120,8 @@ class CutSegment:
     n_alias : int
         Tooth-passing aliases of the peak (f ± f_t, f ± 2 f_t) that are significant new lines too (0–4; 0 when
         the record holds no air cut).
+    growth_db : float or None
+        Rise of the peak's power over the segment along a least-squares line, dB (None with < 6 frames).
     once_per_rev : float or None
         Non-synchronous fraction R of the signal's energy (None when < 10 revolutions).
     """
@@ -126,6 +136,7 @@ class CutSegment:
     rise_db: float | None = None
     dominance: float = 0.0
     n_alias: int = 0
+    growth_db: float | None = None
     once_per_rev: float | None = None
 
     def to_dict(self) -> dict:
@@ -135,7 +146,8 @@ class CutSegment:
         return {"kind": self.kind, "start_s": r(self.start_s), "end_s": r(self.end_s), "verdict": self.verdict,
                 "chatter_hz": r(self.chatter_hz, 2), "peak_hz": r(self.peak_hz, 2),
                 "significance": r(self.significance, 3), "rise_db": r(self.rise_db, 2),
-                "dominance": r(self.dominance, 4), "n_alias": self.n_alias, "once_per_rev": r(self.once_per_rev, 4)}
+                "dominance": r(self.dominance, 4), "n_alias": self.n_alias, "growth_db": r(self.growth_db, 2),
+                "once_per_rev": r(self.once_per_rev, 4)}
 
 
 @dataclass(frozen=True)
@@ -333,7 +345,8 @@ def _once_per_rev(x, rate, f_s):
 def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_tolerance: float = 0.03,
                 band_hz: tuple | None = None, window_s: float = 1.0, activity_db: float = 4.0,
                 rise_db: float = 10.0, dominance: float = 0.05, alias_dominance: float = 0.005,
-                alpha: float = _ALPHA, full_scale: float | None = None, source: str | None = None) -> CutAnalysis:
+                growth_db: float = 6.0, alpha: float = _ALPHA, full_scale: float | None = None,
+                source: str | None = None) -> CutAnalysis:
     """Judge a record of a milling cut: stable or chatter, per segment, with the chatter frequency.
 
     Parameters
@@ -361,6 +374,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     alias_dominance : float, default 0.005
         The same for a peak with a tooth-passing alias (a significant new line at f ± f_t or f ± 2 f_t):
         the regenerative signature that a stray tone does not have (0: never below ``dominance``).
+    growth_db : float, default 6.0
+        Least steady rise of a significant new line's power over a judged part for it to be chatter whatever its
+        strength, dB (with a t-statistic ≥ 4; 0: no growth test). Module docstring, *Growing lines*.
     alpha : float, default 1e-3
         False-alarm probability of the tone test per judged segment.
     full_scale, source
@@ -387,6 +403,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     """
     x = np.asarray(samples, float)
     check_record(x, rate_hz, rpm, teeth, full_scale=full_scale, source=source)
+    if not (math.isfinite(growth_db) and growth_db >= 0):
+        raise InputError(f"must be ≥ 0 dB (0: no growth test), got {growth_db!r}", file=source, field="growth_db")
     rate = float(rate_hz)
     x = x - x.mean()
     dur = x.size / rate
@@ -476,7 +494,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     def judge(ta, tb):
         sel = frames_in(ta, tb)
         seg = _judge(P[sel], nu1, freq, keep, harm, ref, rise_db, (dominance, alias_dominance), alpha, df,
-                     f_s, teeth * f_s)
+                     f_s, teeth * f_s, growth_db)
         opr = _once_per_rev(x[int(ta * rate):int(tb * rate)], rate, f_s)
         return CutSegment("cut", ta, tb, **seg, once_per_rev=opr)
 
@@ -510,7 +528,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         chatter_hz = longest.chatter_hz
         rec, alts = harmonizer_rpm(chatter_hz, teeth, 60 * f_s)
     criterion = {"alpha": alpha, "rise_db": rise_db if ref is not None else None, "dominance": dominance,
-                 "alias_dominance": alias_dominance,
+                 "alias_dominance": alias_dominance, "growth_db": growth_db, "growth_t": _GROWTH_T,
                  "mask_hz": f"2*{df:.4g} + {_MASK_REL:g}*f", "frame_s": L / rate, "band_hz": [lo, hi],
                  "spindle_multiples_removed": True,
                  "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None}
@@ -556,7 +574,7 @@ def _leakage(p, freq, harm, f_s, df):
     return 4 * out
 
 
-def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s, f_t) -> dict:
+def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s, f_t, growth_db=0.0) -> dict:
     """The chatter test on the mean of the frames ``Pseg`` (see the module docstring); ``dominance`` is the pair
     (without, with a tooth-passing alias)."""
     n = Pseg.shape[0]
@@ -597,7 +615,12 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s,
     strong = dom >= d_plain or (n_alias > 0 and d_alias > 0 and dom >= d_alias)
     chatter = sig > 1 and bool(new[i]) and strong and sustained
     out = dict(verdict="chatter" if chatter else "stable", chatter_hz=f_peak if chatter else None, peak_hz=f_peak,
-               significance=sig, rise_db=rise, dominance=float(min(dom, 1e6)), n_alias=n_alias)
+               significance=sig, rise_db=rise, dominance=float(min(dom, 1e6)), n_alias=n_alias,
+               growth_db=_growth(Pseg, slice(max(0, i - 1), i + 2))[0])
+    if not chatter and growth_db > 0 and good.any():
+        grown = _growing_line(Pseg, p, good, freq, df, z, t_a, rise_bins, h_pow, growth_db)
+        if grown is not None:
+            return grown
     if not chatter and ref is not None:
         locked = _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominance, f_s, f_t)
         if locked is not None:
@@ -612,6 +635,43 @@ def _parabola(p, i) -> float:
     a, b, c = np.log(p[i - 1]), np.log(p[i]), np.log(p[i + 1])
     den = a - 2 * b + c
     return float(np.clip(0.5 * (a - c) / den, -0.5, 0.5)) if den != 0 else 0.0
+
+
+_GROWTH_T = 4.0
+"""Least t-statistic of a growing line's least-squares slope (dB per frame) for the growth test."""
+
+
+def _growth(Pseg, bins) -> tuple:
+    """(rise dB over the frames, t-statistic) of the power in ``bins`` along a least-squares line in dB per
+    frame; the slope's standard error from the residuals ×2 (Hann frames at 75 % overlap: about n/4 of the n
+    frames are independent). (None, 0) with fewer than 6 frames."""
+    n = Pseg.shape[0]
+    if n < 6:
+        return None, 0.0
+    y = 10 * np.log10(np.maximum(Pseg[:, bins].sum(axis=1), 1e-300))
+    k = np.arange(n) - 0.5 * (n - 1)
+    sxx = float(k @ k)
+    slope = float(k @ (y - y.mean())) / sxx
+    r = y - y.mean() - slope * k
+    se = 2.0 * math.sqrt(max(float(r @ r), 1e-12) / (n - 2) / sxx)
+    return slope * (n - 1), slope / se
+
+
+def _growing_line(Pseg, p, good, freq, df, z, t_a, rise_bins, h_pow, growth_db) -> dict | None:
+    """The strongest of the 8 strongest significant new local peaks whose power grows by ≥ ``growth_db`` along
+    a least-squares line with t ≥ :data:`_GROWTH_T` (module docstring, *Growing lines*); None if none does."""
+    if Pseg.shape[0] < 6:
+        return None
+    pk = np.flatnonzero(good[1:-1] & (p[1:-1] >= p[:-2]) & (p[1:-1] >= p[2:])) + 1
+    for i in pk[np.argsort(p[pk])[::-1][:8]]:
+        g, t = _growth(Pseg, slice(i - 1, i + 2))
+        if g is not None and g >= growth_db and t >= _GROWTH_T:
+            f_c = float(freq[i] + _parabola(p, i) * df)
+            dom = float(p[i - 1:i + 2].sum()) / h_pow if h_pow > 0 else np.inf
+            return dict(verdict="chatter", chatter_hz=f_c, peak_hz=f_c, significance=float(z[i] / t_a),
+                        rise_db=None if rise_bins is None else float(rise_bins[i]),
+                        dominance=float(min(dom, 1e6)), n_alias=0, growth_db=float(g))
+    return None
 
 
 def _sustained(Pseg, bins) -> bool:
@@ -684,7 +744,7 @@ def _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominan
         return None
     f_c = float(freq[j] + _parabola(p, j) * df)
     return dict(verdict="chatter", chatter_hz=f_c, peak_hz=f_c, significance=sig, rise_db=float(rise),
-                dominance=float(min(dom, 1e6)), n_alias=n_alias)
+                dominance=float(min(dom, 1e6)), n_alias=n_alias, growth_db=_growth(Pseg, win[m])[0])
 
 
 def _merge(windows, judge):

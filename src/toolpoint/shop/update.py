@@ -65,7 +65,7 @@ from scipy.special import log_ndtr
 
 from ..errors import InputError
 from ..stability.zoa_batch import zoa_limits
-from .model import ModalPrior, limit_at_speeds, receptance
+from .model import ModalPrior, limit_at_speeds, receptance, sdm_limits
 
 __all__ = ["TestCut", "Posterior", "read_test_cuts", "check_consistent", "log_likelihood", "update"]
 
@@ -501,20 +501,19 @@ def _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc):
 def _sdm_log_ratio(prior, theta, rpm_cuts, grid, f):
     """ln(a_SDM / a_ZOA) of each sample (R, ·) at the cut speeds (may be none) and on the grid (both limits of
     the same θ)."""
-    from ..stability import sdm_lobes
-
     zg = _limits(prior, theta, f, grid)
     out_c, out_g = np.zeros((theta.shape[0], rpm_cuts.size)), np.zeros((theta.shape[0], grid.size))
     if rpm_cuts.size:
         zc, _ = limit_at_speeds(prior, theta, rpm_cuts, f)
         u, inv = np.unique(rpm_cuts, return_inverse=True)
     for i, t in enumerate(theta):
-        mm, cut = prior.tool(t)
-        sg = sdm_lobes(mm, mm, cut, rpm=grid).depth_m
+        # as deep as the pockets go: with sdm_lobes' own range a pocket past 100 × the minimum limit was inf, its
+        # ratio dropped to 0 and the correction lost exactly where the cuts are (EM28-80)
+        sg = sdm_limits(prior, t, grid)[0]
         with np.errstate(divide="ignore", invalid="ignore"):
             out_g[i] = np.where(np.isfinite(sg / zg[i]) & (sg > 0), np.log(sg / zg[i]), 0.0)
             if rpm_cuts.size:
-                sc = sdm_lobes(mm, mm, cut, rpm=u).depth_m[inv]
+                sc = sdm_limits(prior, t, u)[0][inv]
                 out_c[i] = np.where(np.isfinite(sc / zc[i]) & (sc > 0), np.log(sc / zc[i]), 0.0)
     return out_c, out_g
 
