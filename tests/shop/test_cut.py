@@ -186,7 +186,8 @@ def _write_wav(path, x, rate=44100):
 
 @pytest.mark.parametrize("case,field", [
     ("silent", "samples"), ("clipped", "samples"), ("short", "samples"), ("rpm", "--rpm"), ("teeth", "teeth"),
-    ("teeth_word", "--teeth"), ("rpm_huge", "rpm"), ("dominance", "--dominance")])
+    ("teeth_word", "--teeth"), ("rpm_huge", "rpm"), ("dominance", "--dominance"),
+    ("growth", "--growth-db")])
 def test_bad_input_is_one_line_exit_2(case, field, tmp_path, capsys):
     x, rate, *_ = shop_record(rpm=6000, teeth=4, air_s=0.3, cut_s=0.6, seed=5)
     args = ["--rpm", "6000", "--teeth", "4"]
@@ -206,6 +207,8 @@ def test_bad_input_is_one_line_exit_2(case, field, tmp_path, capsys):
         args = ["--rpm", "6e6", "--teeth", "4"]
     elif case == "dominance":
         args = ["--rpm", "6000", "--teeth", "4", "--dominance", "nan"]
+    elif case == "growth":
+        args = ["--rpm", "6000", "--teeth", "4", "--growth-db", "-3"]
     wav = _write_wav(tmp_path / "r.wav", x)
     out = tmp_path / "o.json"
     assert main(["cut", str(wav), *args, "--out", str(out)]) == 2
