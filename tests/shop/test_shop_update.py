@@ -378,7 +378,7 @@ def test_sdm_forward_model_follows_cuts_that_follow_the_sdm():
 
 def test_sdm_limits_reach_the_deep_pockets_of_a_lightly_damped_mode():
     # one mode of ζ 0.3 % at low immersion (a campaign tool, EM28-80, in its prior's tail): the pocket at
-    # 9700–10000 rpm is past sdm_lobes' default range (100 × the minimum limit) and came back inf — the virtual
+    # 9600–9800 rpm is past sdm_lobes' default range (100 × the minimum limit) and came back inf — the virtual
     # campaigns' truth and the SDM correction of update lost it. sdm_limits searches deeper; the limit it finds is
     # checked by the spectral radius itself: stable 3 % below, unstable 3 % above, at every speed.
     from toolpoint.shop.model import sdm_limits
