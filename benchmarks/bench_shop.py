@@ -223,20 +223,22 @@ def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01):
     1.15, 1.4, 2) × the SDM limit there. The grid of :func:`bench_cut_sim` samples speeds at random; the virtual
     campaigns' cuts sit in these pockets, where the resonant harmonic is 20–30 dB above the rest.
     """
-    from toolpoint.stability import sdm_lobes, sdm_spectral_radius
+    from toolpoint.shop.model import sdm_limits
+    from toolpoint.stability import sdm_spectral_radius
 
     sc = _Score()
     for name, pr in priors.items():
         lo, hi = pr.rpm_range if pr.rpm_range is not None else (5000.0, 25000.0)
         for seed in range(seed_start, seed_start + (1 if quick else truths)):
             rng = np.random.default_rng(seed)
-            mm, c = _truth(pr, rng, random_cut=False)
+            th = pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None, :])[0]  # as _truth draws it
+            mm, c = pr.tool(th)
             sp = (60 * np.asarray(mm.fn_hz)[:, None, None] / (c.teeth * np.arange(1, 5)[None, :, None])
                   * np.array([0.97, 1.0, 1.03])[None, None, :]).ravel()
             sp = np.sort(sp[(sp >= lo) & (sp <= hi)])[-8:]
             if sp.size == 0:
                 continue
-            lim = sdm_lobes(mm, mm, c, rpm=sp).depth_m
+            lim = sdm_limits(pr, th, sp)[0]  # as deep as the pockets go (EM28-80's pass 100 × the minimum)
             ok = np.isfinite(lim)
             sp, lim = sp[ok], lim[ok]
             R = np.repeat(sp, 5)
@@ -260,13 +262,12 @@ def noisy_shop(prior, rng_blur=0.03, f_noise=0.005):
 def sdm_shop(prior, rng_blur=0.03, f_noise=0.005):
     """Labels by the SDM limit of θ* at the cut's speed (its chatter frequency), blurred like :func:`noisy_shop`:
     the whole loop's forward model (the SDM truth) without the simulation and the detector."""
-    from toolpoint.stability import sdm_lobes
+    from toolpoint.shop.model import sdm_limits
 
     def shop(theta, rpm, depth, rng):
-        mm, cut = prior.tool(theta)
-        res = sdm_lobes(mm, mm, cut, rpm=[float(rpm)])
-        stable = bool(depth < res.depth_m[0] * np.exp(rng.normal(0, rng_blur)))
-        f_meas = None if stable else float(res.chatter_hz[0] * (1 + rng.normal(0, f_noise)))
+        lim, fc = sdm_limits(prior, theta, [float(rpm)])
+        stable = bool(depth < lim[0] * np.exp(rng.normal(0, rng_blur)))
+        f_meas = None if stable else float(fc[0] * (1 + rng.normal(0, f_noise)))
         return TestCut(float(rpm), float(depth), stable, f_meas)
     return shop
 
