@@ -215,7 +215,10 @@ def test_smoothing_reduces_rotational_errors_at_one_percent_noise(example, blank
         smooth = subassembly_from_blank(blank, x2, *noisy, smooth=25.0)
         assert np.all(median_rel(smooth, true_noise)[1:] < factor * median_rel(raw, true_noise)[1:])
         assert np.all(norm_rel(smooth, true_noise)[1:] < factor * norm_rel(raw, true_noise)[1:])
-        assert np.array_equal(smooth.R, smooth_subassembly(raw, 25.0).R)
+        # the same as smoothing afterwards; not bitwise: the inverse's linear solves may take another
+        # BLAS path from one call to the next (seen once on the minimum versions in CI)
+        np.testing.assert_allclose(smooth.R, smooth_subassembly(raw, 25.0).R, rtol=1e-9,
+                                   atol=1e-12 * np.abs(smooth.R).max())
     assert median_rel(raw, true_noise)[2] > 5  # the 80 mm blank at 1 %: no usable p
 
 
