@@ -1,5 +1,6 @@
 """`toolpoint library`: tool library → joint distribution → FRF band → lobes with uncertainty → recommendations."""
 
+import atexit
 import csv
 import functools
 import math
@@ -38,6 +39,7 @@ def small_campaign() -> Path:
     A real ``campaign run`` of 50 tools takes ~40 s; the benchmark (benchmarks/bench_library.py) uses one.
     """
     root = Path(tempfile.mkdtemp(prefix="tp_library_"))
+    atexit.register(shutil.rmtree, root, True)  # cached across tests: removed when the worker ends
     camp = root / "camp"
     synthesise(camp, n=4, seed=3)
     toml = (camp / "campaign.toml").read_text()

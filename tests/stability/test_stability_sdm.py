@@ -224,3 +224,30 @@ def test_converges_to_the_independent_first_order_sdm(ri, rpm):
     got = [sdm_lobes(MODE, None, cut(ri), rpm=[rpm], m=m, rtol=1e-7).depth_m[0] for m in (40, 80)]
     ext_ref, ext_got = ref[1] + (ref[1] - ref[0]) / 3, got[1] + (got[1] - got[0]) / 3
     assert ext_got == pytest.approx(ext_ref, rel=1e-4)
+
+
+def test_the_default_range_widens_to_the_deep_pockets_of_a_lightly_damped_mode():
+    # One mode of ζ 0.3 % at 25 % immersion, up milling (a campaign tool, EM28-80, in its prior's tail): the
+    # pocket at 9600–9800 rpm is past 100 × the zero-order minimum and came back inf — campaigns' truth and the
+    # SDM correction of update lost it. The widened default finds it; every limit is checked by the spectral
+    # radius itself: stable 3 % below, unstable 3 % above.
+    w = 2 * np.pi * 654.0
+    mode = ModalModel([654.0], [0.003], [1.7e7 / w**2])
+    c = CuttingConditions(teeth=4, tangential_coeff=7.96e8, radial_ratio=0.212, radial_immersion=0.25,
+                          milling="up")
+    rpm = np.linspace(9400, 10000, 7)
+    narrow = sdm_lobes(mode, mode, c, rpm=rpm, widen=0)
+    assert np.sum(~np.isfinite(narrow.depth_m)) >= 2
+    res = sdm_lobes(mode, mode, c, rpm=rpm)
+    a = res.depth_m
+    assert np.all(np.isfinite(a)) and np.all(np.isfinite(res.chatter_hz))
+    fin = np.isfinite(narrow.depth_m)  # the speeds found at once are not searched again
+    assert np.array_equal(a[fin], narrow.depth_m[fin])
+    assert res.params["depth_max"] > narrow.params["depth_max"]
+    assert np.all(sdm_spectral_radius(mode, mode, c, rpm=rpm, depth=0.97 * a) < 1)
+    assert np.all(sdm_spectral_radius(mode, mode, c, rpm=rpm, depth=1.03 * a) > 1)
+    # a range given by the caller is kept
+    assert sdm_lobes(mode, mode, c, rpm=rpm, depth_max=narrow.params["depth_max"]).params["depth_max"] == \
+        narrow.params["depth_max"]
+    with pytest.raises(InputError, match="widen"):
+        sdm_lobes(mode, mode, c, rpm=rpm, widen=-1)

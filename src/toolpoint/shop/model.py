@@ -251,15 +251,13 @@ def limit_at_speeds(prior: ModalPrior, theta, rpm, freq_hz=None) -> tuple[np.nda
     return limit, best_f
 
 
-def sdm_limits(prior: ModalPrior, theta, rpm, *, widen: int = 2):
-    """Semi-discretisation limit (m) and chatter frequency (Hz) of one θ at increasing speeds, with the depth
-    range widened where it is too low.
+def sdm_limits(prior: ModalPrior, theta, rpm):
+    """Semi-discretisation limit (m) and chatter frequency (Hz) of one θ at increasing speeds.
 
-    :func:`~toolpoint.stability.sdm_lobes` searches up to 100 × the zero-order minimum limit and calls a speed
-    still stable there ``inf``. The pocket of a lightly damped mode at low radial immersion reaches past that
-    (a campaign tool, EM28-80: one 654 Hz mode, 25 % immersion, up milling — 35–52 mm at 9540–9890 rpm against
-    a minimum of 0.34 mm, where the simulated cut chatters at 47 mm): those speeds are searched again with the
-    range × 10, up to ``widen`` times. ``inf`` only for speeds stable at 10^(2 + widen) × the minimum.
+    :func:`~toolpoint.stability.sdm_lobes` with its default depth range, which is widened where the pockets go
+    deeper than 100 × the zero-order minimum (a campaign tool, EM28-80: one 654 Hz mode, 25 % immersion, up
+    milling — 35–52 mm at 9540–9890 rpm against a minimum of 0.34 mm, where the simulated cut chatters at
+    47 mm). ``inf`` only for speeds stable at 10⁴ × the minimum.
 
     Parameters
     ----------
@@ -267,8 +265,6 @@ def sdm_limits(prior: ModalPrior, theta, rpm, *, widen: int = 2):
     theta : array_like, shape (3M + 2,)
     rpm : array_like, shape (R,)
         Increasing speeds, rpm.
-    widen : int, default 2
-        Searches with a ×10 wider range at most.
 
     Returns
     -------
@@ -277,18 +273,8 @@ def sdm_limits(prior: ModalPrior, theta, rpm, *, widen: int = 2):
     from ..stability import sdm_lobes
 
     mm, cut = prior.tool(np.asarray(theta, float))
-    n = np.asarray(rpm, float)
-    res = sdm_lobes(mm, mm, cut, rpm=n)
-    lim, fc = res.depth_m.copy(), res.chatter_hz.copy()
-    top = float(res.params["depth_max"])
-    for _ in range(widen):
-        todo = ~np.isfinite(lim)
-        if not todo.any():
-            break
-        top *= 10.0
-        again = sdm_lobes(mm, mm, cut, rpm=n[todo], depth_max=top)
-        lim[todo], fc[todo] = again.depth_m, again.chatter_hz
-    return lim, fc
+    res = sdm_lobes(mm, mm, cut, rpm=np.asarray(rpm, float))
+    return res.depth_m, res.chatter_hz
 
 
 def example_tool(sigma: float = 0.15) -> ModalPrior:
