@@ -85,7 +85,7 @@ def test_ga_beats_the_paper(case, seed):
     assert r.success and r.status == 0 and r.message.startswith("converged")  # ... and says so
 
 
-@pytest.mark.parametrize("seed", range(5))
+@pytest.mark.parametrize("seed", [0, *(pytest.param(s, marks=pytest.mark.slow) for s in range(1, 5))])
 def test_sa_beats_the_paper(case, seed):
     """Default (paper) settings: initial temperature 300, reannealing interval 50."""
     model, exact, meas = case

@@ -266,6 +266,7 @@ def test_virtual_campaign_converges_with_few_chatters():
     assert isinstance(ModalPrior, type)
 
 
+@pytest.mark.slow
 def test_stable_cuts_climb_by_the_boundary_width_not_by_the_risk_quantile():
     """A truth above the prior's median (K_t / 1.4: the limit 40 % up): with the risk bound alone each stable cut
     sits at the posterior's 30 % quantile, a few % above the last one, and the band creeps (measured: +4–10 % a

@@ -38,9 +38,9 @@ def register(sub) -> None:
     p.add_argument("--dominance", default="0.05",
                    help="least power of a chatter line relative to the strongest spindle harmonic's (default 0.05, "
                         "-13 dB); lower finds weaker chatter and risks calling a noisy stable cut chatter")
-    p.add_argument("--alias-dominance", default="0.005",
+    p.add_argument("--alias-dominance", default="0.002",
                    help="the same for a line whose tooth-passing alias (f +- f_t, f +- 2 f_t) is a new line too "
-                        "(default 0.005, -23 dB; 0: never below --dominance)")
+                        "(default 0.002, -27 dB; 0: never below --dominance)")
     p.add_argument("--growth-db", default="6",
                    help="a new line whose power rises steadily by this much over a judged part is chatter, however "
                         "weak (default 6 dB, with t >= 4; 0: no growth test)")
