@@ -177,6 +177,21 @@ def test_a_weak_line_is_chatter_with_its_tooth_passing_aliases_not_alone():
     assert any(abs(sg.peak_hz / 1234 - 1) < 0.01 and sg.dominance >= 0.005 and sg.n_alias == 0 for sg in cut)
 
 
+def test_a_family_a_few_thousandths_of_the_harmonic_is_chatter_a_weaker_one_is_not():
+    """A lightly damped mode at a pocket: the chatter saturates 25 dB under the resonant harmonic, a family
+    f_c + j f_t. At 0.0034 of the harmonic's power with its aliases it is chatter (the old default, 0.005, missed
+    it); at 0.0015 — the strongest family of any stable simulated record is 0.0013 (docs/design/shop.md) — not."""
+    rpm, teeth = 6000.0, 4
+    for amp, want in ((0.06, "chatter"), (0.04, "stable")):
+        x, rate, *_ = shop_record(rpm=rpm, teeth=teeth, chatter_hz=1234.0, chatter_amp=amp, seed=6)
+        r = analyse_cut(x, rate, rpm=rpm, teeth=teeth, full_scale=1.0)
+        cut = [sg for sg in r.segments if sg.kind == "cut"]
+        assert r.verdict == want, [(sg.peak_hz, sg.dominance, sg.n_alias) for sg in cut]
+        assert all(abs(sg.peak_hz / 1234 - 1) < 0.01 and sg.n_alias >= 1 for sg in cut)
+        assert all(0.002 * (amp > 0.05) <= sg.dominance < (0.005 if amp > 0.05 else 0.002) for sg in cut)
+    assert analyse_cut(x, rate, rpm=rpm, teeth=teeth, full_scale=1.0, alias_dominance=0.0005).verdict == "chatter"
+
+
 def _write_wav(path, x, rate=44100):
     import soundfile as sf
 
