@@ -189,6 +189,7 @@ def test_a_family_a_few_thousandths_of_the_harmonic_is_chatter_a_weaker_one_is_n
         assert r.verdict == want, [(sg.peak_hz, sg.dominance, sg.n_alias) for sg in cut]
         assert all(abs(sg.peak_hz / 1234 - 1) < 0.01 and sg.n_alias >= 1 for sg in cut)
         assert all(0.002 * (amp > 0.05) <= sg.dominance < (0.005 if amp > 0.05 else 0.002) for sg in cut)
+        assert analyse_cut(x, rate, rpm=rpm, teeth=teeth, full_scale=1.0, alias_dominance=0.005).verdict == "stable"
     assert analyse_cut(x, rate, rpm=rpm, teeth=teeth, full_scale=1.0, alias_dominance=0.0005).verdict == "chatter"
 
 
