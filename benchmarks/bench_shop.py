@@ -1,7 +1,8 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only update] [--shops zoa,noisy,sim] [--cases cornelius,example] [--max-cuts 10] [--verbose]
+        [--only cut|update|sampler|forward] [--shops zoa,noisy,sim] [--cases cornelius,example]
+        [--max-cuts 10] [--verbose]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
 
 Prints the machine, date and load first; per case and shop the median cuts to converge, the fraction converged,
@@ -20,6 +21,7 @@ CPU time (time.process_time), not wall time: the machine is shared.
    ``analyse_cut``: the whole loop). Targets: ≤ 6 cuts (median) until the 5–95 %
    band holds the true limit at ≥ 90 % of the speeds and is ≤ 20 % of the limit wide at the recommended speed;
    ≤ 1 chattering cut (median); each update ≤ 30 s CPU. SMC against SIR (ESS at equal CPU) on one case.
+3. ``forward``: CPU of one call of the likelihood's forward model (``limit_at_speeds``, 500 samples, 6 speeds).
 """
 
 from __future__ import annotations
@@ -346,12 +348,26 @@ def bench_sampler():
               f"distinct samples {uniq}, limit at 20000 rpm 5/50/95 % = {np.round(post.limit_q_m[:, j] * 1e3, 3)} mm")
 
 
+def bench_forward():
+    """CPU of the forward model the likelihood calls: ``limit_at_speeds`` of 500 prior samples at 6 speeds."""
+    print("\n## forward model: limit_at_speeds, 500 prior samples × 6 speeds (CPU per call, best of 5)")
+    for pr in (cornelius_2024(0.1), example_tool(0.15)):
+        theta = pr.theta(np.random.default_rng(0).standard_normal((500, pr.sigma.size)) * (pr.sigma > 0))
+        rpm = np.linspace(*pr.rpm_range, 6)
+        cpu = []
+        for _ in range(5):
+            t = time.process_time()
+            limit_at_speeds(pr, theta, rpm)
+            cpu.append(time.process_time() - t)
+        print(f"{pr.name[:40]:40s} {pr.freq_grid().size} frequencies, {pr.modes} modes: {min(cpu):.3f} s")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=("cut", "update", "sampler"))
+    ap.add_argument("--only", choices=("cut", "update", "sampler", "forward"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -377,6 +393,8 @@ def main():
             out, tool = a.library_prior.rsplit(":", 1)
             pockets[tool] = prior_from_library(out, tool)
         bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level)
+    if a.only in (None, "forward"):
+        bench_forward()
     if a.only in (None, "sampler"):
         bench_sampler()
     if a.only in (None, "update"):

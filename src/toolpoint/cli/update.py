@@ -35,10 +35,10 @@ def register(sub) -> None:
                    help="next-cut rule: info = most reduction of the limit's band at the recommended speed with "
                    "P(chatter) ≤ risk (default); risk = most productive cut with P(chatter) ≤ risk")
     p.add_argument("--risk", help="largest P(chatter) of the next cut (default 0.3 for info, 0.1 for risk)")
-    p.add_argument("--min-step", default="0",
-                   help="info rule: a cut this much (log) above the highest stable cut at a speed may be "
-                   "proposed even past --risk, so stable cuts do not creep (default 0: never; 0.1 = 2 × the "
-                   "boundary width saves cuts and costs chattering ones: docs/design/shop.md)")
+    p.add_argument("--min-step",
+                   help="info rule: once two stable cuts at a speed are closer than e^STEP, a cut e^STEP above the "
+                   "highest may be proposed even past --risk, so stable cuts do not creep (default 0.1 = 2 × the "
+                   "boundary width; 0: never: docs/design/shop.md)")
     p.add_argument("--forward", choices=("zoa", "sdm"), default="zoa",
                    help="forward model: zoa = zero-order limit (default); sdm = zero-order corrected by the "
                    "semi-discretisation at posterior samples (cuts that follow the SDM, low radial immersion; "
@@ -56,8 +56,8 @@ def run(args) -> int:
     risk = None if args.risk is None else check_number(args.risk, "--risk", above=0)
     if risk is not None and risk > 0.5:
         raise InputError(f"must be ≤ 0.5, got {args.risk}", file="command line", field="--risk")
-    min_step = check_number(args.min_step, "--min-step", minimum=0)
-    if min_step > 0.5:
+    min_step = None if args.min_step is None else check_number(args.min_step, "--min-step", minimum=0)
+    if min_step is not None and min_step > 0.5:
         raise InputError(f"must be ≤ 0.5 (a log step: ×1.65), got {args.min_step}", file="command line",
                          field="--min-step")
     if args.library and not args.tool:

@@ -43,13 +43,14 @@ at the depth a₀₅ (P(stable) = 0.95). **Next test cut**, two rules:
   than it is and pushed the rule to creep up from below. Above a stable cut a_s the risk bound alone creeps
   too: the posterior piles up just above a_s (the prior's density falls there when the truth is above its
   median), its ``risk`` quantile is a few % higher, and each stable cut lifts the band by that much (measured:
-  9 stable cuts from 2.50 to 3.39 mm before the chatter that closed the band). With ``min_step`` > 0 a step
-  of e^min_step above the highest stable cut at that speed is also a candidate, whatever its P(chatter)
-  (the proposal says ``stepped``): cuts closer than the boundary's own width tell little, and a chatter one
-  step of 2 w up is a bracket of ratio 1.105, which leaves a 5–95 % width of about 0.2. It is off by default:
-  measured, it saves cuts where the shop follows the model and costs chattering cuts in the whole loop — on
-  the Cornelius case the median chattering cuts go 1 → 2 with 0.1, while a campaign tool with one lightly
-  damped mode (EM28-80) needs it: median 8 → 5 cuts, 1 chattering (``docs/design/shop.md``);
+  9 stable cuts from 2.50 to 3.39 mm before the chatter that closed the band). So once the risk bound has crept
+  at a speed — its two highest stable cuts there (±0.5 %) closer than e^min_step — a step of e^min_step above
+  the highest is also a candidate, whatever its P(chatter) (the proposal says ``stepped``): cuts closer than the
+  boundary's own width tell little, and a chatter one step of 2 w up is a bracket of ratio 1.105, which leaves a
+  5–95 % width of about 0.2. ``min_step`` 0.1 by default (0: never). In the whole loop (``docs/design/shop.md``)
+  a step after every stable cut (the rule before 2026-11-26) cost the Cornelius case a second chattering cut
+  (median 1 → 2, seeds 0–19) while a campaign tool with one lightly damped mode (EM28-80) needed it (median
+  8 → 5 cuts); stepping only after a creep gave 4.5 cuts, 1 chattering and 6 cuts, 1 chattering on those seeds;
 * ``"risk"``: the most productive cut (max n · a) whose P(chatter) ≤ ``risk`` (default 0.1) — the depth
   a_risk(n), the ``risk`` quantile of the limit.
 """
@@ -291,7 +292,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            rpm_grid=None, n_moves: int = 3, boundary_width: float = 0.05, label_noise: float = 0.002,
            freq_sigma: float = 0.02, rule: str = "info", risk: float | None = None, lobe_samples: int = 400,
            n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "zoa", sdm_refs: int = 4,
-           min_step: float = 0.0, sdm_train: int = 0, miss_rate: float = 0.0) -> Posterior:
+           min_step: float | None = None, sdm_train: int = 0, miss_rate: float = 0.0) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -343,10 +344,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         cut speeds was measured 0.1–0.2 (ln) off the corrected samples' own. 60 brings the median limit at the
         cut speeds closer to the SDM's but did not make campaigns converge more often, at 3–6 s more per update:
         off by default (``docs/design/shop.md``).
-    min_step : float, default 0
-        ``"info"`` rule: a cut ``min_step`` (log) above the highest stable cut at a speed is a candidate even
-        where it exceeds ``risk`` (0: never; 2 × ``boundary_width`` = 0.1 trades chatters for cuts: module
-        docstring).
+    min_step : float, optional
+        ``"info"`` rule: once the two highest stable cuts at a speed are closer than e^min_step (the risk bound
+        crept), a cut e^min_step above the highest is a candidate even where it exceeds ``risk`` (default 0.1 =
+        2 × ``boundary_width`` for ``"info"``; 0: never; the ``"risk"`` rule has no step: module docstring).
 
     Returns
     -------
@@ -378,6 +379,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         raise InputError(f"must be a whole number ≥ 0, got {sdm_train}", field="sdm_train")
     if not 0 <= miss_rate < 1:
         raise InputError(f"must be in [0, 1), got {miss_rate}", field="miss_rate")
+    if min_step is None:
+        min_step = 0.1 if rule == "info" else 0.0
     if not 0 <= min_step <= 0.5:
         raise InputError(f"must be in [0, 0.5] (a log step), got {min_step}", field="min_step")
     if min_step > 0 and rule != "info":
@@ -588,8 +591,9 @@ def _wquantile_width(vals_sorted, w):
 
 def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), min_step=0.0, miss_rate=0.0):
     """The ``"info"`` rule: min expected relative band width at the recommended speed, P(chatter) ≤ risk —
-    or a step of ``min_step`` (log) above the highest stable cut at that speed (±0.5 %), when the risk bound
-    stops short of it (module docstring)."""
+    or a step of ``min_step`` (log) above the highest stable cut at that speed (±0.5 %), when the two highest
+    stable cuts there are closer than that (the risk bound crept) and it stops short of the step (module
+    docstring)."""
     from scipy.special import ndtr
 
     q50 = np.quantile(lim, 0.5, axis=0)
@@ -608,8 +612,10 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
         depths = depths[ok]
         n_capped = depths.size
         near = [c for c in cuts if abs(c.rpm / grid[k] - 1) <= 0.005]
-        a_s = max((c.depth_m for c in near if c.stable), default=None)
-        if min_step > 0 and a_s is not None and depths[-1] < a_s * math.exp(min_step):
+        st = sorted(c.depth_m for c in near if c.stable)
+        a_s = st[-1] if st else None
+        crept = len(st) >= 2 and st[-1] < st[-2] * math.exp(min_step)
+        if min_step > 0 and a_s is not None and crept and depths[-1] < a_s * math.exp(min_step):
             step = a_s * math.exp(min_step)
             if not any(not c.stable and c.depth_m <= step for c in near):  # not past a chatter already heard
                 depths = np.r_[depths, step]
@@ -631,6 +637,6 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
             "expected_log_width": e, "log_width_now": now, "stepped": bool(stepped),
             "description": "the cut that most reduces the expected relative 5–95 % width of the limit at the "
                            f"recommended speed, among productive speeds, with P(chatter) ≤ {risk:g}"
-                           + (f" or a step of ×{math.exp(min_step):.3f} above the highest stable cut at that speed"
+                           + (f" or, where two stable cuts crept, a step of ×{math.exp(min_step):.3f} above the highest"
                               if min_step > 0 else "")
                            + (" (this one: the step)" if stepped else "")}
