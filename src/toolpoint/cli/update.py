@@ -72,7 +72,7 @@ def run(args) -> int:
     import numpy as np
 
     from ..shop.prior import prior_from_library, read_modal_prior
-    from ..shop.report import write_update
+    from ..shop.report import away_note, write_update
     from ..shop.update import read_test_cuts, update
 
     if args.prior:
@@ -89,4 +89,6 @@ def run(args) -> int:
           f"(P(stable) {rc['p_stable']:.2f}); next test cut ({nc['rule']}) {nc['rpm']:.0f} rpm at "
           f"{1e3 * nc['depth_m']:.3f} mm, P(chatter) {nc['p_chatter']:.2f}"
           f"{' (a step above the stable cut there)' if nc.get('stepped') else ''}; wrote {out}/report.html")
+    if cuts:
+        print("note: " + away_note([{"rpm": c.rpm} for c in cuts]))
     return 0
