@@ -133,7 +133,7 @@ def away_note(cuts) -> str:
     rpm = [c["rpm"] for c in cuts]
     return (f"the band is tested by your cuts at {min(rpm):.0f}–{max(rpm):.0f} rpm; away from those speeds it rests "
             "on the model and was measured over-confident in virtual campaigns (after 9–10 cuts at one speed range "
-            "it held the true limit at only 35–76 % of the other speeds on the failed truths: docs/design/shop.md) "
+            "it held the true limit at only 35–76 % of the speeds on four failed truths: docs/design/shop.md) "
             "— make a test cut at a speed before trusting the band there")
 
 
