@@ -1,8 +1,8 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|update|sampler|forward] [--shops zoa,noisy,sim] [--cases cornelius,example]
-        [--max-cuts 10] [--verbose]
+        [--only cut|update|sampler|forward|ceiling] [--shops zoa,noisy,sim] [--cases cornelius,example]
+        [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
 
 Prints the machine, date and load first; per case and shop the median cuts to converge, the fraction converged,
@@ -22,6 +22,11 @@ CPU time (time.process_time), not wall time: the machine is shared.
    band holds the true limit at ≥ 90 % of the speeds and is ≤ 20 % of the limit wide at the recommended speed;
    ≤ 1 chattering cut (median); each update ≤ 30 s CPU. SMC against SIR (ESS at equal CPU) on one case.
 3. ``forward``: CPU of one call of the likelihood's forward model (``limit_at_speeds``, 500 samples, 6 speeds).
+4. ``ceiling``: what the convergence test asks of an exactly calibrated band. The prior's own 5–95 % band
+   (zero-order lobes of ``lobe_samples`` prior samples) against 1000 truths drawn from the same prior: the mean
+   share of speeds where the truth lies in the band (≈ 0.90 when calibrated) and the share of truths for which it
+   is ≥ 0.90 — the most a campaign's coverage test can pass at one update when the posterior is exact (a
+   posterior given the cuts holds a truth drawn from the prior like the prior holds it, on average over truths).
 """
 
 from __future__ import annotations
@@ -284,13 +289,15 @@ def shop_microphone(res, rpm, teeth, rng, point=0):
 
 
 def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius", "example"), update_kw=None,
-                 max_cuts=10, verbose=False, seed_start=0, library_prior=None, detector=None):
+                 max_cuts=10, verbose=False, seed_start=0, library_prior=None, detector=None, stop=True):
     update_kw = dict(update_kw or {})
     n_s = update_kw.pop("n_samples", 600 if quick else 1000)
     n_l = update_kw.pop("lobe_samples", 300 if quick else 400)
     print(f"\n## update: virtual campaigns (info rule, SMC {n_s} samples, {n_l} lobe samples, {seeds} seeds "
           f"{seed_start}…{seed_start + seeds - 1}, at most {max_cuts} cuts; update options {update_kw or 'default'}"
-          + (f"; detector options {detector}" if detector else "") + ")")
+          + (f"; detector options {detector}" if detector else "")
+          + ("" if stop else "; no stop: every campaign makes all its cuts, convergence read from the same sequence")
+          + ")")
     priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
     if library_prior:  # OUT:TOOL — a tool of a `toolpoint library` output, its prior as `update --library` makes it
         from toolpoint.shop.prior import prior_from_library
@@ -303,13 +310,14 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
     for case in cases:
         prior = priors[case]
         for shop_name in shops:
-            conv, chat, cpu, fails = [], [], [], 0
+            conv, chat, cpu, fails, runs = [], [], [], 0, []
             for seed in range(seed_start, seed_start + seeds):
                 shop = {"zoa": None, "noisy": noisy_shop(prior), "sdm": sdm_shop(prior),
                         "sim": simulated_shop(prior, record=shop_microphone, detector=detector)}[shop_name]
                 truth = sdm_limit(prior) if shop_name in ("sim", "sdm") else None
                 r = virtual_campaign(prior, rng=np.random.default_rng(seed), shop=shop, max_cuts=max_cuts,
-                                     true_limit=truth, n_samples=n_s, lobe_samples=n_l, **update_kw)
+                                     true_limit=truth, n_samples=n_s, lobe_samples=n_l, stop=stop, **update_kw)
+                runs.append(r)
                 conv.append(r.converged_after if r.converged_after is not None else np.inf)
                 made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
                 chat.append(sum(not c.stable for c in made))
@@ -326,6 +334,18 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                   f"(p90 {p90:.1f}), converged {seeds - fails}/{seeds} within {max_cuts}; "
                   f"chattering cuts median {np.median(chat):.1f} (max {max(chat)}); CPU per update median "
                   f"{np.median(cpu):.1f} s, max {max(cpu):.1f} s", flush=True)
+            if not stop:  # calibration after n cuts, over all the truths (none selected by a stop)
+                for n in range(max_cuts + 1):
+                    below = np.mean([r.below_recommended[n] for r in runs])
+                    cov = np.array([r.coverage[n] for r in runs])
+                    near = np.array([r.coverage_near[n] for r in runs])
+                    away = np.array([r.coverage_away[n] for r in runs])
+                    wid = np.median([r.width[n] for r in runs])
+                    print(f"   after {n} cuts: truth below the recommended depth (claims 0.05) {below:.2f}; coverage "
+                          f"mean {cov.mean():.3f} (truths ≥ 0.90: {np.mean(cov >= 0.9):.2f}), near the cuts (±3 %) "
+                          + ("-" if np.all(np.isnan(near)) else f"{np.nanmean(near):.3f}")
+                          + f", away {np.nanmean(away):.3f}; width at the recommended speed median {wid:.2f}",
+                          flush=True)
 
 
 def bench_sampler():
@@ -362,12 +382,36 @@ def bench_forward():
         print(f"{pr.name[:40]:40s} {pr.freq_grid().size} frequencies, {pr.modes} modes: {min(cpu):.3f} s")
 
 
+def bench_ceiling(cases, library_prior=None):
+    from toolpoint.shop.update import _default_grid, _limits
+
+    print("\n## ceiling: a calibrated band (the prior's own, zero-order) against 1000 truths from the same prior")
+    priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
+    if library_prior:
+        from toolpoint.shop.prior import prior_from_library
+
+        out, tool = library_prior.rsplit(":", 1)
+        priors["library"] = prior_from_library(out, tool)
+    for case in cases:
+        pr = priors[case]
+        f, g = pr.freq_grid(), _default_grid(pr)
+        P, free = pr.sigma.size, pr.sigma > 0
+        rng = np.random.default_rng(0)
+        truth = _limits(pr, pr.theta(rng.standard_normal((1000, P)) * free), f, g)
+        for m in (200, 400, 2000):
+            q = np.quantile(_limits(pr, pr.theta(rng.standard_normal((m, P)) * free), f, g), [0.05, 0.95], axis=0)
+            cov = ((q[0] <= truth) & (truth <= q[1])).mean(axis=1)
+            print(f"{pr.name[:40]:40s} band of {m:4d} samples: mean coverage {cov.mean():.3f}, truths with "
+                  f"coverage ≥ 0.90: {(cov >= 0.9).mean():.3f}, coverage 10/25/50 % "
+                  f"{np.round(np.quantile(cov, [0.1, 0.25, 0.5]), 2).tolist()}", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=("cut", "update", "sampler", "forward"))
+    ap.add_argument("--only", choices=("cut", "update", "sampler", "forward", "ceiling"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -380,6 +424,9 @@ def main():
     ap.add_argument("--seed-level", type=float, default=0.01,
                     help="kick of each simulated cut, relative to the forced response (simulate_milling's seed_level)")
     ap.add_argument("--verbose", action="store_true", help="one line per campaign")
+    ap.add_argument("--no-stop", action="store_true",
+                    help="campaigns make all --max-cuts cuts (convergence read from the same sequence) and the "
+                    "band's calibration after each cut is printed over all the truths")
     ap.add_argument("--detector", default="{}", help="JSON of analyse_cut() options of the simulated shop")
     a = ap.parse_args()
     header()
@@ -395,13 +442,15 @@ def main():
         bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level)
     if a.only in (None, "forward"):
         bench_forward()
+    if a.only in (None, "ceiling"):
+        bench_ceiling(a.cases.split(","), a.library_prior)
     if a.only in (None, "sampler"):
         bench_sampler()
     if a.only in (None, "update"):
         import json
 
         bench_update(a.seeds, a.quick, a.shops.split(","), a.cases.split(","), json.loads(a.update), a.max_cuts,
-                     a.verbose, a.seed_start, a.library_prior, json.loads(a.detector))
+                     a.verbose, a.seed_start, a.library_prior, json.loads(a.detector), stop=not a.no_stop)
 
 
 if __name__ == "__main__":

@@ -61,10 +61,37 @@ def test_smc_posterior_matches_quadrature_on_one_parameter():
     w = np.exp(lp - lp.max())
     cdf = np.cumsum(w) / w.sum()
     exact = np.interp([0.05, 0.5, 0.95], cdf, zg)
-    post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50)
-    got = np.quantile(post.z[:, -2], [0.05, 0.5, 0.95])
+    post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(0, 0))
+    got = np.quantile(post.z[:, pr.sigma.size - 2], [0.05, 0.5, 0.95])
     np.testing.assert_allclose(got, exact, atol=0.08)
     assert exact[2] - exact[0] < 0.6 * 2 * 1.645  # the cuts did narrow it
+
+
+def test_smc_posterior_matches_quadrature_with_the_label_offset():
+    """K_t and the label offset δ uncertain: the exact posterior of ln K_t on a 2-D grid (ln K_t × δ, the labels'
+    boundary at a_lim e^δ) vs the SMC samples' — δ shifts the band down (chatter heard only above the limit) and
+    widens it, since the cuts cannot tell δ from K_t."""
+    pr = _kt_only()
+    cuts = [TestCut(20000.0, 0.55e-3, True), TestCut(20000.0, 0.62e-3, False, 1290.0), TestCut(9000.0, 0.5e-3, True)]
+    mu, sd = 0.05, 0.04
+    zg = np.linspace(-5, 5, 401)
+    zz = np.zeros((zg.size, pr.sigma.size))
+    zz[:, -2] = zg
+    th = pr.theta(zz)
+    lp = np.array([-0.5 * zg ** 2 - 0.5 * d ** 2 + log_likelihood(pr, th, cuts, label_offset=mu + sd * d) for d in zg])
+    w = np.exp(lp - lp.max()).sum(axis=0)  # marginal over δ (rows), on the ln K_t grid
+    cdf = np.cumsum(w) / w.sum()
+    exact = np.interp([0.05, 0.5, 0.95], cdf, zg)
+    post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(mu, sd))
+    got = np.quantile(post.z[:, pr.sigma.size - 2], [0.05, 0.5, 0.95])
+    np.testing.assert_allclose(got, exact, atol=0.08)
+    none = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(0, 0))
+    j = int(np.argmin(np.abs(post.rpm - 20000)))
+    # K_t lower (a higher limit) with δ = 0 than with δ ≈ 0.05: the limit at the cut speed moves down by about e^-μ
+    ratio = post.limit_q_m[1, j] / none.limit_q_m[1, j]
+    assert np.exp(-mu - 0.03) < ratio < np.exp(-mu + 0.03)
+    q = post.parameter_quantiles()["label_offset_ln"]
+    np.testing.assert_allclose(q[0], (mu - 1.645 * sd, mu, mu + 1.645 * sd), atol=1e-3)
 
 
 @pytest.mark.slow
@@ -107,7 +134,7 @@ def test_a_missed_chatter_rate_weakens_stable_labels_only():
     assert np.exp(far_below) == pytest.approx(1 - eps + m * eps, rel=1e-6)
     cut = [TestCut(rpm, 1.3 * a0, True)]
     q = {mr: update(pr, cut, rng=np.random.default_rng(0), n_samples=400, lobe_samples=200, rpm_grid=[rpm],
-                    miss_rate=mr).limit_q_m[:, 0] for mr in (0.0, m)}
+                    miss_rate=mr, label_offset=(0, 0)).limit_q_m[:, 0] for mr in (0.0, m)}
     assert q[0.0][0] > 1.2 * a0 and q[m][0] < q[0.0][0] and q[m][1] < q[0.0][1], q
     with pytest.raises(InputError, match="miss_rate|0, 1"):
         update(pr, cut, rng=np.random.default_rng(0), n_samples=50, miss_rate=1.0)
@@ -168,7 +195,8 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(out), "--samples", "300"]) == 0
     printed = capsys.readouterr().out
     assert "next test cut (info)" in printed
-    # the band away from the cut speeds is not vouched for (measured over-confident there): said on screen and in
+    # the band away from the cut speeds rests on the model alone (calibrated on average, not for every tool): said on
+    # screen and in
     # the report, with the speeds the cuts did test
     assert "note: the band is tested by your cuts at 12000–20000 rpm; away from those speeds" in printed
     assert "tested by your cuts at 12000–20000 rpm" in (out / "report.html").read_text()
@@ -212,6 +240,22 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o4"),
                  "--min-step", "0.1", "--rule", "risk"]) == 2
     assert "min_step" in capsys.readouterr().err and not (tmp_path / "o4").exists()
+    # --label-offset MEAN,SD: the labels' boundary e^δ above the limit. The default (0.035, 0.035) puts the band at
+    # the cut speed below that of 0,0 (labels = the limit), and parameters.csv reports δ's prior and posterior
+    rows = {r.split(",")[0]: r.split(",") for r in (out / "parameters.csv").read_text().splitlines()}
+    assert rows["label_offset_ln"][1] == "ln" and [float(v) for v in rows["label_offset_ln"][2:5]] == \
+        pytest.approx([0.035 - 1.645 * 0.035, 0.035, 0.035 + 1.645 * 0.035], abs=1e-4)
+    o0 = tmp_path / "o0"
+    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(o0), "--samples", "300",
+                 "--label-offset", "0,0"]) == 0
+    lobes0 = np.genfromtxt(o0 / "lobes.csv", delimiter=",", names=True)
+    assert lobes0["p05_mm"][k] > lobes["p05_mm"][k], (lobes0["p05_mm"][k], lobes["p05_mm"][k])
+    for bad in ("0.1", "0.1,x", "0.1,-0.1", "0.9,0.1", "nan,0.1"):
+        capsys.readouterr()
+        assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o5"),
+                     "--label-offset", bad]) == 2, bad
+        err = capsys.readouterr().err
+        assert "--label-offset" in err and "Traceback" not in err and not (tmp_path / "o5").exists(), (bad, err)
 
 
 def test_modal_prior_file_errors_name_the_field(tmp_path):
@@ -303,8 +347,10 @@ def test_stable_cuts_climb_by_the_boundary_width_not_by_the_risk_quantile():
     truth[3 * pr.modes] /= 1.4
     top, conv, runs = {}, {}, {}
     for ms in (0.0, 0.1):
+        # the zero-order shop labels by the limit itself: δ = 0 known (the default prior of δ widens the band
+        # by its own spread, which this test of the next-cut rule is not about)
         r = virtual_campaign(pr, rng=np.random.default_rng(3), theta_true=truth, max_cuts=9, n_samples=300,
-                             lobe_samples=150, min_step=ms)
+                             lobe_samples=150, min_step=ms, label_offset=(0, 0))
         top[ms] = max(c.depth_m for c in r.cuts[:7] if c.stable)
         conv[ms] = np.inf if r.converged_after is None else r.converged_after
         runs[ms] = [(round(1e3 * c.depth_m, 3), c.stable) for c in r.cuts]
@@ -338,7 +384,8 @@ def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
 @pytest.mark.slow
 def test_virtual_campaigns_on_the_example_tool_meet_the_targets():
     """The loop on the example tool (3 lightly damped modes, σ 0.15), its own forward model, seeds 0–4 with the
-    settings of ``benchmarks/bench_shop.py``: median cuts to converge ≤ 6 and median chattering cuts ≤ 1 (issue
+    settings of ``benchmarks/bench_shop.py`` and δ = 0 (the shop's labels are the limit):
+    median cuts to converge ≤ 6 and median chattering cuts ≤ 1 (issue
     25's targets). Measured on these seeds (2026-11-25): cuts 6, 5, 4, not within 8, 4 (median 5: margin one cut);
     chattering cuts 1, 1, 1, 6, 1 (median 1: no margin); 4/5 converged (no margin). Seed 3 is a truth in the prior's
     tail (K_t 3.3 σ above its median). ~2.5 min CPU."""
@@ -347,7 +394,8 @@ def test_virtual_campaigns_on_the_example_tool_meet_the_targets():
     pr = example_tool(0.15)
     cuts, chat = [], []
     for seed in range(5):
-        r = virtual_campaign(pr, rng=np.random.default_rng(seed), max_cuts=8, n_samples=500, lobe_samples=200)
+        r = virtual_campaign(pr, rng=np.random.default_rng(seed), max_cuts=8, n_samples=500, lobe_samples=200,
+                             label_offset=(0, 0))  # the zero-order shop labels by the limit itself: δ = 0 known
         cuts.append(np.inf if r.converged_after is None else r.converged_after)
         made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
         chat.append(sum(not c.stable for c in made))
@@ -410,3 +458,32 @@ def test_sdm_forward_model_follows_cuts_that_follow_the_sdm():
     pri = {fw: update(pr, [], rng=np.random.default_rng(0), n_samples=300, lobe_samples=150, forward=fw, sdm_refs=2,
                       rpm_grid=rpm).limit_q_m[1] / a_sdm for fw in ("zoa", "sdm")}
     assert np.all(np.abs(pri["sdm"] - 1) < 0.1) and np.all(np.abs(pri["zoa"] - 1) > 0.15), pri
+
+
+def test_a_campaign_without_a_stop_makes_the_same_cuts_and_reports_calibration():
+    """``stop=False`` (the benchmark's calibration runs): the same cuts as a campaign that stops, up to its stop,
+    the same ``converged_after``, and per update whether the truth lies under the recommended depth (checked here
+    against the band and the truth's own zero-order limit) and the coverage near and away from the cut speeds."""
+    from toolpoint.shop.update import _limits
+
+    pr = cornelius_2024(0.1)
+    kw = dict(max_cuts=4, n_samples=200, lobe_samples=100, label_offset=(0, 0))
+    a = virtual_campaign(pr, rng=np.random.default_rng(1), **kw)
+    b = virtual_campaign(pr, rng=np.random.default_rng(1), stop=False, **kw)
+    assert a.converged_after == b.converged_after is not None and len(b.cuts) == 4
+    assert b.cuts[:a.converged_after] == a.cuts and b.coverage[:len(a.coverage)] == a.coverage
+    assert a.chatter_cuts == b.chatter_cuts == sum(not c.stable for c in a.cuts)
+    assert len(b.below_recommended) == len(b.coverage_near) == len(b.coverage_away) == 5
+    assert np.isnan(b.coverage_near[0]) and b.coverage_away[0] == b.coverage[0]
+    # the first update, replayed in the campaign's random order (the truth is drawn first): its recommendation
+    # against the truth's zero-order limit at the recommended speed
+    rng = np.random.default_rng(1)
+    rng.standard_normal(pr.sigma.size)
+    post = update(pr, [], rng=rng, n_samples=200, lobe_samples=100, label_offset=(0, 0))
+    truth = _limits(pr, b.theta_true[None, :], pr.freq_grid(), post.rpm)[0]
+    j = int(np.argmin(np.abs(post.rpm - post.recommended["rpm"])))
+    assert b.below_recommended[0] == bool(truth[j] < post.recommended["depth_m"])
+    q = post.limit_q_m
+    assert b.coverage[0] == pytest.approx(np.mean((q[0] <= truth * 1.0000001) & (truth <= q[2] * 1.0000001)))
+    for near, away, cov in zip(b.coverage_near[1:], b.coverage_away[1:], b.coverage[1:]):
+        assert 0 <= near <= 1 and 0 <= away <= 1 and min(near, away) <= cov + 1e-12 <= max(near, away) + 2e-12

@@ -62,7 +62,10 @@ def check_number(value, flag: str, *, minimum: float | None = None, above: float
     Python's ``float`` accepts ``nan`` and ``inf``; they would reach the numerics
     (a NaN noise level writes a campaign of NaNs), so every numeric option is judged here.
     """
-    v = float(value)
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"must be a number, got {value!r}", file="command line", field=flag) from None
     bound = ""
     if minimum is not None:
         bound = f" ≥ {minimum:g}"

@@ -39,6 +39,10 @@ def register(sub) -> None:
                    help="info rule: once two stable cuts at a speed are closer than e^STEP, a cut e^STEP above the "
                    "highest may be proposed even past --risk, so stable cuts do not creep (default 0.1 = 2 × the "
                    "boundary width; 0: never: docs/design/shop.md)")
+    p.add_argument("--label-offset", metavar="MEAN,SD",
+                   help="ln of how far above the stability limit your cuts' chatter is first heard (mean, standard "
+                   "deviation; default 0.035,0.035: the chatter detector measured 0.004 on one tool and 0.070 on "
+                   "another, docs/design/shop.md); 0,0 if your labels are the limit itself")
     p.add_argument("--forward", choices=("zoa", "sdm"), default="zoa",
                    help="forward model: zoa = zero-order limit (default); sdm = zero-order corrected by the "
                    "semi-discretisation at posterior samples (cuts that follow the SDM, low radial immersion; "
@@ -60,6 +64,18 @@ def run(args) -> int:
     if min_step is not None and min_step > 0.5:
         raise InputError(f"must be ≤ 0.5 (a log step: ×1.65), got {args.min_step}", file="command line",
                          field="--min-step")
+    offset = {}
+    if args.label_offset is not None:
+        parts = args.label_offset.split(",")
+        if len(parts) != 2:
+            raise InputError(f"must be MEAN,SD, got {args.label_offset!r}", file="command line",
+                             field="--label-offset")
+        mu = check_number(parts[0], "--label-offset", minimum=-0.2)
+        sd = check_number(parts[1], "--label-offset", minimum=0)
+        if mu > 0.5 or sd > 0.5:
+            raise InputError(f"mean and sd must be ≤ 0.5 (ln), got {args.label_offset!r}", file="command line",
+                             field="--label-offset")
+        offset = {"label_offset": (mu, sd)}
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")
     if args.sigma_freq is not None and not args.library:
@@ -82,7 +98,7 @@ def run(args) -> int:
     cuts = read_test_cuts(args.cuts, teeth=prior.cutting.teeth) if args.cuts else []
     use_agg()
     post = update(prior, cuts, rng=np.random.default_rng(int(seed)), n_samples=int(n), method=args.method,
-                  rule=args.rule, risk=risk, forward=args.forward, min_step=min_step)
+                  rule=args.rule, risk=risk, forward=args.forward, min_step=min_step, **offset)
     write_update(post, out)
     rc, nc = post.recommended, post.next_cut
     print(f"{len(cuts)} test cuts; recommended {rc['rpm']:.0f} rpm at {1e3 * rc['depth_m']:.3f} mm "

@@ -45,6 +45,12 @@ class CampaignResult:
         relative band width at the recommended speed.
     update_cpu_s : tuple of float
         CPU time of each update.
+    below_recommended : tuple of bool
+        After each update: the true limit at the recommended speed lies below the recommended depth (the 5 %
+        limit: a calibrated band has this for 5 % of the truths).
+    coverage_near, coverage_away : tuple of float
+        After each update: the coverage over the speeds within ±3 % of a cut made so far (nan before the first
+        cut) and over the others.
     """
 
     theta_true: np.ndarray
@@ -54,6 +60,9 @@ class CampaignResult:
     coverage: tuple
     width: tuple
     update_cpu_s: tuple
+    below_recommended: tuple = ()
+    coverage_near: tuple = ()
+    coverage_away: tuple = ()
 
 
 def zoa_shop(prior: ModalPrior):
@@ -143,9 +152,13 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
 
 
 def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, max_cuts: int = 10,
-                     coverage: float = 0.9, width: float = 0.2, theta_true=None, true_limit=None,
+                     coverage: float = 0.9, width: float = 0.2, theta_true=None, true_limit=None, stop: bool = True,
                      **update_kw) -> CampaignResult:
     """Run one virtual campaign (see the module docstring); ``update_kw`` go to :func:`update`.
+
+    ``stop=False`` makes all ``max_cuts`` cuts (the same cuts, in the same random order, as a campaign that stops)
+    and reports ``converged_after`` all the same: a campaign that stops when its band holds the truth selects the
+    truths that go on, so the band's calibration after n cuts is read from campaigns that do not stop.
 
     ``true_limit(theta_true, rpm_grid) -> limit_m`` is the truth the coverage is judged against (default: the
     zero-order limit of θ*, the update's own model; a time-domain shop's truth is the SDM's).
@@ -153,7 +166,7 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
     shop = zoa_shop(prior) if shop is None else shop
     if theta_true is None:
         theta_true = prior.theta((rng.standard_normal(prior.sigma.size) * (prior.sigma > 0))[None, :])[0]
-    cuts, cov_h, wid_h, cpu = [], [], [], []
+    cuts, cov_h, wid_h, cpu, below, near_h, away_h = [], [], [], [], [], [], []
     converged = None
     true_lim = None
     for n in range(max_cuts + 1):
@@ -169,13 +182,19 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
         cov_h.append(cov)
         wid_h.append(wid)
         cpu.append(post.cpu_s)
-        if cov >= coverage and wid <= width:
+        below.append(bool(true_lim[j] < post.recommended["depth_m"]))
+        near = (np.any(np.abs(post.rpm[:, None] / np.array([c.rpm for c in cuts])[None, :] - 1) <= 0.03, axis=1)
+                if cuts else np.zeros(post.rpm.size, bool))
+        near_h.append(float(inside[near].mean()) if near.any() else float("nan"))
+        away_h.append(float(inside[~near].mean()) if (~near).any() else float("nan"))
+        if converged is None and cov >= coverage and wid <= width:
             converged = n
-            break
+            if stop:
+                break
         if n == max_cuts:
             break
         nc = post.next_cut
         cuts.append(shop(theta_true, nc["rpm"], nc["depth_m"], rng))
-    chat = sum(not c.stable for c in cuts)
+    chat = sum(not c.stable for c in (cuts if converged is None else cuts[:converged]))
     return CampaignResult(np.asarray(theta_true), tuple(cuts), converged, chat, tuple(cov_h), tuple(wid_h),
-                          tuple(cpu))
+                          tuple(cpu), tuple(below), tuple(near_h), tuple(away_h))
