@@ -132,11 +132,11 @@ def write_update(post: Posterior, out_dir) -> list:
 def away_note(cuts) -> str:
     """One line on how far the band can be trusted: ``cuts`` are the report's rows (``rpm`` keys)."""
     rpm = [c["rpm"] for c in cuts]
-    # measured on 40 campaigns without a stop (seeds 40–59 of two tools, 1–6 cuts; docs/design/shop.md): the band
+    # measured on 80 campaigns without a stop (truths 20–59 of two tools, 1–6 cuts; docs/design/shop.md): the band
     # is calibrated on average away from the cuts, but a tool in the prior's tail falls outside it over a range
     return (f"the band is tested by your cuts at {min(rpm):.0f}–{max(rpm):.0f} rpm; away from those speeds it rests "
-            "on the model alone — in virtual campaigns it held the true limit at 91–96 % of those speeds on average "
-            "(it claims 90 %), yet at under 90 % of all speeds for 10–30 % of the tools (docs/design/shop.md): make "
+            "on the model alone — in virtual campaigns it held the true limit at 87–94 % of those speeds on average "
+            "(it claims 90 %), yet at under 90 % of all speeds for 20–43 % of the tools (docs/design/shop.md): make "
             "a test cut at a speed before trusting the band there")
 
 

@@ -12,7 +12,8 @@ harmonic, the whole loop's detector heard it only 7 % above the SDM limit on one
 0.4 % above it on the Cornelius case (probit fits to 281 and 231 labelled cuts, ``docs/design/shop.md``). The
 cuts cannot tell δ from the limit, so its prior carries to the band. With δ = 0 assumed, EM28-80's recommended
 depth was above the true limit in 30–55 % of 20 truths after 3–6 cuts, where it claims 5 %; with this prior in
-5–15 % (Cornelius: 10–15 % → 0–5 %; campaigns without a stop, ``docs/design/shop.md``).
+5–15 % (Cornelius: 10–15 % → 0–5 %; campaigns without a stop, ``docs/design/shop.md``; on truths 20–39 with
+it 0–5 % and 5–20 %).
 w (default 0.05) the relative width of the fuzzy boundary (a cut 5 % below the limit is stable with
 probability Φ(1) = 0.84: the limit of a real cut is not a sharp line), ε (default 0.002) the probability that
 a label is simply wrong, whatever the distance to the limit. ε sets how tight a bracket of cuts can make the band:
@@ -59,8 +60,8 @@ at the depth a₀₅ (P(stable) = 0.95). **Next test cut**, two rules:
   a step after every stable cut (the rule before 2026-11-26) cost the Cornelius case a second chattering cut
   (median 1 → 2, seeds 0–19) while a campaign tool with one lightly damped mode (EM28-80) needed it (median
   8 → 5 cuts); stepping only after a creep gave 4.5 cuts, 1 chattering and 6 cuts, 1 chattering on those seeds
-  (on seeds 20–39 neither rule met the targets, with δ = 0: the label offset above; with it, seeds 40–59 gave 5
-  cuts, 1 chattering and 6 cuts, 1 chattering, ``docs/design/shop.md``);
+  (on seeds 20–39 neither rule met the targets, with δ = 0; with the label offset above, seeds 40–59 gave 5 cuts,
+  1 chattering and 6 cuts, 1 chattering, seeds 20–39 more than 6 cuts on both: ``docs/design/shop.md``);
 * ``"risk"``: the most productive cut (max n · a) whose P(chatter) ≤ ``risk`` (default 0.1) — the depth
   a_risk(n), the ``risk`` quantile of the limit.
 """
