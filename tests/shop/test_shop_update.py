@@ -74,12 +74,12 @@ def test_smc_posterior_matches_quadrature_with_the_label_offset():
     pr = _kt_only()
     cuts = [TestCut(20000.0, 0.55e-3, True), TestCut(20000.0, 0.62e-3, False, 1290.0), TestCut(9000.0, 0.5e-3, True)]
     mu, sd = 0.05, 0.04
-    zg = np.linspace(-5, 5, 401)
-    zz = np.zeros((zg.size, pr.sigma.size))
-    zz[:, -2] = zg
-    th = pr.theta(zz)
-    lp = np.array([-0.5 * zg ** 2 - 0.5 * d ** 2 + log_likelihood(pr, th, cuts, label_offset=mu + sd * d) for d in zg])
-    w = np.exp(lp - lp.max()).sum(axis=0)  # marginal over δ (rows), on the ln K_t grid
+    zg, dg = np.linspace(-5, 5, 161), np.linspace(-4, 4, 61)
+    zk, zd = (g.ravel() for g in np.meshgrid(zg, dg))  # (ln K_t, δ) coordinates, one likelihood call
+    zz = np.zeros((zk.size, pr.sigma.size))
+    zz[:, -2] = zk
+    lp = -0.5 * (zk ** 2 + zd ** 2) + log_likelihood(pr, pr.theta(zz), cuts, label_offset=mu + sd * zd)
+    w = np.exp(lp - lp.max()).reshape(dg.size, zg.size).sum(axis=0)  # marginal over δ (rows), on the ln K_t grid
     cdf = np.cumsum(w) / w.sum()
     exact = np.interp([0.05, 0.5, 0.95], cdf, zg)
     post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(mu, sd))
