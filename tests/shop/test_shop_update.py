@@ -50,6 +50,56 @@ def _kt_only(sig=0.2):
                    sigma_kt=sig, sigma_kr=0.0)
 
 
+def test_growth_rate_matches_the_semi_discretisation():
+    """κ = Re ∂s/∂ln a of the zero-order characteristic equation against a second method: the SDM's spectral radius
+    ρ per tooth period T just past the SDM limit, ln ρ / (T ln(a / a_lim)) at a = 1.05 a_lim. Where both methods
+    put the limit on the same lobe (Cornelius case, 12000 and 15000 rpm: ZOA/SDM limits within 2 %, κ 352 and 506
+    /s against the SDM's 359 and 377 /s) they agree within 35 %; a lightly damped mode grows ~ζω_n."""
+    from toolpoint.shop.model import growth_rate, sdm_limits
+    from toolpoint.stability import sdm_spectral_radius
+
+    pr = cornelius_2024(0.1)
+    th = pr.theta(np.zeros((1, pr.sigma.size)))
+    rpm = np.array([12000.0, 15000.0])
+    _, fc = limit_at_speeds(pr, th, rpm)
+    kap = growth_rate(pr, th, rpm, fc)[0]
+    mm, cut = pr.tool(th[0])
+    a_sdm = sdm_limits(pr, th[0], rpm)[0]
+    rho = sdm_spectral_radius(mm, mm, cut, rpm=rpm, depth=1.05 * a_sdm)
+    ref = np.log(rho) / (60.0 / (rpm * cut.teeth) * np.log(1.05))
+    assert np.all(np.abs(kap / ref - 1) < 0.35), (kap, ref)
+    # one lightly damped mode (ζ = 0.5 %, 750 Hz), chatter between the harmonics: κ ≈ ζ ω_n within a factor 2
+    one = ModalPrior((750.0,), (2e7,), (0.005,), (0.0,), (0.0,), (0.0,), pr.cutting, 0.0, 0.0)
+    t1 = one.theta(np.zeros((1, 5)))
+    r1 = np.array([14000.0])
+    _, f1 = limit_at_speeds(one, t1, r1)
+    k1 = growth_rate(one, t1, r1, f1)[0, 0]
+    assert 0.5 < k1 / (0.005 * 2 * np.pi * 750) < 2, k1
+
+
+def test_the_label_growth_moves_the_boundary_by_g_over_kappa_t():
+    """log_likelihood's growth term: a stable label at a = a_lim e^x has P = ε + (1 − 2ε) Φ((G / (κ t) − x) / w),
+    t the cut's ``duration_s`` or ``cut_duration_s``; the term is capped at 0.5 (a cut too short to hear chatter)."""
+    from scipy.stats import norm
+
+    from toolpoint.shop.model import growth_rate
+
+    pr = cornelius_2024(0.1)
+    th = pr.theta(np.zeros((1, pr.sigma.size)))
+    rpm = 12000.0
+    a, fc = limit_at_speeds(pr, th, [rpm])
+    kap = growth_rate(pr, th, [rpm], fc)[0, 0]
+    eps, w, x, g = 0.002, 0.05, 0.03, 3.0
+    for dur, kw in ((0.5, {}), (None, {"cut_duration_s": 0.2}), (1e-3, {})):
+        t = kw.get("cut_duration_s", dur)
+        cut = [TestCut(rpm, float(a[0, 0] * np.exp(x)), True, duration_s=dur)]
+        got = np.exp(log_likelihood(pr, th, cut, label_noise=eps, label_growth=g, **kw)[0])
+        shift = min(g / (kap * t), 0.5)
+        assert got == pytest.approx(eps + (1 - 2 * eps) * norm.cdf((shift - x) / w), rel=1e-6), (dur, kw)
+    assert np.exp(log_likelihood(pr, th, cut, label_noise=eps)[0]) == \
+        pytest.approx(eps + (1 - 2 * eps) * norm.cdf(-x / w), rel=1e-6)  # G = 0: no shift
+
+
 def test_smc_posterior_matches_quadrature_on_one_parameter():
     """Only K_t uncertain: the exact posterior on a fine grid of ln K_t vs the SMC samples' quantiles."""
     pr = _kt_only()
@@ -61,7 +111,8 @@ def test_smc_posterior_matches_quadrature_on_one_parameter():
     w = np.exp(lp - lp.max())
     cdf = np.cumsum(w) / w.sum()
     exact = np.interp([0.05, 0.5, 0.95], cdf, zg)
-    post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(0, 0))
+    post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(0, 0),
+                  label_growth=(0, 0))
     got = np.quantile(post.z[:, pr.sigma.size - 2], [0.05, 0.5, 0.95])
     np.testing.assert_allclose(got, exact, atol=0.08)
     assert exact[2] - exact[0] < 0.6 * 2 * 1.645  # the cuts did narrow it
@@ -82,10 +133,12 @@ def test_smc_posterior_matches_quadrature_with_the_label_offset():
     w = np.exp(lp - lp.max()).reshape(dg.size, zg.size).sum(axis=0)  # marginal over δ (rows), on the ln K_t grid
     cdf = np.cumsum(w) / w.sum()
     exact = np.interp([0.05, 0.5, 0.95], cdf, zg)
-    post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(mu, sd))
+    post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(mu, sd),
+                  label_growth=(0, 0))
     got = np.quantile(post.z[:, pr.sigma.size - 2], [0.05, 0.5, 0.95])
     np.testing.assert_allclose(got, exact, atol=0.08)
-    none = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(0, 0))
+    none = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(0, 0),
+                  label_growth=(0, 0))
     j = int(np.argmin(np.abs(post.rpm - 20000)))
     # K_t lower (a higher limit) with δ = 0 than with δ ≈ 0.05: the limit at the cut speed moves down by about e^-μ
     ratio = post.limit_q_m[1, j] / none.limit_q_m[1, j]
@@ -134,7 +187,7 @@ def test_a_missed_chatter_rate_weakens_stable_labels_only():
     assert np.exp(far_below) == pytest.approx(1 - eps + m * eps, rel=1e-6)
     cut = [TestCut(rpm, 1.3 * a0, True)]
     q = {mr: update(pr, cut, rng=np.random.default_rng(0), n_samples=400, lobe_samples=200, rpm_grid=[rpm],
-                    miss_rate=mr, label_offset=(0, 0)).limit_q_m[:, 0] for mr in (0.0, m)}
+                    miss_rate=mr, label_offset=(0, 0), label_growth=(0, 0)).limit_q_m[:, 0] for mr in (0.0, m)}
     assert q[0.0][0] > 1.2 * a0 and q[m][0] < q[0.0][0] and q[m][1] < q[0.0][1], q
     with pytest.raises(InputError, match="miss_rate|0, 1"):
         update(pr, cut, rng=np.random.default_rng(0), n_samples=50, miss_rate=1.0)
@@ -256,6 +309,17 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
                      "--label-offset", bad]) == 2, bad
         err = capsys.readouterr().err
         assert "--label-offset" in err and "Traceback" not in err and not (tmp_path / "o5").exists(), (bad, err)
+    # --label-growth MEDIAN,SD (G: chatter is heard once grown by e^G within the cut) and --cut-duration: G's prior
+    # quantiles in parameters.csv; bad values exit 2 naming the option, nothing written
+    assert [float(v) for v in rows["label_growth_ln"][2:5]] == \
+        pytest.approx([2.5 * np.exp(-1.645 * 0.5), 2.5, 2.5 * np.exp(1.645 * 0.5)], rel=1e-3)
+    for flag, bad in (("--label-growth", "2"), ("--label-growth", "-1,0.5"), ("--label-growth", "2,x"),
+                      ("--label-growth", "30,0.5"), ("--cut-duration", "0"), ("--cut-duration", "inf")):
+        capsys.readouterr()
+        assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o6"),
+                     f"{flag}={bad}"]) == 2, bad
+        err = capsys.readouterr().err
+        assert flag in err and "Traceback" not in err and not (tmp_path / "o6").exists(), (bad, err)
 
 
 def test_modal_prior_file_errors_name_the_field(tmp_path):
@@ -350,7 +414,7 @@ def test_stable_cuts_climb_by_the_boundary_width_not_by_the_risk_quantile():
         # the zero-order shop labels by the limit itself: δ = 0 known (the default prior of δ widens the band
         # by its own spread, which this test of the next-cut rule is not about)
         r = virtual_campaign(pr, rng=np.random.default_rng(3), theta_true=truth, max_cuts=9, n_samples=300,
-                             lobe_samples=150, min_step=ms, label_offset=(0, 0))
+                             lobe_samples=150, min_step=ms, label_offset=(0, 0), label_growth=(0, 0))
         top[ms] = max(c.depth_m for c in r.cuts[:7] if c.stable)
         conv[ms] = np.inf if r.converged_after is None else r.converged_after
         runs[ms] = [(round(1e3 * c.depth_m, 3), c.stable) for c in r.cuts]
@@ -373,9 +437,11 @@ def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
     x, rate, *_ = shop_record(rpm=12000, teeth=4, chatter_hz=1310.0, chatter_amp=0.5, seed=8)
     sf.write(tmp_path / "c1.wav", x, int(rate), subtype="PCM_16")
     p = tmp_path / "cuts.csv"
-    p.write_text("rpm,depth_mm,result,record\n12000,0.8,,c1.wav\n9000,0.3,stable,\n")
+    p.write_text("rpm,depth_mm,result,record,duration_s\n12000,0.8,,c1.wav,\n9000,0.3,stable,,3.5\n")
     cuts = read_test_cuts(p, teeth=4)
     assert not cuts[0].stable and abs(cuts[0].chatter_hz / 1310 - 1) < 0.01 and cuts[1].stable
+    # how long the tool cut: from the record (its run of entry, cut and exit: 2 s) or the table's duration_s
+    assert cuts[0].duration_s == pytest.approx(2.0, abs=0.15) and cuts[1].duration_s == 3.5
     p.write_text("rpm,depth_mm,result,record\n12000,0.8,stable,c1.wav\n")
     with pytest.raises(InputError, match="line 2: the table says stable, its record c1.wav says chatter"):
         read_test_cuts(p, teeth=4)
@@ -395,7 +461,8 @@ def test_virtual_campaigns_on_the_example_tool_meet_the_targets():
     cuts, chat = [], []
     for seed in range(5):
         r = virtual_campaign(pr, rng=np.random.default_rng(seed), max_cuts=8, n_samples=500, lobe_samples=200,
-                             label_offset=(0, 0))  # the zero-order shop labels by the limit itself: δ = 0 known
+                             label_offset=(0, 0), label_growth=(0, 0))  # the zero-order shop labels by the limit
+        # itself: δ = 0 and G = 0 known
         cuts.append(np.inf if r.converged_after is None else r.converged_after)
         made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
         chat.append(sum(not c.stable for c in made))
@@ -467,7 +534,7 @@ def test_a_campaign_without_a_stop_makes_the_same_cuts_and_reports_calibration()
     from toolpoint.shop.update import _limits
 
     pr = cornelius_2024(0.1)
-    kw = dict(max_cuts=4, n_samples=200, lobe_samples=100, label_offset=(0, 0))
+    kw = dict(max_cuts=4, n_samples=200, lobe_samples=100, label_offset=(0, 0), label_growth=(0, 0))
     a = virtual_campaign(pr, rng=np.random.default_rng(1), **kw)
     b = virtual_campaign(pr, rng=np.random.default_rng(1), stop=False, **kw)
     assert a.converged_after == b.converged_after is not None and len(b.cuts) == 4
@@ -479,7 +546,7 @@ def test_a_campaign_without_a_stop_makes_the_same_cuts_and_reports_calibration()
     # against the truth's zero-order limit at the recommended speed
     rng = np.random.default_rng(1)
     rng.standard_normal(pr.sigma.size)
-    post = update(pr, [], rng=rng, n_samples=200, lobe_samples=100, label_offset=(0, 0))
+    post = update(pr, [], rng=rng, n_samples=200, lobe_samples=100, label_offset=(0, 0), label_growth=(0, 0))
     truth = _limits(pr, b.theta_true[None, :], pr.freq_grid(), post.rpm)[0]
     j = int(np.argmin(np.abs(post.rpm - post.recommended["rpm"])))
     assert b.below_recommended[0] == bool(truth[j] < post.recommended["depth_m"])

@@ -43,6 +43,13 @@ def register(sub) -> None:
                    help="ln of how far above the stability limit your cuts' chatter is first heard (mean, standard "
                    "deviation; default 0.035,0.035: the chatter detector measured 0.004 on one tool and 0.070 on "
                    "another, docs/design/shop.md); 0,0 if your labels are the limit itself")
+    p.add_argument("--label-growth", metavar="MEDIAN,SD",
+                   help="ln of how much chatter must grow within a cut to be heard (median, log standard deviation; "
+                   "default 2.5,0.5: fitted to the chatter detector's labels, docs/design/shop.md); just past the "
+                   "limit chatter grows slowly on a lightly damped mode, so a short cut there sounds stable; 0,0: off")
+    p.add_argument("--cut-duration",
+                   help="how long each test cut lasted, s, where the table has no duration_s and no record "
+                   "(default 1; shorter is the safer guess)")
     p.add_argument("--forward", choices=("zoa", "sdm"), default="zoa",
                    help="forward model: zoa = zero-order limit (default); sdm = zero-order corrected by the "
                    "semi-discretisation at posterior samples (cuts that follow the SDM, low radial immersion; "
@@ -76,6 +83,22 @@ def run(args) -> int:
             raise InputError(f"mean and sd must be ≤ 0.5 (ln), got {args.label_offset!r}", file="command line",
                              field="--label-offset")
         offset = {"label_offset": (mu, sd)}
+    if args.label_growth is not None:
+        parts = args.label_growth.split(",")
+        if len(parts) != 2:
+            raise InputError(f"must be MEDIAN,SD, got {args.label_growth!r}", file="command line",
+                             field="--label-growth")
+        g = check_number(parts[0], "--label-growth", minimum=0)
+        gs = check_number(parts[1], "--label-growth", minimum=0)
+        if g > 20 or gs > 1.5:
+            raise InputError(f"median must be ≤ 20 and sd ≤ 1.5 (ln), got {args.label_growth!r}",
+                             file="command line", field="--label-growth")
+        offset["label_growth"] = (g, gs)
+    if args.cut_duration is not None:
+        t = check_number(args.cut_duration, "--cut-duration", above=0)
+        if t > 600:
+            raise InputError(f"must be ≤ 600 s, got {args.cut_duration}", file="command line", field="--cut-duration")
+        offset["cut_duration_s"] = t
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")
     if args.sigma_freq is not None and not args.library:

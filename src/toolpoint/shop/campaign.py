@@ -147,7 +147,8 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
                                seed=int(rng.integers(1 << 30)), seed_level=seed_level)
         x, fs = make(res, float(rpm), cut.teeth, rng)
         r = analyse_cut(x, fs, rpm=float(rpm), teeth=cut.teeth, full_scale=1.0, **opts)
-        return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz)
+        return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz,
+                       duration_s=revolutions * 60.0 / float(rpm))
     return shop
 
 

@@ -76,7 +76,7 @@ def _doc(post: Posterior) -> dict:
                         "limit_p95_mm": round(1e3 * rc["limit_p95_m"], 4)},
         "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},
         "cuts": [{"rpm": c.rpm, "depth_mm": round(1e3 * c.depth_m, 6), "result": "stable" if c.stable else "chatter",
-                  "chatter_hz": c.chatter_hz} for c in post.cuts],
+                  "chatter_hz": c.chatter_hz, "duration_s": c.duration_s} for c in post.cuts],
         "sampler": {"method": post.method, "samples": int(post.z.shape[0]), "ess": [round(e, 1) for e in post.ess],
                     "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
                     "cpu_s": round(post.cpu_s, 2)},

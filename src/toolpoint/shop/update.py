@@ -14,6 +14,14 @@ cuts cannot tell δ from the limit, so its prior carries to the band. With δ = 
 depth was above the true limit in 30–55 % of 20 truths after 3–6 cuts, where it claims 5 %; with this prior in
 5–15 % (Cornelius: 10–15 % → 0–5 %; campaigns without a stop, ``docs/design/shop.md``; on truths 20–39 with
 it 0–5 % and 5–20 %).
+Chatter must also have *grown* to be heard, and just past the limit it grows slowly: e^{κ ln(a/a_lim) t} over a cut
+of t seconds, κ = Re ∂s/∂ln a the growth rate of the sample's limiting lobe
+(:func:`~toolpoint.shop.model.growth_rate`, ≈ ζω_n of the chattering mode). So each cut's boundary moves up by a
+further min(G / (κ t), 0.5), G the ln of the growth the shop needs to hear chatter — a second parameter of the
+posterior (column P + 1), with prior ln G ~ N(ln 2.5, 0.5²); it took EM12-60's recommended depth from above the true
+limit for 24 % of 20 truths (1–6 cuts, mean) to 8 %, at the price of a wider band (``docs/design/shop.md``). On a
+campaign tool whose chatter at the productive speeds is a 750 Hz mode with ζ ≈ 0.4 % (EM12-60: κ ≈ 25–40 /s) this is
+7–12 % for a 0.9 s cut; on a well-damped mode (κ ≈ 500 /s) 0.5 %.
 w (default 0.05) the relative width of the fuzzy boundary (a cut 5 % below the limit is stable with
 probability Φ(1) = 0.84: the limit of a real cut is not a sharp line), ε (default 0.002) the probability that
 a label is simply wrong, whatever the distance to the limit. ε sets how tight a bracket of cuts can make the band:
@@ -78,14 +86,15 @@ from scipy.special import log_ndtr
 
 from ..errors import InputError
 from ..stability.zoa_batch import zoa_limits
-from .model import ModalPrior, limit_at_speeds, receptance, sdm_limits
+from .model import ModalPrior, growth_rate, limit_at_speeds, receptance, sdm_limits
 
 __all__ = ["TestCut", "Posterior", "read_test_cuts", "check_consistent", "log_likelihood", "update"]
 
 
 @dataclass(frozen=True)
 class TestCut:
-    """One test cut: speed (rpm), depth (m), stable or not, measured chatter frequency (Hz) if any."""
+    """One test cut: speed (rpm), depth (m), stable or not, measured chatter frequency (Hz) if any, and how long
+    the tool cut (s; None: not known, :func:`update`'s ``cut_duration_s``)."""
 
     __test__ = False  # a shop's test cut, not a pytest test class
 
@@ -95,14 +104,17 @@ class TestCut:
     chatter_hz: float | None = None
     line: int | None = None
     source: str | None = None
+    duration_s: float | None = None
 
 
 def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
-    """Read a test-cut table: CSV ``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz`` and ``record``.
+    """Read a test-cut table: CSV ``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz``,
+    ``duration_s`` (how long the tool cut, s) and ``record``.
 
     A ``record`` (path relative to the table) is analysed by :func:`toolpoint.shop.analyse_cut` (needs
-    ``teeth``): it gives ``result`` and ``chatter_hz`` where the table leaves them empty; where both are given
-    and disagree the table is refused (a contradiction is reported, not averaged).
+    ``teeth``): it gives ``result`` and ``chatter_hz`` where the table leaves them empty, and ``duration_s``
+    (its longest run of entry, cut and exit); where both are given and disagree the table is refused (a
+    contradiction is reported, not averaged).
 
     Raises
     ------
@@ -139,6 +151,9 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
         if depth > 1000:
             raise InputError(f"line {line}: {depth:g} mm is not a depth of cut", file=p, field="depth_mm")
         fc = num("chatter_hz", required=False)
+        dur = num("duration_s", required=False)
+        if dur is not None and dur > 3600:
+            raise InputError(f"line {line}: {dur:g} s is not a test cut's duration", file=p, field="duration_s")
         res = (row.get("result") or "").strip().lower()
         if res and res not in ("stable", "chatter"):
             raise InputError(f"line {line}: must be 'stable' or 'chatter', got {res!r}", file=p, field="result")
@@ -159,15 +174,26 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             res = a.verdict
             if fc is None and a.chatter_hz is not None:
                 fc = a.chatter_hz
+            if dur is None:
+                dur = _cutting_s(a.segments)
         if not res:
             raise InputError(f"line {line}: empty (and no record)", file=p, field="result")
         if res == "stable" and fc is not None:
             raise InputError(f"line {line}: a stable cut has no chatter frequency", file=p, field="chatter_hz")
-        cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p)))
+        cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p), dur))
     if not cuts:
         raise InputError("no test cuts", file=p, field="rpm")
     check_consistent(cuts, source=str(p))
     return cuts
+
+
+def _cutting_s(segments) -> float | None:
+    """The longest run of non-air segments of a record (entry, cut, exit: chatter grows within one run), s."""
+    best = run = 0.0
+    for g in segments:
+        run = 0.0 if g.kind == "air" else run + (g.end_s - g.start_s)
+        best = max(best, run)
+    return best if best > 0 else None
 
 
 def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, source: str | None = None) -> None:
@@ -192,22 +218,30 @@ def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, s
 
 def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.05, label_noise: float = 0.002,
                    freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None,
-                   miss_rate: float = 0.0, label_offset=0.0) -> np.ndarray:
+                   miss_rate: float = 0.0, label_offset=0.0, label_growth=0.0,
+                   cut_duration_s: float = 1.0) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
     ``log_ratio`` (per cut, optional): ln of a factor on the zero-order limit at the cut's speed (the SDM
     correction of :func:`update`'s ``forward="sdm"``); ``boundary_width`` may be one value per cut.
     ``miss_rate``: probability that a chattering cut is labelled stable (a detector's missed chatter), on top
     of ε: P(label stable) = p_s + m p_c, P(label chatter) = (1 − m) p_c. ``label_offset`` δ (scalar or one per
-    sample, (S,)): the labels' boundary is a_lim e^δ — chatter is heard only δ (ln) above the limit."""
+    sample, (S,)): the labels' boundary is a_lim e^δ — chatter is heard only δ (ln) above the limit.
+    ``label_growth`` G (scalar or (S,)): the boundary moves up by a further min(G / (κ t), 0.5) per cut, κ the
+    sample's chatter growth rate at the cut (:func:`~toolpoint.shop.model.growth_rate`), t the cut's
+    ``duration_s`` (else ``cut_duration_s``): chatter is heard once it has grown by e^G."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
     a_lim, f_c = limit_at_speeds(prior, theta, rpm, freq_hz)
     lr = np.zeros(len(cuts)) if log_ratio is None else np.asarray(log_ratio, float)
+    offset = np.reshape(np.asarray(label_offset, float), (-1, 1))
+    g = np.reshape(np.asarray(label_growth, float), (-1, 1))
+    if np.any(g > 0):
+        dur = np.array([cut_duration_s if c.duration_s is None else c.duration_s for c in cuts], float)
+        offset = offset + growth_offset(prior, theta, rpm, f_c, g, dur)
     with np.errstate(divide="ignore"):
-        x = (np.log(a_lim) + lr[None, :] + np.reshape(np.asarray(label_offset, float), (-1, 1))
-             - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
+        x = (np.log(a_lim) + lr[None, :] + offset - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
     x = np.where(np.isfinite(x), x, 50.0)  # no lobe reaches the speed: stable at any depth in the grid
     eps = label_noise
     ls = np.logaddexp(np.log(eps), np.log1p(-2 * eps) + log_ndtr(x))  # ln P(stable)
@@ -231,6 +265,20 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     return ll
 
 
+_GROWTH_CAP = 0.5  # ln: a chatter that cannot grow audibly within the cut leaves the label uninformative, not wild
+
+
+def growth_offset(prior: ModalPrior, theta, rpm, chatter_hz, growth, duration_s) -> np.ndarray:
+    """min(G / (κ t), 0.5): how far (ln) above the limit a chatter that must grow by e^G within t seconds is heard,
+    κ the growth rate (:func:`~toolpoint.shop.model.growth_rate`) of each sample (S, R); 0.5 where κ ≤ 0, 0 where
+    no lobe reaches the speed (the sample is stable there anyway)."""
+    kap = growth_rate(prior, theta, rpm, chatter_hz)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.reshape(growth, (-1, 1)) / (kap * np.reshape(duration_s, (1, -1)))
+    d = np.where(kap > 0, np.minimum(d, _GROWTH_CAP), _GROWTH_CAP)
+    return np.where(np.isfinite(np.asarray(chatter_hz, float)), d, 0.0)
+
+
 @dataclass(frozen=True)
 class Posterior:
     """Result of :func:`update` (SI inside: depths m, frequencies Hz, K_t N/m²).
@@ -241,9 +289,10 @@ class Posterior:
     cuts : tuple of TestCut
     method : str
         ``"smc"`` or ``"sir"``.
-    z : ndarray, shape (S, P + 1)
+    z : ndarray, shape (S, P + 2)
         Equally weighted posterior samples in the prior's standard-normal coordinates; column P: the label
-        offset's (δ = μ + s z, ``update``'s ``label_offset``).
+        offset's (δ = μ + s z, ``update``'s ``label_offset``), column P + 1: the label growth's
+        (G = G̃ e^{s_G z}, ``label_growth``).
     ess : tuple of float
         Effective sample sizes at each tempering step (SIR: the one).
     acceptance : float
@@ -263,6 +312,8 @@ class Posterior:
         CPU time of the update.
     label_offset : (float, float)
         Prior mean and standard deviation of the label offset δ (ln; :func:`update`).
+    label_growth : (float, float)
+        Prior median and log standard deviation of the label growth G (ln of the amplitude; :func:`update`).
     """
 
     prior: ModalPrior
@@ -280,6 +331,7 @@ class Posterior:
     next_cut: dict
     cpu_s: float
     label_offset: tuple = (0.0, 0.0)
+    label_growth: tuple = (0.0, 0.0)
 
     @property
     def theta(self) -> np.ndarray:
@@ -295,6 +347,10 @@ class Posterior:
         mu, sd = self.label_offset
         off = mu + sd * self.z[:, self.prior.sigma.size]
         out["label_offset_ln"] = (tuple(mu + zq * sd), tuple(np.quantile(off, [0.05, 0.5, 0.95])))
+        gm, gs = self.label_growth
+        if gm > 0:
+            g = gm * np.exp(gs * self.z[:, self.prior.sigma.size + 1])
+            out["label_growth_ln"] = (tuple(gm * np.exp(zq * gs)), tuple(np.quantile(g, [0.05, 0.5, 0.95])))
         return out
 
 
@@ -314,7 +370,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            freq_sigma: float = 0.02, rule: str = "info", risk: float | None = None, lobe_samples: int = 400,
            n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "zoa", sdm_refs: int = 4,
            min_step: float | None = None, sdm_train: int = 0, miss_rate: float = 0.0,
-           label_offset: tuple = (0.035, 0.035)) -> Posterior:
+           label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
+           cut_duration_s: float = 1.0) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -376,6 +433,19 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         EM28-80, whose pocket speed hides chatter up to 6 % above the limit; with δ = 0 EM28-80's recommended
         depth was above the true limit in 30–55 % of 20 truths after 3–6 cuts, where it claims 5 % (5–15 % with
         this default). (0, 0): the labels are the limit (a detector checked on this machine and tool).
+    label_growth : (float, float), default (2.5, 0.5)
+        Median G̃ and log standard deviation s_G of G, the ln of how much chatter must grow within a cut to be
+        heard: each cut's labels' boundary moves up by a further min(G / (κ t), 0.5), κ the sample's chatter
+        growth rate at the cut (:func:`~toolpoint.shop.model.growth_rate`, ≈ ζω_n of the chattering mode) and t
+        the cut's duration (a parameter of the posterior, column ``P + 1`` of ``z``). Just past the limit chatter
+        grows slowly, e^{κ ln(a/a_lim) t}: on a lightly damped mode (κ ≈ 30 /s) a 1 s cut 10 % past the limit
+        barely chatters, on a well-damped one (κ ≈ 500 /s) 1 % past it does. G̃ = 2.5 was fitted to the whole
+        loop's labels on the campaign tool EM12-60 (60 cuts, truths 40–49: its cuts at the 750 Hz mode, κ ≈ 25–40
+        /s, were heard as chatter only 7–12 % above the SDM limit, those at its 2000 Hz mode, κ ≈ 900 /s, at
+        1–3 %; ``docs/design/shop.md``). (0, 0): off.
+    cut_duration_s : float, default 1.0
+        Duration (s) of the cuts whose :class:`TestCut` does not state it, and of the next cut. Shorter is the
+        safer guess (chatter had less time to grow, so a stable label says less).
     min_step : float, optional
         ``"info"`` rule: once the two highest stable cuts at a speed are closer than e^min_step (the risk bound
         crept), a cut e^min_step above the highest is a candidate even where it exceeds ``risk`` (default 0.1 =
@@ -422,17 +492,28 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     if not (-0.2 <= off_mu <= 0.5 and 0 <= off_sd <= 0.5):
         raise InputError(f"mean must be in [-0.2, 0.5] and sd in [0, 0.5] (ln), got {label_offset!r}",
                          field="label_offset")
+    try:
+        g_med, g_sd = (float(v) for v in label_growth)
+    except (TypeError, ValueError):
+        raise InputError(f"must be (median, sd), got {label_growth!r}", field="label_growth") from None
+    if not (0 <= g_med <= 20 and 0 <= g_sd <= 1.5):
+        raise InputError(f"median must be in [0, 20] and sd in [0, 1.5] (ln), got {label_growth!r}",
+                         field="label_growth")
+    if not (math.isfinite(cut_duration_s) and 0 < cut_duration_s <= 600):
+        raise InputError(f"must be in (0, 600] s, got {cut_duration_s}", field="cut_duration_s")
     if min_step > 0 and rule != "info":
         raise InputError("the step above stable cuts belongs to the info rule; the risk rule has none",
                          field="min_step")
     cuts = tuple(cuts)
     f = prior.freq_grid()
     P = prior.sigma.size
-    # z: the prior's standard-normal coordinates and, in column P, the label offset's (δ = μ + s z)
-    free = np.r_[prior.sigma > 0, off_sd > 0]
+    # z: the prior's standard-normal coordinates; column P the label offset's (δ = μ + s z), P + 1 the label
+    # growth's (G = G̃ e^{s_G z})
+    free = np.r_[prior.sigma > 0, off_sd > 0, g_med > 0 and g_sd > 0]
     kw = dict(boundary_width=boundary_width, label_noise=label_noise, freq_sigma=freq_sigma, freq_hz=f,
-              miss_rate=miss_rate, label_offset=(off_mu, off_sd))
-    z = rng.standard_normal((n_samples, P + 1)) * free
+              miss_rate=miss_rate, label_offset=(off_mu, off_sd), label_growth=(g_med, g_sd),
+              cut_duration_s=cut_duration_s)
+    z = rng.standard_normal((n_samples, P + 2)) * free
     ess_hist, acc = [], []
     log_ratio_grid = None
     grid = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)  # speeds of the lobes
@@ -447,7 +528,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
             spread = lr_c.std(axis=0) if sdm_refs > 1 else np.zeros(rpm_c.size)
             kw2 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + spread ** 2),
                        log_ratio=lr_c.mean(axis=0))
-            z = _sample(prior, rng.standard_normal((n_samples, P + 1)) * free, cuts, kw2, method, n_moves, rng,
+            z = _sample(prior, rng.standard_normal((n_samples, P + 2)) * free, cuts, kw2, method, n_moves, rng,
                         ess_hist, acc)
             log_ratio_grid = lr_g
             if sdm_train > 0:
@@ -465,7 +546,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
                 kw3 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + sd_u[inv] ** 2),
                            log_ratio=mean_u[inv])
-                z = _sample(prior, rng.standard_normal((n_samples, P + 1)) * free, cuts, kw3, method, n_moves,
+                z = _sample(prior, rng.standard_normal((n_samples, P + 2)) * free, cuts, kw3, method, n_moves,
                             rng, ess_hist, acc)
                 log_ratio_grid = lr_g + _carry(mean_u[None, :] - lr_ref_u, grid, u)
     elif forward == "sdm":  # no cuts yet: the prior's lobes (and the first cut's risk) corrected the same way
@@ -497,21 +578,33 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                "p_chatter": float(np.mean(lim[:, k] <= qr[k])),
                "description": f"most productive cut (max rpm × depth) with P(chatter) ≤ {risk:g}"}
     else:
+        known = [c.duration_s for c in cuts if c.duration_s is not None]
+        t_next = float(np.median(known)) if known else cut_duration_s  # the next cut lasts as the others did
+        th_pick, off_pick = prior.theta(z[pick, :P]), off_mu + off_sd * z[pick, P]
+        g_pick = g_med * np.exp(g_sd * z[pick, P + 1])
+
+        def offset(ks):  # each lobe sample's label offset at the candidate speeds grid[ks], (m, len(ks))
+            if g_med <= 0:
+                return np.broadcast_to(off_pick[:, None], (m, len(ks)))
+            _, fc = limit_at_speeds(prior, th_pick, grid[ks], f)
+            return off_pick[:, None] + growth_offset(prior, th_pick, grid[ks], fc, g_pick, t_next)
+
         nxt = _next_info(lim, grid, j, risk, boundary_width, label_noise, chatter_cost, cuts, min_step, miss_rate,
-                         off_mu + off_sd * z[pick, P])
+                         offset)
     return Posterior(prior, cuts, method, z, tuple(ess_hist), float(np.mean(acc)) if acc else float("nan"), grid, q,
-                     depths, p_st, qp, rec, nxt, time.process_time() - c0, (off_mu, off_sd))
+                     depths, p_st, qp, rec, nxt, time.process_time() - c0, (off_mu, off_sd), (g_med, g_sd))
 
 
 def _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc):
     """Posterior samples (z) from prior samples ``z`` given the cuts: SIR or tempered SMC (module docstring)."""
     n_samples, P = z.shape[0], prior.sigma.size
-    free = np.r_[prior.sigma > 0, np.ones(z.shape[1] - P, bool)]
     mu, sd = kw["label_offset"]
-    free[P:] &= sd > 0
+    g_med, g_sd = kw["label_growth"]
+    free = np.r_[prior.sigma > 0, sd > 0, g_med > 0 and g_sd > 0]
 
     def loglik(z):
-        return log_likelihood(prior, prior.theta(z[:, :P]), cuts, **dict(kw, label_offset=mu + sd * z[:, P]))
+        return log_likelihood(prior, prior.theta(z[:, :P]), cuts, **dict(
+            kw, label_offset=mu + sd * z[:, P], label_growth=g_med * np.exp(g_sd * z[:, P + 1])))
 
     ll = loglik(z)
     if method == "sir":
@@ -637,23 +730,28 @@ def _wquantile_width(vals_sorted, w):
 
 
 def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), min_step=0.0, miss_rate=0.0,
-               offset=0.0):
+               offset=None):
     """The ``"info"`` rule: min expected relative band width at the recommended speed, P(chatter) ≤ risk —
     or a step of ``min_step`` (log) above the highest stable cut at that speed (±0.5 %), when the two highest
     stable cuts there are closer than that (the risk bound crept) and it stops short of the step (module
-    docstring). ``offset``: each sample's label offset δ (the outcome heard is that of a_lim e^δ; the risk is
-    the cut's own, at a_lim)."""
+    docstring). ``offset(ks) -> (S, len(ks))``: each sample's label offset at the speeds grid[ks] (the outcome
+    heard is that of a_lim e^δ; the risk is the cut's own, at a_lim)."""
     from scipy.special import ndtr
+
+    if offset is None:
+        def offset(ks):
+            return np.zeros((lim.shape[0], len(ks)))
 
     q50 = np.quantile(lim, 0.5, axis=0)
     score = np.where(np.isfinite(q50), grid * q50, -np.inf)
     speeds = np.unique(np.r_[np.argsort(-score)[:6], j_rec])
+    off = offset(speeds)  # (S, len(speeds)): one call for all the candidate speeds
     levels = np.linspace(0.02, risk, 12)
     target = lim[:, j_rec]
     order = np.argsort(target)
     ts = np.where(np.isfinite(target[order]), target[order], 1e9)
     cand = []
-    for k in speeds:  # a few speeds; vectorised over depths and samples
+    for ki, k in enumerate(speeds):  # a few speeds; vectorised over depths and samples
         depths = np.quantile(lim[:, k], levels)
         ok = np.isfinite(depths) & (depths > 0)
         if not ok.any():
@@ -672,7 +770,7 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
             x = (np.log(lim[None, :, k]) - np.log(depths[:, None])) / width  # (C, S)
         ps = eps + (1 - 2 * eps) * ndtr(np.where(np.isfinite(x), x, 50.0))
         p_stable = ps.mean(axis=1)  # the risk is the cut's, not the label's
-        xh = x + np.reshape(offset, (1, -1)) / width
+        xh = x + off[None, :, ki] / width
         ph = eps + (1 - 2 * eps) * ndtr(np.where(np.isfinite(xh), xh, 50.0))
         ph = ph + miss_rate * (1 - ph)  # P(heard stable): the outcomes the posterior will see
         p_heard = ph.mean(axis=1)
