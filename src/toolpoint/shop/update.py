@@ -513,7 +513,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     kw = dict(boundary_width=boundary_width, label_noise=label_noise, freq_sigma=freq_sigma, freq_hz=f,
               miss_rate=miss_rate, label_offset=(off_mu, off_sd), label_growth=(g_med, g_sd),
               cut_duration_s=cut_duration_s)
-    z = rng.standard_normal((n_samples, P + 2)) * free
+    z = _draw_z(rng, n_samples, free)
     ess_hist, acc = [], []
     log_ratio_grid = None
     grid = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)  # speeds of the lobes
@@ -528,7 +528,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
             spread = lr_c.std(axis=0) if sdm_refs > 1 else np.zeros(rpm_c.size)
             kw2 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + spread ** 2),
                        log_ratio=lr_c.mean(axis=0))
-            z = _sample(prior, rng.standard_normal((n_samples, P + 2)) * free, cuts, kw2, method, n_moves, rng,
+            z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw2, method, n_moves, rng,
                         ess_hist, acc)
             log_ratio_grid = lr_g
             if sdm_train > 0:
@@ -546,7 +546,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
                 kw3 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + sd_u[inv] ** 2),
                            log_ratio=mean_u[inv])
-                z = _sample(prior, rng.standard_normal((n_samples, P + 2)) * free, cuts, kw3, method, n_moves,
+                z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw3, method, n_moves,
                             rng, ess_hist, acc)
                 log_ratio_grid = lr_g + _carry(mean_u[None, :] - lr_ref_u, grid, u)
     elif forward == "sdm":  # no cuts yet: the prior's lobes (and the first cut's risk) corrected the same way
@@ -593,6 +593,16 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                          offset)
     return Posterior(prior, cuts, method, z, tuple(ess_hist), float(np.mean(acc)) if acc else float("nan"), grid, q,
                      depths, p_st, qp, rec, nxt, time.process_time() - c0, (off_mu, off_sd), (g_med, g_sd))
+
+
+def _draw_z(rng, n, free):
+    """Prior draws of z (n, P + 2): the model's P columns and δ's, then G's only when G is free — a run with G off
+    draws exactly what it drew before G existed (same seed, same samples)."""
+    z = np.zeros((n, free.size))
+    z[:, :-1] = rng.standard_normal((n, free.size - 1)) * free[:-1]
+    if free[-1]:
+        z[:, -1] = rng.standard_normal(n)
+    return z
 
 
 def _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc):
