@@ -211,7 +211,10 @@ def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):
 
 @pytest.mark.parametrize("text,field", [
     ("rpm,depth_mm,result\n12000,-1,stable\n", "depth_mm"), ("rpm,depth_mm,result\n12000,1,maybe\n", "result"),
-    ("rpm,result\n12000,stable\n", "depth_mm"), ("rpm,depth_mm,result,chatter_hz\n1e9,1,chatter,900\n", "rpm")])
+    ("rpm,result\n12000,stable\n", "depth_mm"), ("rpm,depth_mm,result,chatter_hz\n1e9,1,chatter,900\n", "rpm"),
+    ("rpm,depth_mm,result,duration_s\n12000,1,stable,0\n", "duration_s"),
+    ("rpm,depth_mm,result,duration_s\n12000,1,stable,1e5\n", "duration_s"),
+    ("rpm,depth_mm,result,duration_s\n12000,1,stable,x\n", "duration_s")])
 def test_bad_tables_name_the_field(tmp_path, text, field):
     p = tmp_path / "c.csv"
     p.write_text(text)
