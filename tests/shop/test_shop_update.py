@@ -269,27 +269,6 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     # the stable cut at 20000 rpm, 0.5 mm: the posterior 5 % limit there is near or above it
     k = np.argmin(np.abs(lobes["rpm"] - 20000))
     assert lobes["p05_mm"][k] > 0.45 and lobes["p95_mm"][k] < 0.95
-    # the step above stable cuts (--min-step, default 0.1): at 20678 rpm (a grid speed of this prior) the risk bound
-    # alone proposes ~0.775 mm above a stable cut at 0.74 mm (+5 %). After one stable cut there, or two more than
-    # ×e^0.1 apart, that is the proposal; after two closer than ×e^0.1 (the risk bound crept), the step ×e^0.1
-    # above the highest, past the risk bound (P(chatter) 0.50 measured); --min-step 0 never steps.
-    base = "rpm,depth_mm,result\n20000,0.5,stable\n12000,0.3,stable\n"
-    nxt = {}
-    for name, rows in (("one", "20678,0.74,stable\n"), ("far", "20678,0.62,stable\n20678,0.74,stable\n"),
-                       ("crept", "20678,0.70,stable\n20678,0.74,stable\n")):
-        (tmp_path / f"{name}.csv").write_text(base + rows)
-        for ms in ((), ("--min-step", "0")):
-            capsys.readouterr()
-            o = tmp_path / f"{name}{len(ms)}"
-            assert main(["update", "--prior", str(prior), "--cuts", str(tmp_path / f"{name}.csv"), "--out", str(o),
-                         "--samples", "300", *ms]) == 0
-            nxt[name, bool(ms)] = (json.loads((o / "update.json").read_text())["next_cut"], capsys.readouterr().out)
-    for key, (nc, printed) in nxt.items():
-        if key != ("crept", False):
-            assert nc["p_chatter"] <= 0.3 and not nc["stepped"] and "a step above" not in printed, (key, nc)
-    nc2, printed = nxt["crept", False]
-    assert nc2["stepped"] and nc2["p_chatter"] > 0.3 and "a step above the stable cut there" in printed, nc2
-    assert abs(nc2["rpm"] / 20678 - 1) <= 0.005 and abs(nc2["depth_mm"] / 0.74 - np.exp(0.1)) < 1e-3, nc2
     assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o3"),
                  "--min-step", "-1"]) == 2
     assert "--min-step" in capsys.readouterr().err and not (tmp_path / "o3").exists()
@@ -323,6 +302,35 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
                      f"{flag}={bad}"]) == 2, bad
         err = capsys.readouterr().err
         assert flag in err and "Traceback" not in err and not (tmp_path / "o6").exists(), (bad, err)
+
+
+@pytest.mark.slow
+def test_cli_update_steps_above_stable_cuts_that_crept(tmp_path, capsys):
+    """``toolpoint update`` steps ×e^--min-step above two stable cuts that crept, and only then (six updates of 300
+    samples, ~15 s CPU: the slow tier; the rest of the CLI in ``test_cli_update_writes_files_and_report``)."""
+    prior = tmp_path / "prior.toml"
+    prior.write_text(PRIOR_TOML)
+    # the step above stable cuts (--min-step, default 0.1): at 20678 rpm (a grid speed of this prior) the risk bound
+    # alone proposes ~0.775 mm above a stable cut at 0.74 mm (+5 %). After one stable cut there, or two more than
+    # ×e^0.1 apart, that is the proposal; after two closer than ×e^0.1 (the risk bound crept), the step ×e^0.1
+    # above the highest, past the risk bound (P(chatter) 0.50 measured); --min-step 0 never steps.
+    base = "rpm,depth_mm,result\n20000,0.5,stable\n12000,0.3,stable\n"
+    nxt = {}
+    for name, rows in (("one", "20678,0.74,stable\n"), ("far", "20678,0.62,stable\n20678,0.74,stable\n"),
+                       ("crept", "20678,0.70,stable\n20678,0.74,stable\n")):
+        (tmp_path / f"{name}.csv").write_text(base + rows)
+        for ms in ((), ("--min-step", "0")):
+            capsys.readouterr()
+            o = tmp_path / f"{name}{len(ms)}"
+            assert main(["update", "--prior", str(prior), "--cuts", str(tmp_path / f"{name}.csv"), "--out", str(o),
+                         "--samples", "300", *ms]) == 0
+            nxt[name, bool(ms)] = (json.loads((o / "update.json").read_text())["next_cut"], capsys.readouterr().out)
+    for key, (nc, printed) in nxt.items():
+        if key != ("crept", False):
+            assert nc["p_chatter"] <= 0.3 and not nc["stepped"] and "a step above" not in printed, (key, nc)
+    nc2, printed = nxt["crept", False]
+    assert nc2["stepped"] and nc2["p_chatter"] > 0.3 and "a step above the stable cut there" in printed, nc2
+    assert abs(nc2["rpm"] / 20678 - 1) <= 0.005 and abs(nc2["depth_mm"] / 0.74 - np.exp(0.1)) < 1e-3, nc2
 
 
 def test_modal_prior_file_errors_name_the_field(tmp_path):
