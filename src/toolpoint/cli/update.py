@@ -97,8 +97,9 @@ def run(args) -> int:
         offset["label_growth"] = (g, gs)
     if args.cut_duration is not None:
         t = check_number(args.cut_duration, "--cut-duration", above=0)
-        if t > 600:
-            raise InputError(f"must be ≤ 600 s, got {args.cut_duration}", file="command line", field="--cut-duration")
+        if t > 3600:
+            raise InputError(f"must be ≤ 3600 s (as a table's duration_s), got {args.cut_duration}",
+                             file="command line", field="--cut-duration")
         offset["cut_duration_s"] = t
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")

@@ -286,7 +286,7 @@ def growth_rate(prior: ModalPrior, theta, rpm, chatter_hz) -> np.ndarray:
     tooth-passing harmonics κ ≈ ζ ω_n: a lightly damped mode chatters slowly just past its limit (a campaign
     tool's 750 Hz mode with ζ = 0.4 %: κ ≈ 30 /s, so 10 % past the limit chatter grows by e^3 in 1 s; the
     Cornelius case: κ ≈ 350–650 /s). Checked against the semi-discretisation's spectral radius ρ per tooth
-    period (ln ρ / (T x) at x = ln 1.02 … ln 1.1) in ``tests/test_shop.py``.
+    period (ln ρ / (T x) at x = ln 1.05) in ``tests/shop/test_shop_update.py``.
 
     Parameters
     ----------

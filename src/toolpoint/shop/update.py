@@ -499,8 +499,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     if not (0 <= g_med <= 20 and 0 <= g_sd <= 1.5):
         raise InputError(f"median must be in [0, 20] and sd in [0, 1.5] (ln), got {label_growth!r}",
                          field="label_growth")
-    if not (math.isfinite(cut_duration_s) and 0 < cut_duration_s <= 600):
-        raise InputError(f"must be in (0, 600] s, got {cut_duration_s}", field="cut_duration_s")
+    if not (math.isfinite(cut_duration_s) and 0 < cut_duration_s <= 3600):
+        raise InputError(f"must be in (0, 3600] s, got {cut_duration_s}", field="cut_duration_s")
     if min_step > 0 and rule != "info":
         raise InputError("the step above stable cuts belongs to the info rule; the risk rule has none",
                          field="min_step")
