@@ -129,6 +129,13 @@ def test_real_shop_recording_air_entry_cut_chatter_exit():
             assert min(abs(ratio - 1), abs(ratio / 2 - 1)) < 0.01, s
     long_chat = [s for s in cut if s.verdict == "chatter" and s.end_s - s.start_s > 2]
     assert long_chat and all(abs(s.chatter_hz / fc - 1) < 0.01 for s in long_chat)
+    # how long the tool cut, as a test-cut table's record gives it to `update` (chatter grows within one run): from
+    # the entry's start to the exit's end, inside the two air cuts
+    from toolpoint.shop.update import _cutting_s
+
+    entry, exit_ = res.segments[1], res.segments[-2]
+    assert _cutting_s(res.segments) == pytest.approx(exit_.end_s - entry.start_s)
+    assert res.segments[0].end_s <= entry.start_s and exit_.end_s <= res.segments[-1].start_s
 
 
 def test_cli_cut_writes_json_and_plot(tmp_path, capsys):

@@ -74,27 +74,9 @@ def run(args) -> int:
                          field="--min-step")
     offset = {}
     if args.label_offset is not None:
-        parts = args.label_offset.split(",")
-        if len(parts) != 2:
-            raise InputError(f"must be MEAN,SD, got {args.label_offset!r}", file="command line",
-                             field="--label-offset")
-        mu = check_number(parts[0], "--label-offset", minimum=-0.2)
-        sd = check_number(parts[1], "--label-offset", minimum=0)
-        if mu > 0.5 or sd > 0.5:
-            raise InputError(f"mean and sd must be ≤ 0.5 (ln), got {args.label_offset!r}", file="command line",
-                             field="--label-offset")
-        offset = {"label_offset": (mu, sd)}
+        offset["label_offset"] = _pair(args.label_offset, "--label-offset", "MEAN,SD", (-0.2, 0.5), (0, 0.5))
     if args.label_growth is not None:
-        parts = args.label_growth.split(",")
-        if len(parts) != 2:
-            raise InputError(f"must be MEDIAN,SD, got {args.label_growth!r}", file="command line",
-                             field="--label-growth")
-        g = check_number(parts[0], "--label-growth", minimum=0)
-        gs = check_number(parts[1], "--label-growth", minimum=0)
-        if g > 20 or gs > 1.5:
-            raise InputError(f"median must be ≤ 20 and sd ≤ 1.5 (ln), got {args.label_growth!r}",
-                             file="command line", field="--label-growth")
-        offset["label_growth"] = (g, gs)
+        offset["label_growth"] = _pair(args.label_growth, "--label-growth", "MEDIAN,SD", (0, 20), (0, 1.5))
     if args.cut_duration is not None:
         t = check_number(args.cut_duration, "--cut-duration", above=0)
         if t > 3600:
@@ -133,3 +115,16 @@ def run(args) -> int:
     if cuts:
         print("note: " + away_note([{"rpm": c.rpm} for c in cuts]))
     return 0
+
+
+def _pair(value: str, flag: str, form: str, first: tuple, second: tuple) -> tuple:
+    """``A,B`` of a prior (ln), A in ``first`` and B in ``second`` (closed ranges), else one line naming ``flag``."""
+    parts = value.split(",")
+    if len(parts) != 2:
+        raise InputError(f"must be {form}, got {value!r}", file="command line", field=flag)
+    a = check_number(parts[0], flag, minimum=first[0])
+    b = check_number(parts[1], flag, minimum=second[0])
+    if a > first[1] or b > second[1]:
+        raise InputError(f"{form} must be ≤ {first[1]:g},{second[1]:g} (ln), got {value!r}", file="command line",
+                         field=flag)
+    return a, b
