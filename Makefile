@@ -21,7 +21,7 @@ test: lint browser
 	$(PY) -m pytest -q -n 2 -m "not slow"
 
 test-slow: $(STAMP) browser
-	$(PY) -m pytest -q -n 2 -m slow
+	$(PY) -m pytest -q -n 2 --maxschedchunk 1 -m slow
 
 # The report's browser test needs Chromium (Debian's package); installed here when this user may.
 browser:

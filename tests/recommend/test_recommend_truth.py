@@ -33,6 +33,7 @@ S28-80,28,80,4,ER40,,,al7075,0.25,up,2000,12000
 """
 
 
+@pytest.mark.first
 def test_recommended_points_are_below_the_true_limit_on_a_small_campaign(tmp_path):
     camp, res, out = tmp_path / "camp", tmp_path / "camp" / "results", tmp_path / "lib"
     assert main(["campaign", "synth", str(camp), "--n", "40", "--seed", "11"]) == 0

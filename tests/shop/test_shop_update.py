@@ -148,6 +148,7 @@ def test_smc_posterior_matches_quadrature_with_the_label_offset():
 
 
 @pytest.mark.slow
+@pytest.mark.first
 def test_bands_are_calibrated_out_of_sample():
     """Truths drawn from the prior, three cuts at random speeds and depths labelled by the truth: the posterior
     5–95 % band of the limit holds the true limit at a random speed about 90 % of the time."""
@@ -459,6 +460,7 @@ def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.first
 def test_virtual_campaigns_on_the_example_tool_meet_the_targets():
     """The loop on the example tool (3 lightly damped modes, σ 0.15), its own forward model, seeds 0–4 with the
     settings of ``benchmarks/bench_shop.py`` and δ = 0 (the shop's labels are the limit):
@@ -483,6 +485,7 @@ def test_virtual_campaigns_on_the_example_tool_meet_the_targets():
 
 
 @pytest.mark.slow
+@pytest.mark.first
 def test_the_corrected_samples_own_sdm_limits_move_the_band_to_the_sdm():
     """A wide prior (σ 0.05): the references' SDM/ZOA ratio is that of the zero-order posterior, which moved its
     parameters to explain cuts that follow the SDM. Six truths drawn from the prior, cuts bracketing each one's

@@ -37,6 +37,7 @@ def test_boundary_within_2_percent_of_sdm_one_mode():
 
 
 @pytest.mark.slow
+@pytest.mark.first
 def test_boundary_within_2_percent_of_sdm_two_modes_with_cross_terms():
     # two modes per direction, turned by 30°: the structure has cross receptances (a full state-space model)
     mx, my = (ModalModel([f for f, _, _ in m], [z for _, _, z in m], [k / (2 * np.pi * f) ** 2 for f, k, _ in m])

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import OptimizeResult
 
+from ..blas import single_thread_blas
 from ..dynamics.assembly import Assembly
 from ..dynamics.model import ToolPointModel
 from ..dynamics.subassembly import Subassembly
@@ -272,14 +273,18 @@ def solve(problem, method: str = "hybrid", seed: int | None = 0, *, options: dic
     algo = make_algorithm(method, options)
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
-    opt = algo.minimize(problem, rng, callback=callback)
-    x_log = np.asarray(opt.x, float)
-    ci, se, corr = intervals_and_correlation(problem, x_log)
-    extra: tuple = ()
-    if intervals == "profile":
-        prof = profile_intervals(problem, x_log, se)
-        ci = prof.ci
-        extra = tuple(open_end_warnings(prof, names, units))
+    # One BLAS thread: the SVDs and least-squares steps here are 4–12 columns wide. On the paper's case (2 cores,
+    # GA seeds 0 and 3) two threads took 7.8 s wall / 15.5 s CPU against 5.4 s / 5.5 s with one; with two such
+    # processes side by side (pytest's two workers) GA seed 0 took 151 s against 2.5 s, the threads spinning.
+    with single_thread_blas():
+        opt = algo.minimize(problem, rng, callback=callback)
+        x_log = np.asarray(opt.x, float)
+        ci, se, corr = intervals_and_correlation(problem, x_log)
+        extra: tuple = ()
+        if intervals == "profile":
+            prof = profile_intervals(problem, x_log, se)
+            ci = prof.ci
+            extra = tuple(open_end_warnings(prof, names, units))
     seconds = time.perf_counter() - t0  # includes the uncertainty step
     kw = dict(names=names, units=units, pairs=True) if general else {}
     found = tuple(identifiability_warnings(x_log, ci, problem.bounds, corr=corr, **kw)) + extra
