@@ -100,6 +100,40 @@ def test_the_label_growth_moves_the_boundary_by_g_over_kappa_t():
         pytest.approx(eps + (1 - 2 * eps) * norm.cdf(-x / w), rel=1e-6)  # G = 0: no shift
 
 
+def _one_slow_mode():
+    """One lightly damped mode (750 Hz, ζ 0.5 %, k 2e7 N/m) on the Cornelius cut, nothing uncertain but δ and G."""
+    pr = cornelius_2024(0.1)
+    one = ModalPrior((750.0,), (2e7,), (0.005,), (0.0,), (0.0,), (0.0,), pr.cutting, 0.0, 0.0)
+    return one, one.theta(np.zeros((1, 5)))[0]
+
+
+@pytest.mark.slow
+def test_the_label_growth_against_the_time_domain_a_longer_cut_hears_slow_chatter():
+    """The label-growth model (``update``'s ``label_growth``) against a second method, the time domain: on one lightly
+    damped mode (ζ 0.5 %, 750 Hz, κ ≈ ζω_n ≈ 24 /s) at 17000 rpm, 5 % past the SDM limit, chatter grows as e^{κ x t}.
+    The simulated shop's usual cut (250 revolutions, 0.88 s: growth ≈ e^1) sounds stable; a cut of
+    t = G̃ / (0.05 κ) ≈ 2.1 s (growth e^G̃ = e^2.5) is heard as chatter at the mode. On a well-damped lobe the same
+    0.88 s cut hears chatter 1–3 % past the limit (``docs/design/shop.md``). Seeds 0 and 1 (2026-11-27: 3/3 seeds
+    each way; at 1.1 × the limit the short cut hears it too). ~35 s."""
+    from toolpoint.shop.campaign import simulated_shop
+    from toolpoint.shop.model import growth_rate, sdm_limits
+
+    one, th = _one_slow_mode()
+    rpm = 17000.0
+    _, fc = limit_at_speeds(one, th[None, :], [rpm])
+    kap = growth_rate(one, th[None, :], [rpm], fc)[0, 0]
+    assert 0.5 < kap / (0.005 * 2 * np.pi * 750.0) < 2, kap
+    t = 2.5 / (0.05 * kap)
+    a = 1.05 * sdm_limits(one, th, [rpm])[0][0]
+    shop = simulated_shop(one)
+    for seed in (0, 1):
+        short = shop(th, rpm, a, np.random.default_rng(seed))
+        long = shop(th, rpm, a, np.random.default_rng(seed), duration_s=t)
+        assert short.stable and short.duration_s == pytest.approx(250 * 60 / rpm), (seed, short)
+        assert long.duration_s == pytest.approx(t, abs=60 / rpm), (seed, long)
+        assert not long.stable and long.chatter_hz == pytest.approx(750.0, rel=0.01), (seed, long)
+
+
 def test_smc_posterior_matches_quadrature_on_one_parameter():
     """Only K_t uncertain: the exact posterior on a fine grid of ln K_t vs the SMC samples' quantiles."""
     pr = _kt_only()

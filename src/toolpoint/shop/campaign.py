@@ -17,6 +17,7 @@ loop; its truth is the semi-discretisation limit (:func:`sdm_limit`), not the ze
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -128,7 +129,8 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
     Returns
     -------
     callable
-        ``shop(theta, rpm, depth_m, rng) -> TestCut`` with the detector's verdict and chatter frequency.
+        ``shop(theta, rpm, depth_m, rng, duration_s=None) -> TestCut`` with the detector's verdict and chatter
+        frequency; a cut lasts ``revolutions``, or ``duration_s`` (s) when that is longer.
     """
     from ..simulation import sensor_signal, simulate_milling
     from .detect import analyse_cut
@@ -141,14 +143,15 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
 
     make = default_record if record is None else record
 
-    def shop(theta, rpm, depth_m, rng):
+    def shop(theta, rpm, depth_m, rng, duration_s=None):
         mm, cut = prior.tool(theta)
-        res = simulate_milling(mm, mm, cut, rpm=[float(rpm)], depth_m=[float(depth_m)], revolutions=revolutions,
+        revs = revolutions if duration_s is None else max(revolutions, math.ceil(duration_s * float(rpm) / 60.0))
+        res = simulate_milling(mm, mm, cut, rpm=[float(rpm)], depth_m=[float(depth_m)], revolutions=revs,
                                seed=int(rng.integers(1 << 30)), seed_level=seed_level)
         x, fs = make(res, float(rpm), cut.teeth, rng)
         r = analyse_cut(x, fs, rpm=float(rpm), teeth=cut.teeth, full_scale=1.0, **opts)
         return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz,
-                       duration_s=revolutions * 60.0 / float(rpm))
+                       duration_s=revs * 60.0 / float(rpm))
     return shop
 
 
