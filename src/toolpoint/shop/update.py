@@ -434,15 +434,14 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         depth was above the true limit in 30–55 % of 20 truths after 3–6 cuts, where it claims 5 % (5–15 % with
         this default). (0, 0): the labels are the limit (a detector checked on this machine and tool).
     label_growth : (float, float), default (2.5, 0.5)
-        Median G̃ and log standard deviation s_G of G, the ln of how much chatter must grow within a cut to be
-        heard: each cut's labels' boundary moves up by a further min(G / (κ t), 0.5), κ the sample's chatter
-        growth rate at the cut (:func:`~toolpoint.shop.model.growth_rate`, ≈ ζω_n of the chattering mode) and t
-        the cut's duration (a parameter of the posterior, column ``P + 1`` of ``z``). Just past the limit chatter
-        grows slowly, e^{κ ln(a/a_lim) t}: on a lightly damped mode (κ ≈ 30 /s) a 1 s cut 10 % past the limit
-        barely chatters, on a well-damped one (κ ≈ 500 /s) 1 % past it does. G̃ = 2.5 was fitted to the whole
-        loop's labels on the campaign tool EM12-60 (60 cuts, truths 40–49: its cuts at the 750 Hz mode, κ ≈ 25–40
-        /s, were heard as chatter only 7–12 % above the SDM limit, those at its 2000 Hz mode, κ ≈ 900 /s, at
-        1–3 %; ``docs/design/shop.md``). (0, 0): off.
+        Median G̃ and log standard deviation s_G of G, the ln of how much chatter must grow within a cut to be heard (a
+        parameter of the posterior, column ``P + 1`` of ``z``): each cut's labels' boundary moves up by a further min(G
+        / (κ t), 0.5), κ the sample's chatter growth rate at the cut (:func:`~toolpoint.shop.model.growth_rate`, ≈ ζω_n
+        of the chattering mode) and t the cut's duration. Just past the limit chatter grows slowly, e^{κ ln(a/a_lim) t}:
+        on a lightly damped mode (κ ≈ 30 /s) a 1 s cut 10 % past the limit barely chatters, on a well-damped one (κ ≈
+        500 /s) 1 % past it does. G̃ = 2.5 was fitted to the whole loop's labels on the campaign tool EM12-60 (60 cuts,
+        truths 40–49: its cuts at the 750 Hz mode, κ ≈ 25–40 /s, were heard as chatter only 7–12 % above the SDM limit,
+        those at its 2000 Hz mode, κ ≈ 900 /s, at 1–3 %; ``docs/design/shop.md``). (0, 0): off.
     cut_duration_s : float, default 1.0
         Duration (s) of the cuts whose :class:`TestCut` does not state it, and of the next cut. Shorter is the
         safer guess (chatter had less time to grow, so a stable label says less).
