@@ -77,6 +77,29 @@ def test_growth_rate_matches_the_semi_discretisation():
     assert 0.5 < k1 / (0.005 * 2 * np.pi * 750) < 2, k1
 
 
+def test_reference_ratios_started_near_the_first_agree_with_the_full_search():
+    """The SDM/ZOA ratios of the reference samples after the first (bracketed from the first's ratio by
+    sdm_limit_near) against each sample's own upward SDM search at every speed (sdm_limits, over the same speeds):
+    within 1 % in ln a at the grid and at the cut speeds, also on the example tool's three modes."""
+    from toolpoint.shop.model import example_tool, sdm_limits
+    from toolpoint.shop.update import _limits, _sdm_log_ratio
+
+    for pr, grid in ((cornelius_2024(0.1), np.linspace(9000.0, 21000.0, 25)),
+                     (example_tool(), np.linspace(14000.0, 26000.0, 13))):
+        f = pr.freq_grid()
+        th = pr.theta(np.random.default_rng(3).standard_normal((3, pr.sigma.size)) * (pr.sigma > 0))
+        rpm_c = np.array([grid[4] * 1.013, grid[8]])
+        lr_c, lr_g = _sdm_log_ratio(pr, th, rpm_c, grid, f)
+        zg, zc = _limits(pr, th, f, grid), limit_at_speeds(pr, th, rpm_c, f)[0]
+        speeds = np.unique(np.r_[grid, rpm_c])  # the full search's resolution follows its speed range
+        for i in range(3):
+            full = sdm_limits(pr, th[i], speeds)[0]
+            ref_g = np.log(full[np.searchsorted(speeds, grid)] / zg[i])
+            ref_c = np.log(full[np.searchsorted(speeds, rpm_c)] / zc[i])
+            assert np.all(np.isfinite(ref_g)) and np.max(np.abs(lr_g[i] - ref_g)) < 0.01, (i, lr_g[i] - ref_g)
+            assert np.max(np.abs(lr_c[i] - ref_c)) < 0.01, (i, lr_c[i], ref_c)
+
+
 def test_the_label_growth_moves_the_boundary_by_g_over_kappa_t():
     """log_likelihood's growth term: a stable label at a = a_lim e^x has P = ε + (1 − 2ε) Φ((G / (κ t) − x) / w),
     t the cut's ``duration_s`` or ``cut_duration_s``; the term is capped at 0.5 (a cut too short to hear chatter)."""

@@ -126,6 +126,15 @@ def test_two_directions_and_grid_contour():
     assert np.all(rho[depth < 0.999 * res.depth_m] < 1) and np.all(rho[depth > 1.001 * res.depth_m] >= 1)
 
 
+def test_limits_only_are_the_same_limits_without_chatter_frequencies():
+    """``chatter=False`` skips the eigenvectors, not the search: the same limits, no chatter frequency, no lobes."""
+    rpm = np.linspace(7000.0, 16000.0, 12)
+    full = sdm_lobes(MODE, None, cut(0.05), rpm=rpm)
+    bare = sdm_lobes(MODE, None, cut(0.05), rpm=rpm, chatter=False)
+    assert np.array_equal(bare.depth_m, full.depth_m) and np.all(np.isfinite(full.chatter_hz))
+    assert np.all(np.isnan(bare.chatter_hz)) and bare.lobes == [] and bare.min_depth_m == full.min_depth_m
+
+
 def test_stable_everywhere_gives_inf():
     res = sdm_lobes(MODE, None, cut(0.05), rpm=[9000.0, 9100.0], depth_min=1e-6, depth_max=1e-5)
     assert np.all(np.isinf(res.depth_m)) and np.all(np.isnan(res.chatter_hz))

@@ -318,7 +318,7 @@ def growth_rate(prior: ModalPrior, theta, rpm, chatter_hz) -> np.ndarray:
         return np.real(-1.0 / (T[None, :] * e / (1 - e) + dphi / phi))
 
 
-def sdm_limits(prior: ModalPrior, theta, rpm):
+def sdm_limits(prior: ModalPrior, theta, rpm, *, chatter: bool = True):
     """Semi-discretisation limit (m) and chatter frequency (Hz) of one θ at increasing speeds.
 
     :func:`~toolpoint.stability.sdm_lobes` with its default depth range, which is widened where the pockets go
@@ -332,6 +332,8 @@ def sdm_limits(prior: ModalPrior, theta, rpm):
     theta : array_like, shape (3M + 2,)
     rpm : array_like, shape (R,)
         Increasing speeds, rpm.
+    chatter : bool, default True
+        ``False``: the limits only (chatter frequencies ``nan``), a sixth to a third faster.
 
     Returns
     -------
@@ -340,7 +342,7 @@ def sdm_limits(prior: ModalPrior, theta, rpm):
     from ..stability import sdm_lobes
 
     mm, cut = prior.tool(np.asarray(theta, float))
-    res = sdm_lobes(mm, mm, cut, rpm=np.asarray(rpm, float))
+    res = sdm_lobes(mm, mm, cut, rpm=np.asarray(rpm, float), chatter=chatter)
     return res.depth_m, res.chatter_hz
 
 

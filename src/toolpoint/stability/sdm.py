@@ -748,6 +748,7 @@ def sdm_lobes(
     seed: bool = True,
     progress=None,
     widen: int = 2,
+    chatter: bool = True,
 ) -> LobeResult:
     """Stability limit by semi-discretisation, per spindle speed.
 
@@ -794,6 +795,11 @@ def sdm_lobes(
     widen : int, default 2
         Widenings of the default ``depth_max`` (0: none; ignored when
         ``depth_max`` is given).
+    chatter : bool, default True
+        ``False``: the limits only — no chatter frequencies (``nan``) and no
+        lobes, which spares one eigen-decomposition with eigenvectors per
+        speed (a sixth to a third of the time on the shop's priors:
+        ``docs/design/stability.md``).
 
     Returns
     -------
@@ -844,7 +850,7 @@ def sdm_lobes(
     params = dict(cut.as_dict(), cutting=cut, phi_st=sysm.phi_st, phi_ex=sysm.phi_ex, m=msteps,
                   node_spacing=spacing, accuracy=acc, depth_min=depth_min, depth_max=depth_max, step=step,
                   rtol=rtol, seed=seed, evaluations=evaluations, model=sysm.model)
-    return _sdm_result(sysm, grid, limit, msteps, spacing, params)
+    return _sdm_result(sysm, grid, limit, msteps, spacing, params, chatter)
 
 
 def _check_widen(widen) -> int:
@@ -901,12 +907,13 @@ def _limits(sysm: _System, grid, msteps, spacing, start, depth_min, depth_max, s
     return hi, count[0]
 
 
-def _sdm_result(sysm: _System, grid, limit, msteps, spacing, params) -> LobeResult:
-    """The LobeResult: chatter frequencies at the limit, lobes, and the lowest limit."""
+def _sdm_result(sysm: _System, grid, limit, msteps, spacing, params, with_chatter=True) -> LobeResult:
+    """The LobeResult: chatter frequencies at the limit (unless ``with_chatter`` is false), lobes, and the lowest
+    limit."""
     n = grid.size
     chatter = np.full(n, np.nan)
     fin = np.isfinite(limit)
-    if fin.any():
+    if fin.any() and with_chatter:
         chatter[fin] = sysm.critical(grid[fin], limit[fin], msteps[fin], spacing[fin])[1]
     lobes = _split_lobes(grid, limit, chatter, sysm.teeth)
     if not fin.any():
