@@ -1,7 +1,7 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|update|sampler|forward|ceiling] [--shops zoa,noisy,sim] [--cases cornelius,example]
+        [--only cut|update|sampler|forward|ceiling|sdm-bands] [--shops zoa,noisy,sim] [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
 
@@ -27,6 +27,8 @@ CPU time (time.process_time), not wall time: the machine is shared.
    share of speeds where the truth lies in the band (≈ 0.90 when calibrated) and the share of truths for which it
    is ≥ 0.90 — the most a campaign's coverage test can pass at one update when the posterior is exact (a
    posterior given the cuts holds a truth drawn from the prior like the prior holds it, on average over truths).
+5. ``sdm-bands``: the ``forward="sdm"`` band against the truth's own SDM limit at a cut speed and at a random
+   speed (Cornelius σ 0.12, 40 truths, three cuts each, lobe grids of 41 and 21 speeds).
 """
 
 from __future__ import annotations
@@ -406,12 +408,43 @@ def bench_ceiling(cases, library_prior=None):
                   f"{np.round(np.quantile(cov, [0.1, 0.25, 0.5]), 2).tolist()}", flush=True)
 
 
+def bench_sdm_bands(truths=40, grids=(41, 21), update_kw=None):
+    """``forward="sdm"`` against the truth's own SDM limit (not zero-order × reference ratio): Cornelius σ 0.12,
+    truths from the prior, three cuts at grid speeds labelled by ``sdm_limits`` of the truth at depths
+    e^N(0, 0.15) × it; the 5–95 % band's coverage at one cut speed and one random speed per truth."""
+    from toolpoint.shop.model import sdm_limits
+
+    print(f"\n## sdm-bands: forward=\"sdm\" bands against the truth's SDM limit, {truths} truths per grid")
+    pr = cornelius_2024(0.12)
+    for n in grids:
+        rng = np.random.default_rng(12)
+        grid = np.linspace(5000, 25000, n)
+        at_cut, away, width = [], [], []
+        c0 = time.process_time()
+        for _ in range(truths):
+            truth = pr.theta(rng.standard_normal((1, pr.sigma.size)))[0]
+            rpm = np.sort(rng.choice(grid, 3, replace=False))
+            a_sdm = sdm_limits(pr, truth, grid)[0]
+            k = np.searchsorted(grid, rpm)
+            depth = a_sdm[k] * np.exp(rng.normal(0, 0.15, 3))
+            cuts = [TestCut(r, d, bool(d < a), None) for r, d, a in zip(rpm, depth, a_sdm[k])]
+            kw = dict(dict(n_samples=500, lobe_samples=200), **(update_kw or {}))
+            q = update(pr, cuts, rng=rng, rpm_grid=grid, forward="sdm", **kw).limit_q_m
+            j, g = k[rng.integers(3)], rng.integers(grid.size)
+            at_cut.append(q[0, j] <= a_sdm[j] <= q[2, j])
+            away.append(q[0, g] <= a_sdm[g] <= q[2, g])
+            width.append((q[2, j] - q[0, j]) / q[1, j])
+        print(f"grid of {n} speeds: band holds the truth's SDM limit at a cut speed {np.mean(at_cut):.2f}, at a "
+              f"random speed {np.mean(away):.2f} (claims 0.90); width at the cut speed median {np.median(width):.3f}; "
+              f"{time.process_time() - c0:.0f} s CPU", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=("cut", "update", "sampler", "forward", "ceiling"))
+    ap.add_argument("--only", choices=("cut", "update", "sampler", "forward", "ceiling", "sdm-bands"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -446,6 +479,10 @@ def main():
         bench_ceiling(a.cases.split(","), a.library_prior)
     if a.only in (None, "sampler"):
         bench_sampler()
+    if a.only in (None, "sdm-bands"):
+        import json
+
+        bench_sdm_bands(12 if a.quick else 40, update_kw=json.loads(a.update))
     if a.only in (None, "update"):
         import json
 

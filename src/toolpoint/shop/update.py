@@ -404,8 +404,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         ``"sdm"``: after the zero-order posterior, the semi-discretisation limit of ``sdm_refs`` posterior
         samples at the cut speeds and on the lobe grid gives ln(a_SDM / a_ZOA); the posterior is sampled again
         with the zero-order limit times the references' mean ratio at each cut speed (their spread added to
-        the boundary width), and each lobe sample is multiplied by one reference's ratio, moved to that mean
-        within a few % of the cut speeds (where the cuts constrain the corrected limit). For cuts that
+        the boundary width), and each lobe sample is multiplied by one reference's ratio. For cuts that
         follow the SDM (time domain, a real machine) where the ZOA is biased (low radial immersion). Without
         cuts the prior's lobes are corrected by ``sdm_refs`` prior samples' ratios (so is the first cut's
         risk). Limits: ``docs/design/shop.md``.
@@ -530,20 +529,16 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                        log_ratio=lr_c.mean(axis=0))
             z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw2, method, n_moves, rng,
                         ess_hist, acc)
-            u, inv = np.unique(rpm_c, return_inverse=True)
-            first = np.zeros(u.size, int)
-            first[inv[::-1]] = np.arange(rpm_c.size)[::-1]
-            lr_ref_u = lr_c[:, first]  # (R, U)
-            # each lobe sample keeps one reference's ratio curve, moved to the references' mean near the cuts:
-            # there the likelihood used that mean (the spread went into the boundary width), so the samples'
-            # zero-order limits times the mean are what the cuts constrain — another reference's ratio on top
-            # would count the spread twice
-            log_ratio_grid = lr_g + _carry(lr_ref_u.mean(axis=0)[None, :] - lr_ref_u, grid, u)
+            log_ratio_grid = lr_g
             if sdm_train > 0:
                 # the references' ratio is that of the zero-order posterior, not of the corrected one: the
                 # corrected samples' own SDM limits at the cut speeds (sdm_train of them) give the ratio there,
                 # its mean in the likelihood and its spread in the boundary width, and the posterior is sampled
-                # a third time; each lobe sample's ratio is moved to that mean near the cuts instead
+                # a third time; each lobe sample keeps one reference's ratio, moved to that mean near the cuts
+                u, inv = np.unique(rpm_c, return_inverse=True)
+                first = np.zeros(u.size, int)
+                first[inv[::-1]] = np.arange(rpm_c.size)[::-1]
+                lr_ref_u = lr_c[:, first]  # (R, U)
                 z_tr = z[rng.choice(n_samples, min(int(sdm_train), n_samples), replace=False), :P]
                 lr_tr = _sdm_own_log_ratio(prior, z_tr, u, f, lr_ref_u.mean(axis=0))  # (T, U)
                 mean_u = lr_tr.mean(axis=0)
