@@ -416,6 +416,8 @@ def bench_sdm_bands(truths=40, grids=(41, 21), update_kw=None):
 
     print(f"\n## sdm-bands: forward=\"sdm\" bands against the truth's SDM limit, {truths} truths per grid")
     pr = cornelius_2024(0.12)
+    kw = dict(dict(n_samples=500, lobe_samples=200), **(update_kw or {}))
+    kw.pop("forward", None)  # this check is of forward="sdm"
     for n in grids:
         rng = np.random.default_rng(12)
         grid = np.linspace(5000, 25000, n)
@@ -428,7 +430,6 @@ def bench_sdm_bands(truths=40, grids=(41, 21), update_kw=None):
             k = np.searchsorted(grid, rpm)
             depth = a_sdm[k] * np.exp(rng.normal(0, 0.15, 3))
             cuts = [TestCut(r, d, bool(d < a), None) for r, d, a in zip(rpm, depth, a_sdm[k])]
-            kw = dict(dict(n_samples=500, lobe_samples=200), **(update_kw or {}))
             q = update(pr, cuts, rng=rng, rpm_grid=grid, forward="sdm", **kw).limit_q_m
             j, g = k[rng.integers(3)], rng.integers(grid.size)
             at_cut.append(q[0, j] <= a_sdm[j] <= q[2, j])

@@ -69,8 +69,8 @@ def test_growth_rate_matches_the_semi_discretisation():
     ref = np.log(rho) / (60.0 / (rpm * cut.teeth) * np.log(1.05))
     assert np.all(np.abs(kap / ref - 1) < 0.35), (kap, ref)
     # one lightly damped mode (ζ = 0.5 %, 750 Hz), chatter between the harmonics: κ ≈ ζ ω_n within a factor 2
-    one = ModalPrior((750.0,), (2e7,), (0.005,), (0.0,), (0.0,), (0.0,), pr.cutting, 0.0, 0.0)
-    t1 = one.theta(np.zeros((1, 5)))
+    one, t1 = _one_slow_mode()
+    t1 = t1[None, :]
     r1 = np.array([14000.0])
     _, f1 = limit_at_speeds(one, t1, r1)
     k1 = growth_rate(one, t1, r1, f1)[0, 0]
