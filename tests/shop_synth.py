@@ -9,14 +9,20 @@ shop hears, and what is modelled here:
 * room: pink-ish noise (integrated white noise, high-passed) and fan/pump tones at fixed
   frequencies that are not spindle multiples, the same in air cut and cut;
 * chatter: a tone at f_c with aliases f_c ± f_t, growing in over ``onset_s`` and wandering ±0.1 % in
-  frequency; at entry a decaying free vibration at the mode (stable cuts too).
+  frequency; at entry a decaying free vibration at the mode (stable cuts too);
+* the spindle's speed (optional): a droop under load (``speed_droop`` of the speed when the tool enters, half
+  of it recovered by the drive with a 0.3 s time constant) and a slow wander (± ``speed_wander`` at
+  ``wander_hz``). Sizes: the real recording in ``examples/cuts`` runs 0.15–0.2 % faster in air than in the cut
+  (its first two tooth-passing harmonics); a spindle drive without an encoder slips by a percent or more under
+  load.
 """
 
 import numpy as np
 
 
 def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_amp=1.0, air_s=1.0, cut_s=2.0,
-                fans=(617.0, 1813.0), fan_amp=0.3, noise=0.05, mode_hz=None, seed=0):
+                fans=(617.0, 1813.0), fan_amp=0.3, noise=0.05, mode_hz=None, speed_droop=0.0, speed_wander=0.0,
+                wander_hz=0.5, seed=0):
     """(samples, rate, cut start s, cut end s)."""
     rng = np.random.default_rng(seed)
     n = int((2 * air_s + cut_s) * rate)
@@ -27,11 +33,19 @@ def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_a
     x = np.zeros(n)
     kmax = int(min(8000.0, 0.45 * rate) / f_s)
     phases = rng.uniform(0, 2 * np.pi, kmax + 1)
+    if speed_droop or speed_wander:  # the spindle's phase, 2π ∫ f_s(t) dt
+        te = np.clip(t - t0, 0, None)
+        f_inst = f_s * (1 - speed_droop * ramp * (0.5 + 0.5 * np.exp(-te / 0.3)))
+        f_inst = f_inst * (1 + speed_wander * np.sin(2 * np.pi * wander_hz * t))
+        spin = 2 * np.pi * np.cumsum(f_inst) / rate
+    else:
+        spin = None
     for k in range(1, kmax + 1):  # loops over harmonics (tens), not samples
         tooth = k % teeth == 0
         a_air = 0.02 / k
         a_cut = (1.0 if tooth else 0.1) / (k / teeth) ** 1.2
-        x += (a_air + a_cut * ramp) * np.sin(2 * np.pi * k * f_s * t + phases[k])
+        arg = 2 * np.pi * k * f_s * t if spin is None else k * spin
+        x += (a_air + a_cut * ramp) * np.sin(arg + phases[k])
     for f in fans:
         x += fan_amp * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
     room = np.cumsum(rng.standard_normal(n))

@@ -21,7 +21,20 @@ The detector (:func:`analyse_cut`):
    ``window_s`` judged one by one (neighbours with the same verdict merged);
 3. **harmonics removed** — every bin within ``2 Δf + 0.05 % f`` (the Hann window's main lobe, and the
    speed's wander) of a multiple of f_s is masked
-   (runout included: all multiples, not only those of f_t);
+   (runout included: all multiples, not only those of f_t). *A wandering spindle*: the speed of each cutting
+   frame is read from its four lowest tooth-passing harmonics (the strongest forced lines; the peak near each,
+   ≥ 10 dB over the floor, at least two agreeing within 0.1 %; a running median of 5 frames). Where it departs
+   from its median by more than the mask's 0.05 %, each judged part masks every multiple of the speeds its
+   frames ran at, k f_min − pad … k f_max + pad, and the harmonics' leakage into the floor is the Hann
+   window's sidelobe envelope from their nearest position (a moving line is mostly off the bins). A spindle
+   slows when the tool enters and its drive recovers; a fixed mask left the moving flanks of the strong
+   harmonics as new lines near them, which passed for chatter with their tooth-passing "aliases" (stable
+   synthetic records with ±0.3 % wander at 0.5–2 Hz: 27 of 48 called chatter with the fixed mask, 1 with the
+   tracked one; ``docs/design/shop.md``). Not by the comb of all the harmonics (step 2) frame by frame:
+   developed chatter near a tooth harmonic, with its aliases and its own harmonics, is a comb a little off
+   the spindle's, and on the real recording in ``examples/cuts`` that comb read the spindle 0.9 % slow during
+   the chatter while its first two tooth harmonics did not move. The cost: chatter within the speed range
+   plus the pad of a harmonic is masked (it cannot be told from the moving harmonic on a spectrum);
 4. **the chatter test** in the averaged (Welch) power spectrum P of a segment, with the floor F the
    median of the unmasked bins in blocks of 32 bins (corrected for the median of χ²_ν/ν) plus what the
    Hann window leaks from the two nearest spindle harmonics (×4; strong harmonics' sidelobes are not tones):
@@ -93,6 +106,9 @@ __all__ = ["CutSegment", "CutAnalysis", "analyse_cut", "harmonizer_rpm", "check_
 _ALPHA = 1e-3
 _BLOCK = 32
 _MASK_REL = 5e-4
+_TRACK_REL = _MASK_REL  # speed wander the mask covers; beyond it each judged part masks its own range of speeds
+_TRACK_AGREE = 1e-3
+_SIDELOBE = 0.0267  # the Hann window's first sidelobe, amplitude (−31.5 dB)
 
 
 @dataclass(frozen=True)
@@ -175,7 +191,10 @@ class CutAnalysis:
     criterion : dict
         The thresholds used (α, t_α per segment is in ``significance``), for the record;
         ``on_harmonic_excess_db`` is the excess over the runout lines that makes a spindle harmonic chatter
-        (None where that test cannot run: fewer than 3 teeth, or no air cut).
+        (None where that test cannot run: fewer than 3 teeth, or no air cut); ``speed_wander`` the largest
+        relative departure of the tracked spindle speed from its median over the cutting frames (0 where it
+        could not be tracked), ``speed_tracked`` whether it exceeded the mask's 0.05 % and each judged part
+        masked the speeds it ran at (module docstring, step 3).
     time_s, freq_hz, power : ndarray
         The spectrogram (frame centres s, frequencies Hz, power per bin) for the figure.
     """
@@ -485,18 +504,30 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             f_s = f_nom
     else:
         f_s, spindle_found = f_nom, True
+    # the speed per cutting frame: spindles slow under load and their speed wanders; where it wanders by more than
+    # the mask allows, each judged part masks the harmonics over the range of speeds its frames ran at
+    track, wander = None, 0.0
+    if rpm_tolerance > 0 and cutting.size >= 3:
+        t_f, f_f = _track_speed(P[cutting], frame_t[cutting], freq, inband, f_s, teeth * f_s, rpm_tolerance, df)
+        if t_f.size >= 3:
+            wander = float(np.max(np.abs(f_f / np.median(f_f) - 1)))
+            if wander > _TRACK_REL:
+                track = (t_f, f_f)
+                f_s = float(np.median(f_f))
 
     # 3. harmonic mask: all multiples of the spindle frequency
-    k = np.round(freq / f_s)
-    near = (k >= 1) & (np.abs(freq - k * f_s) <= 2 * df + _MASK_REL * freq)
-    keep = inband & ~near
-    harm = inband & near
+    keep, harm = _harmonic_mask(freq, inband, f_s, f_s, df)
     nu1 = _welch_dof(L, hop)
 
     def judge(ta, tb):
         sel = frames_in(ta, tb)
-        seg = _judge(P[sel], nu1, freq, keep, harm, ref, rise_db, (dominance, alias_dominance), alpha, df,
-                     f_s, teeth * f_s, growth_db)
+        keep_w, harm_w, f_w, f_range = keep, harm, f_s, None
+        if track is not None:  # the speeds these frames ran at
+            fr = np.interp(frame_t[sel], *track)
+            f_w, f_range = float(np.median(fr)), (float(fr.min()), float(fr.max()))
+            keep_w, harm_w = _harmonic_mask(freq, inband, *f_range, df)
+        seg = _judge(P[sel], nu1, freq, keep_w, harm_w, ref, rise_db, (dominance, alias_dominance), alpha, df,
+                     f_w, teeth * f_w, growth_db, f_range)
         opr = _once_per_rev(x[int(ta * rate):int(tb * rate)], rate, f_s)
         return CutSegment("cut", ta, tb, **seg, once_per_rev=opr)
 
@@ -533,9 +564,61 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                  "alias_dominance": alias_dominance, "growth_db": growth_db, "growth_t": _GROWTH_T,
                  "mask_hz": f"2*{df:.4g} + {_MASK_REL:g}*f", "frame_s": L / rate, "band_hz": [lo, hi],
                  "spindle_multiples_removed": True,
-                 "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None}
+                 "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None,
+                 "speed_wander": round(wander, 6), "speed_tracked": track is not None}
     return CutAnalysis(verdict, chatter_hz, tuple(segments), float(rpm), 60 * f_s, spindle_found, int(teeth), rec,
                        alts, criterion, frame_t, freq, P)
+
+
+def _harmonic_mask(freq, inband, f_lo, f_hi, df):
+    """(keep, harm): in-band bins away from / near every multiple k f of a spindle frequency f in [f_lo, f_hi] Hz —
+    within 2 Δf (the Hann window's main lobe) + ``_MASK_REL`` f of k f_lo … k f_hi."""
+    k = np.round(freq / (0.5 * (f_lo + f_hi)))
+    pad = 2 * df + _MASK_REL * freq
+    near = (k >= 1) & (freq >= k * f_lo - pad) & (freq <= k * f_hi + pad)
+    return inband & ~near, inband & near
+
+
+def _track_speed(P, frame_t, freq, inband, f_s, f_t, tol, df):
+    """Spindle frequency of each frame from its four lowest tooth-passing harmonics k f_t, the strongest forced
+    lines: the peak within ``tol`` of each (parabola through the log power of three bins), where it stands
+    ≥ 10 dB over the floor. A frame counts where at least two of them do and they agree within ``_TRACK_AGREE``.
+    Why not the comb of all the spindle harmonics: developed chatter f_c near j f_t, with its aliases
+    f_c + i f_t and its own harmonics, makes a comb of spacing f_c/j that the whole-spectrum comb follows (the
+    real recording in ``examples/cuts``: the comb read the spindle 0.9 % slow during chatter, its first two tooth
+    harmonics did not move). Smoothed by a running median of 5 frames. Returns (times s, spindle Hz)."""
+    from scipy.ndimage import median_filter
+
+    lf = np.log(_block_floor(P, inband) + 1e-300)
+    lp = np.log(P + 1e-300)
+    est = []
+    for k in range(1, 5):
+        c = k * f_t
+        w = max(3 * df, tol * c)
+        sel = np.flatnonzero(inband & (np.abs(freq - c) <= w))
+        if sel.size < 3 or sel[0] == 0 or sel[-1] >= freq.size - 1:
+            continue
+        j = sel[np.argmax(lp[:, sel], axis=1)]  # (frames,)
+        r = np.arange(P.shape[0])
+        y0, y1, y2 = lp[r, j - 1], lp[r, j], lp[r, j + 1]
+        den = y0 - 2 * y1 + y2
+        d = np.where(den < 0, 0.5 * (y0 - y2) / np.where(den < 0, den, -1.0), 0.0)
+        f_k = (freq[j] + np.clip(d, -0.5, 0.5) * df) / (k * f_t / f_s)
+        est.append(np.where(y1 - lf[r, j] >= math.log(10.0), f_k, np.nan))
+    if len(est) < 2:
+        return np.zeros(0), np.zeros(0)
+    est = np.array(est)  # (harmonics, frames)
+    with np.errstate(invalid="ignore"):
+        agree = np.abs(est[:, None, :] / est[None, :, :] - 1) <= _TRACK_AGREE  # nan compares False
+    count = agree.sum(axis=1)  # (harmonics, frames): estimates agreeing with each (itself included)
+    best = np.argmax(count, axis=0)  # the largest group; ties go to the lowest harmonic
+    r = np.arange(est.shape[1])
+    grp = agree[best, :, r]  # (frames, harmonics)
+    good = count[best, r] >= 2
+    if good.sum() < 3:
+        return np.zeros(0), np.zeros(0)
+    med = np.nansum(np.where(grp, est.T, 0.0), axis=1) / np.maximum(grp.sum(axis=1), 1)
+    return frame_t[good], median_filter(med[good], size=5, mode="nearest")
 
 
 def _welch_dof(L, hop):
@@ -558,9 +641,13 @@ def _welch_dof(L, hop):
     return nu
 
 
-def _leakage(p, freq, harm, f_s, df):
+def _leakage(p, freq, harm, f_lo, f_hi, df):
     """Power the Hann window leaks from the two nearest spindle harmonics into each bin, ×4 (6 dB: a harmonic
-    between two bins shows less than its true peak): P_h (sinc δ / (1 − δ²))², δ the offset in bins."""
+    between two bins shows less than its true peak): P_h (sinc δ / (1 − δ²))², δ the offset in bins. A harmonic
+    that moved over k f_lo … k f_hi during the part (a wandering spindle) leaks from every position, mostly off
+    the bins: there the sidelobe envelope 1/(π δ |δ² − 1|) (at most the first sidelobe's 0.0267, −31.5 dB) at
+    the nearest position."""
+    f_s = 0.5 * (f_lo + f_hi)
     k = np.round(freq / f_s)
     out = np.zeros_like(p)
     hp = np.where(harm, p, 0.0)
@@ -569,21 +656,29 @@ def _leakage(p, freq, harm, f_s, df):
     np.maximum.at(peak, np.clip(k.astype(int), 0, kmax + 1), hp)  # each harmonic's highest bin
     for side in (0, 1):  # the harmonic below and the one above each bin
         kk = np.floor(freq / f_s) + side
-        d = (freq - kk * f_s) / df
-        with np.errstate(divide="ignore", invalid="ignore"):
-            w = np.where(np.abs(np.abs(d) - 1) < 1e-9, 0.5, np.sinc(d) / (1 - d * d))
+        if f_hi > f_lo:
+            d = np.maximum(np.maximum(kk * f_lo - freq, freq - kk * f_hi), 0.0) / df
+            with np.errstate(divide="ignore"):
+                w = np.minimum(1.0 / (np.pi * d * np.abs(d * d - 1)), _SIDELOBE)
+            w = np.where(d < 1.5, 1.0, w)  # in the main lobe: masked bins, kept for the leakage's sake
+        else:
+            d = (freq - kk * f_s) / df
+            with np.errstate(divide="ignore", invalid="ignore"):
+                w = np.where(np.abs(np.abs(d) - 1) < 1e-9, 0.5, np.sinc(d) / (1 - d * d))
         out += peak[np.clip(kk.astype(int), 0, kmax + 1)] * w * w
     return 4 * out
 
 
-def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s, f_t, growth_db=0.0) -> dict:
+def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s, f_t, growth_db=0.0,
+           f_range=None) -> dict:
     """The chatter test on the mean of the frames ``Pseg`` (see the module docstring); ``dominance`` is the pair
-    (without, with a tooth-passing alias)."""
+    (without, with a tooth-passing alias); ``f_range`` the spindle frequencies (Hz) the frames ran at when the
+    speed was tracked."""
     n = Pseg.shape[0]
     p = Pseg.mean(axis=0)
     nu = float(nu1(n))
     floor0 = _block_floor(p[None, :], keep)[0] / _chi2_median_ratio(nu)
-    floor = floor0 + _leakage(p, freq, harm, f_s, df)
+    floor = floor0 + _leakage(p, freq, harm, *(f_range or (f_s, f_s)), df)
     z = np.where(keep, p / floor, 0.0)
     t_a = _threshold(nu, int(keep.sum()), alpha)
     rise_bins = None
