@@ -410,7 +410,8 @@ def bench_ceiling(cases, library_prior=None):
 
 def bench_sdm_bands(truths=40, grids=(41, 21), update_kw=None):
     """``forward="sdm"`` against the truth's own SDM limit (not zero-order × reference ratio): Cornelius σ 0.12,
-    truths from the prior, three cuts at grid speeds labelled by ``sdm_limits`` of the truth at depths
+    truths from the prior (their own rng: every setting sees the same truths), three cuts at grid speeds labelled
+    by ``sdm_limits`` of the truth at depths
     e^N(0, 0.15) × it; the 5–95 % band's coverage at one cut speed and one random speed per truth."""
     from toolpoint.shop.model import sdm_limits
 
@@ -419,7 +420,8 @@ def bench_sdm_bands(truths=40, grids=(41, 21), update_kw=None):
     kw = dict(dict(n_samples=500, lobe_samples=200), **(update_kw or {}))
     kw.pop("forward", None)  # this check is of forward="sdm"
     for n in grids:
-        rng = np.random.default_rng(12)
+        rng = np.random.default_rng(12)  # truths, cut speeds and depths: the same whatever the update draws
+        rng_u = np.random.default_rng(13)  # the updates' own
         grid = np.linspace(5000, 25000, n)
         at_cut, away, width = [], [], []
         c0 = time.process_time()
@@ -430,7 +432,7 @@ def bench_sdm_bands(truths=40, grids=(41, 21), update_kw=None):
             k = np.searchsorted(grid, rpm)
             depth = a_sdm[k] * np.exp(rng.normal(0, 0.15, 3))
             cuts = [TestCut(r, d, bool(d < a), None) for r, d, a in zip(rpm, depth, a_sdm[k])]
-            q = update(pr, cuts, rng=rng, rpm_grid=grid, forward="sdm", **kw).limit_q_m
+            q = update(pr, cuts, rng=rng_u, rpm_grid=grid, forward="sdm", **kw).limit_q_m
             j, g = k[rng.integers(3)], rng.integers(grid.size)
             at_cut.append(q[0, j] <= a_sdm[j] <= q[2, j])
             away.append(q[0, g] <= a_sdm[g] <= q[2, g])
