@@ -29,7 +29,7 @@ The detector (:func:`analyse_cut`):
    window's sidelobe envelope from their nearest position (a moving line is mostly off the bins). A spindle
    slows when the tool enters and its drive recovers; a fixed mask left the moving flanks of the strong
    harmonics as new lines near them, which passed for chatter with their tooth-passing "aliases" (stable
-   synthetic records with ±0.3 % wander at 0.5–2 Hz: 27 of 48 called chatter with the fixed mask, 1 with the
+   synthetic records with ±0.2–0.5 % wander at 0.5–2 Hz: 27 of 48 called chatter with the fixed mask, 1 with the
    tracked one; ``docs/design/shop.md``). Not by the comb of all the harmonics (step 2) frame by frame:
    developed chatter near a tooth harmonic, with its aliases and its own harmonics, is a comb a little off
    the spindle's, and on the real recording in ``examples/cuts`` that comb read the spindle 0.9 % slow during
