@@ -22,7 +22,7 @@ import numpy as np
 
 def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_amp=1.0, air_s=1.0, cut_s=2.0,
                 fans=(617.0, 1813.0), fan_amp=0.3, noise=0.05, mode_hz=None, speed_droop=0.0, speed_wander=0.0,
-                wander_hz=0.5, seed=0):
+                wander_hz=0.5, speed_step=0.0, seed=0):
     """(samples, rate, cut start s, cut end s)."""
     rng = np.random.default_rng(seed)
     n = int((2 * air_s + cut_s) * rate)
@@ -33,10 +33,11 @@ def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_a
     x = np.zeros(n)
     kmax = int(min(8000.0, 0.45 * rate) / f_s)
     phases = rng.uniform(0, 2 * np.pi, kmax + 1)
-    if speed_droop or speed_wander:  # the spindle's phase, 2π ∫ f_s(t) dt
+    if speed_droop or speed_wander or speed_step:  # the spindle's phase, 2π ∫ f_s(t) dt
         te = np.clip(t - t0, 0, None)
         f_inst = f_s * (1 - speed_droop * ramp * (0.5 + 0.5 * np.exp(-te / 0.3)))
         f_inst = f_inst * (1 + speed_wander * np.sin(2 * np.pi * wander_hz * t))
+        f_inst = f_inst * (1 + speed_step * np.clip((t - 0.5 * (t0 + t1)) / 0.2, 0, 1))
         spin = 2 * np.pi * np.cumsum(f_inst) / rate
     else:
         spin = None

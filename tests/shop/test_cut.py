@@ -298,20 +298,24 @@ def test_a_drooping_or_wandering_spindle_is_not_chatter():
     # them: 3 of these 10 stable records were called chatter with the speed untracked (seeds 0–2 at ±0.3 %).
     # Tracked from the lowest tooth-passing harmonics, each judged part masks the speeds it ran at.
     false = []
-    cases = [(0.0, 0.003, seed) for seed in range(3)] + [(0.01, 0.0, 3)]
-    for droop, wander, seed in cases:
+    # A step of the override in the middle of the cut (1.5 %): every one of 12 stable records was called chatter with
+    # the fixed mask (steps of 0.5–3 %, three speeds), none tracked.
+    cases = [(0.0, 0.003, 0.0, seed) for seed in range(3)] + [(0.01, 0.0, 0.0, 3), (0.0, 0.0, 0.015, 4)]
+    for droop, wander, step, seed in cases:
         for rpm, teeth in ((6000, 4), (12000, 2), (9000, 3))[: 3 if wander else 1]:
-            x, rate, *_ = shop_record(rpm=rpm, teeth=teeth, speed_droop=droop, speed_wander=wander, seed=seed)
+            x, rate, *_ = shop_record(rpm=rpm, teeth=teeth, speed_droop=droop, speed_wander=wander, speed_step=step,
+                                      seed=seed)
             res = analyse_cut(x, rate, rpm=rpm, teeth=teeth, full_scale=1.0)
-            assert res.criterion["speed_tracked"] and res.criterion["speed_wander"] < 2 * max(droop, wander)
-            assert abs(res.rpm / rpm - 1) < 0.01
-            false += [(droop, wander, seed, rpm)] if res.verdict != "stable" else []
+            assert res.criterion["speed_tracked"] and res.criterion["speed_wander"] < 2 * max(droop, wander, step)
+            assert abs(res.rpm / rpm - 1) < 0.02
+            false += [(droop, wander, step, seed, rpm)] if res.verdict != "stable" else []
     assert not false
     # chatter is still found, at its frequency
-    x, rate, *_ = shop_record(rpm=9000, teeth=3, chatter_hz=1234.0, chatter_amp=0.5, speed_droop=0.005,
-                              speed_wander=0.003, seed=9)
-    res = analyse_cut(x, rate, rpm=9000, teeth=3, full_scale=1.0)
-    assert res.verdict == "chatter" and abs(res.chatter_hz / 1234.0 - 1) < 0.01
+    for step in (0.0, 0.015):
+        x, rate, *_ = shop_record(rpm=9000, teeth=3, chatter_hz=1234.0, chatter_amp=0.5, speed_droop=0.005,
+                                  speed_wander=0.003, speed_step=step, seed=9)
+        res = analyse_cut(x, rate, rpm=9000, teeth=3, full_scale=1.0)
+        assert res.verdict == "chatter" and abs(res.chatter_hz / 1234.0 - 1) < 0.01
     # a steady spindle is not tracked: the mask of the steady speed, as before
     x, rate, *_ = shop_record(rpm=6000, teeth=4, seed=1)
     res = analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0)

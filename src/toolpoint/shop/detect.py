@@ -30,7 +30,8 @@ The detector (:func:`analyse_cut`):
    slows when the tool enters and its drive recovers; a fixed mask left the moving flanks of the strong
    harmonics as new lines near them, which passed for chatter with their tooth-passing "aliases" (stable
    synthetic records with ±0.2–0.5 % wander at 0.5–2 Hz: 27 of 48 called chatter with the fixed mask, 1 with the
-   tracked one; ``docs/design/shop.md``). Not by the comb of all the harmonics (step 2) frame by frame:
+   tracked one; with a 0.5–3 % step of the speed mid-cut, 12 of 12 and none; ``docs/design/shop.md``). Not by
+   the comb of all the harmonics (step 2) frame by frame:
    developed chatter near a tooth harmonic, with its aliases and its own harmonics, is a comb a little off
    the spindle's, and on the real recording in ``examples/cuts`` that comb read the spindle 0.9 % slow during
    the chatter while its first two tooth harmonics did not move. The cost: chatter within the speed range
