@@ -295,11 +295,11 @@ def test_a_weak_growing_line_is_chatter_a_steady_or_decaying_one_is_not():
 def test_a_drooping_or_wandering_spindle_is_not_chatter():
     # The spindle's speed wanders (±0.3 % at 0.5 Hz) or droops when the tool enters (1 %, half recovered by the
     # drive); its harmonics move with it. A mask fixed at one speed leaves their moving flanks as new lines near
-    # them: 3 of these 10 stable records were called chatter with the speed untracked (seeds 0–2 at ±0.3 %).
-    # Tracked from the lowest tooth-passing harmonics, each judged part masks the speeds it ran at.
+    # them. A step of the override in the middle of the cut (1.5 %) too. With the speed untracked, 3 of the 9 wander
+    # records below and the step record were called chatter (and 12 of 12 stable records with steps of 0.5–3 % from
+    # a second generator: docs/design/shop.md). Tracked from the lowest tooth-passing harmonics, each judged part
+    # masks the speeds it ran at.
     false = []
-    # A step of the override in the middle of the cut (1.5 %): every one of 12 stable records was called chatter with
-    # the fixed mask (steps of 0.5–3 %, three speeds), none tracked.
     cases = [(0.0, 0.003, 0.0, seed) for seed in range(3)] + [(0.01, 0.0, 0.0, 3), (0.0, 0.0, 0.015, 4)]
     for droop, wander, step, seed in cases:
         for rpm, teeth in ((6000, 4), (12000, 2), (9000, 3))[: 3 if wander else 1]:
