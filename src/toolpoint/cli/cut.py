@@ -102,4 +102,6 @@ def run(args) -> int:
            + (f", its speed wandered ±{100 * res.criterion['speed_wander']:.2g} % (tracked)"
               if res.criterion.get("speed_tracked") else ""))
     print(msg, file=sys.stderr if out is None else sys.stdout)
+    for w in res.criterion.get("warnings", ()):
+        print(f"{rec_path.name}: warning: {w}", file=sys.stderr)
     return 0

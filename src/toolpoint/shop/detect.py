@@ -110,6 +110,7 @@ _MASK_REL = 5e-4
 _TRACK_REL = _MASK_REL  # speed wander the mask covers; beyond it each judged part masks its own range of speeds
 _TRACK_AGREE = 1e-3
 _SIDELOBE = 0.0267  # the Hann window's first sidelobe, amplitude (−31.5 dB)
+_MAINS_REL = 2e-3  # mains frequency tolerance (grids hold 50/60 Hz within ±0.2 %)
 
 
 @dataclass(frozen=True)
@@ -195,7 +196,9 @@ class CutAnalysis:
         (None where that test cannot run: fewer than 3 teeth, or no air cut); ``speed_wander`` the largest
         relative departure of the tracked spindle speed from its median over the cutting frames (0 where it
         could not be tracked), ``speed_tracked`` whether it exceeded the mask's 0.05 % and each judged part
-        masked the speeds it ran at (module docstring, step 3).
+        masked the speeds it ran at (module docstring, step 3); ``warnings`` what the verdict cannot rule out
+        (chatter on a mains harmonic, 50 or 60 Hz × k within 2 Δf + 0.2 %, in a record without an air cut: hum
+        from a ground loop is a steady tone there, and without the air cut only its strength is judged).
     time_s, freq_hz, power : ndarray
         The spectrogram (frame centres s, frequencies Hz, power per bin) for the figure.
     """
@@ -561,12 +564,20 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         longest = max(chat, key=lambda sg: sg.end_s - sg.start_s)
         chatter_hz = longest.chatter_hz
         rec, alts = harmonizer_rpm(chatter_hz, teeth, 60 * f_s)
+    warns = []
+    if chatter_hz is not None and ref is None:  # without an air cut a steady tone is judged by its strength alone
+        for mains in (50.0, 60.0):
+            k = max(1, round(chatter_hz / mains))
+            if abs(chatter_hz - k * mains) <= 2 * df + _MAINS_REL * chatter_hz:
+                warns.append(f"chatter at {chatter_hz:.1f} Hz sits on the mains harmonic {k} x {mains:g} Hz and the "
+                             "record holds no air cut to tell hum from chatter: record the spindle running in air "
+                             "before the cut")
     criterion = {"alpha": alpha, "rise_db": rise_db if ref is not None else None, "dominance": dominance,
                  "alias_dominance": alias_dominance, "growth_db": growth_db, "growth_t": _GROWTH_T,
                  "mask_hz": f"2*{df:.4g} + {_MASK_REL:g}*f", "frame_s": L / rate, "band_hz": [lo, hi],
                  "spindle_multiples_removed": True,
                  "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None,
-                 "speed_wander": round(wander, 6), "speed_tracked": track is not None}
+                 "speed_wander": round(wander, 6), "speed_tracked": track is not None, "warnings": warns}
     return CutAnalysis(verdict, chatter_hz, tuple(segments), float(rpm), 60 * f_s, spindle_found, int(teeth), rec,
                        alts, criterion, frame_t, freq, P)
 
