@@ -13,7 +13,7 @@ shop hears, and what is modelled here:
 * the spindle's speed (optional): a droop under load (``speed_droop`` of the speed when the tool enters, half
   of it recovered by the drive with a 0.3 s time constant), a slow wander (± ``speed_wander`` at ``wander_hz``)
   and a step (``speed_step`` of the speed over 0.2 s in the middle of the cut: the override turned, or a
-  Harmonizer's new speed). Sizes: the real recording in ``examples/cuts`` runs 0.15–0.2 % faster in air than in
+  Harmonizer's new speed). Sizes: the real recording in ``examples/cuts`` runs 0.1–0.2 % faster in air than in
   the cut (its first two tooth-passing harmonics); an induction motor slips a few percent at full load, of which a
   drive without speed feedback leaves part.
 """

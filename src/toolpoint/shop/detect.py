@@ -612,10 +612,8 @@ def _track_speed(P, frame_t, freq, inband, f_s, f_t, tol, df):
             continue
         j = sel[np.argmax(lp[:, sel], axis=1)]  # (frames,)
         r = np.arange(P.shape[0])
-        y0, y1, y2 = lp[r, j - 1], lp[r, j], lp[r, j + 1]
-        den = y0 - 2 * y1 + y2
-        d = np.where(den < 0, 0.5 * (y0 - y2) / np.where(den < 0, den, -1.0), 0.0)
-        f_k = (freq[j] + np.clip(d, -0.5, 0.5) * df) / (k * f_t / f_s)
+        y1 = lp[r, j]
+        f_k = (freq[j] + _vertex(lp[r, j - 1], y1, lp[r, j + 1]) * df) / (k * f_t / f_s)
         est.append(np.where(y1 - lf[r, j] >= math.log(10.0), f_k, np.nan))
     if len(est) < 2:
         return np.zeros(0), np.zeros(0)
@@ -741,9 +739,16 @@ def _parabola(p, i) -> float:
     """Offset (bins, |·| ≤ ½) of the peak at bin i from a parabola through the log power of bins i − 1 … i + 1."""
     if not (0 < i < p.size - 1 and p[i - 1] > 0 and p[i] > 0 and p[i + 1] > 0):
         return 0.0
-    a, b, c = np.log(p[i - 1]), np.log(p[i]), np.log(p[i + 1])
-    den = a - 2 * b + c
-    return float(np.clip(0.5 * (a - c) / den, -0.5, 0.5)) if den != 0 else 0.0
+    return float(_vertex(np.log(p[i - 1]), np.log(p[i]), np.log(p[i + 1])))
+
+
+def _vertex(a, b, c):
+    """Offset (bins, clipped to ±½) of the vertex of the parabola through a, b, c at bins −1, 0, 1 (0 where they
+    lie on a line); element-wise."""
+    den = np.asarray(a - 2 * b + c, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        off = np.where(den != 0, 0.5 * (a - c) / np.where(den != 0, den, 1.0), 0.0)
+    return np.clip(off, -0.5, 0.5)
 
 
 _GROWTH_T = 4.0
