@@ -516,6 +516,40 @@ def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
         read_test_cuts(p, teeth=4)
 
 
+def test_a_doubtful_record_s_warning_reaches_update_s_report(tmp_path, capsys):
+    # A record without an air cut whose "chatter" sits on 50 Hz (hum from a ground loop: `cut` cannot tell the two
+    # apart, test_cut.py) keeps its chatter label, and its warning goes with the cut to update.json, report.html and
+    # one stderr line naming the table, the line and the record. A record without a doubt carries none.
+    import soundfile as sf
+
+    from shop_synth import shop_record
+
+    x, rate, *_ = shop_record(rpm=6000, teeth=4, air_s=0.0, fans=(), seed=0)
+    t = np.arange(x.size) / rate
+    a = np.std(x) * 10 ** (-10 / 20)
+    x = x + sum(a / k * np.sin(2 * np.pi * 50 * k * t + k) for k in (1, 3, 5, 7))
+    sf.write(tmp_path / "hum.wav", 0.5 * x / np.abs(x).max(), int(rate), subtype="PCM_16")
+    y, rate, *_ = shop_record(rpm=12000, teeth=4, chatter_hz=1310.0, chatter_amp=0.5, seed=8)
+    sf.write(tmp_path / "c1.wav", y, int(rate), subtype="PCM_16")
+    (tmp_path / "prior.toml").write_text(PRIOR_TOML)
+    cuts = tmp_path / "cuts.csv"
+    cuts.write_text("rpm,depth_mm,result,record\n6000,2.0,,hum.wav\n12000,0.8,,c1.wav\n20000,0.5,stable,\n")
+    read = read_test_cuts(cuts, teeth=4)
+    assert [c.stable for c in read] == [False, False, True] and abs(read[0].chatter_hz - 50) < 0.5
+    assert len(read[0].warnings) == 1 and read[0].warnings[0].startswith("hum.wav: chatter at 50.0 Hz sits on")
+    assert read[1].warnings == () and read[2].warnings == ()
+    out = tmp_path / "out"
+    assert main(["update", "--prior", str(tmp_path / "prior.toml"), "--cuts", str(cuts), "--out", str(out),
+                 "--samples", "200"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"{cuts}: line 2: warning: hum.wav: chatter at 50.0 Hz"), err
+    doc = json.loads((out / "update.json").read_text())
+    assert [len(c["warnings"]) for c in doc["cuts"]] == [1, 0, 0]
+    assert doc["cuts"][0]["warnings"][0].startswith("line 2: hum.wav: chatter at 50.0 Hz")
+    html = (out / "report.html").read_text()
+    assert "Warnings from the records" in html and "line 2: hum.wav: chatter at 50.0 Hz sits on the mains" in html
+
+
 @pytest.mark.slow
 @pytest.mark.first
 def test_virtual_campaigns_on_the_example_tool_meet_the_targets():

@@ -11,6 +11,8 @@ not averaged.
 
 from __future__ import annotations
 
+import sys
+
 from ..errors import InputError
 from .common import check_number, out_folder, use_agg
 
@@ -114,6 +116,9 @@ def run(args) -> int:
           f"{' (a step above the stable cut there)' if nc.get('stepped') else ''}; wrote {out}/report.html")
     if cuts:
         print("note: " + away_note([{"rpm": c.rpm} for c in cuts]))
+    for c in cuts:  # a label that rests on a doubtful record: said where the user looks
+        for w in c.warnings:
+            print(f"{args.cuts}: line {c.line}: warning: {w}", file=sys.stderr)
     return 0
 
 

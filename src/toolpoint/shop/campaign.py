@@ -151,7 +151,7 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
         x, fs = make(res, float(rpm), cut.teeth, rng)
         r = analyse_cut(x, fs, rpm=float(rpm), teeth=cut.teeth, full_scale=1.0, **opts)
         return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz,
-                       duration_s=revs * 60.0 / float(rpm))
+                       duration_s=revs * 60.0 / float(rpm), warnings=tuple(r.criterion.get("warnings", ())))
     return shop
 
 

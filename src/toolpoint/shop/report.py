@@ -76,7 +76,8 @@ def _doc(post: Posterior) -> dict:
                         "limit_p95_mm": round(1e3 * rc["limit_p95_m"], 4)},
         "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},
         "cuts": [{"rpm": c.rpm, "depth_mm": round(1e3 * c.depth_m, 6), "result": "stable" if c.stable else "chatter",
-                  "chatter_hz": c.chatter_hz, "duration_s": c.duration_s} for c in post.cuts],
+                  "chatter_hz": c.chatter_hz, "duration_s": c.duration_s,
+                  "warnings": [f"line {c.line}: {w}" if c.line else w for w in c.warnings]} for c in post.cuts],
         "sampler": {"method": post.method, "samples": int(post.z.shape[0]), "ess": [round(e, 1) for e in post.ess],
                     "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
                     "cpu_s": round(post.cpu_s, 2)},
@@ -149,6 +150,9 @@ def _html(post, doc, rows, png) -> str:
     par_rows = "".join("<tr>" + "".join(f"<td>{e(str(v))}</td>" for v in r) + "</tr>" for r in rows)
     s = doc["sampler"]
     caveat = f"<p><b>Note</b>: {e(away_note(doc['cuts']))}</p>" if doc["cuts"] else ""
+    warns = [w for c in doc["cuts"] for w in c["warnings"]]
+    if warns:  # what the records' analysis could not rule out: the labels above rest on it
+        caveat += "<p><b>Warnings from the records</b>:</p><ul>" + "".join(f"<li>{e(w)}</li>" for w in warns) + "</ul>"
     return (
         "<!doctype html><html><head><meta charset='utf-8'><title>toolpoint update</title><style>"
         "body{font-family:sans-serif;max-width:960px;margin:auto}table{border-collapse:collapse}"

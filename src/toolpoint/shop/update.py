@@ -93,8 +93,9 @@ __all__ = ["TestCut", "Posterior", "read_test_cuts", "check_consistent", "log_li
 
 @dataclass(frozen=True)
 class TestCut:
-    """One test cut: speed (rpm), depth (m), stable or not, measured chatter frequency (Hz) if any, and how long
-    the tool cut (s; None: not known, :func:`update`'s ``cut_duration_s``)."""
+    """One test cut: speed (rpm), depth (m), stable or not, measured chatter frequency (Hz) if any, how long
+    the tool cut (s; None: not known, :func:`update`'s ``cut_duration_s``), and what the analysis of its record
+    could not rule out (``warnings``: :func:`toolpoint.shop.analyse_cut`'s, e.g. chatter on a mains harmonic)."""
 
     __test__ = False  # a shop's test cut, not a pytest test class
 
@@ -105,6 +106,7 @@ class TestCut:
     line: int | None = None
     source: str | None = None
     duration_s: float | None = None
+    warnings: tuple = ()
 
 
 def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
@@ -114,7 +116,8 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
     A ``record`` (path relative to the table) is analysed by :func:`toolpoint.shop.analyse_cut` (needs
     ``teeth``): it gives ``result`` and ``chatter_hz`` where the table leaves them empty, and ``duration_s``
     (its longest run of entry, cut and exit); where both are given and disagree the table is refused (a
-    contradiction is reported, not averaged).
+    contradiction is reported, not averaged). What the analysis cannot rule out (chatter on a mains harmonic in a
+    record without an air cut) stays with the cut (``TestCut.warnings``) and reaches the report.
 
     Raises
     ------
@@ -158,6 +161,7 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
         if res and res not in ("stable", "chatter"):
             raise InputError(f"line {line}: must be 'stable' or 'chatter', got {res!r}", file=p, field="result")
         rec = (row.get("record") or "").strip()
+        warns = ()
         if rec:
             if teeth is None:
                 raise InputError(f"line {line}: a record needs the number of teeth", file=p, field="record")
@@ -176,11 +180,12 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                 fc = a.chatter_hz
             if dur is None:
                 dur = _cutting_s(a.segments)
+            warns = tuple(f"{rec}: {w}" for w in a.criterion.get("warnings", ()))
         if not res:
             raise InputError(f"line {line}: empty (and no record)", file=p, field="result")
         if res == "stable" and fc is not None:
             raise InputError(f"line {line}: a stable cut has no chatter frequency", file=p, field="chatter_hz")
-        cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p), dur))
+        cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p), dur, warns))
     if not cuts:
         raise InputError("no test cuts", file=p, field="rpm")
     check_consistent(cuts, source=str(p))
