@@ -260,3 +260,6 @@ def test_the_default_range_widens_to_the_deep_pockets_of_a_lightly_damped_mode()
         narrow.params["depth_max"]
     with pytest.raises(InputError, match="widen"):
         sdm_lobes(mode, mode, c, rpm=rpm, widen=-1)
+    for bad in ({"chatter": "False"}, {"seed": 0}):  # a flag, not a truthy string or number
+        with pytest.raises(InputError, match=f"{next(iter(bad))}.*must be True or False"):
+            sdm_lobes(mode, mode, c, rpm=rpm, **bad)

@@ -830,6 +830,9 @@ def sdm_lobes(
     sysm = _System(as_state_space(modes_x, modes_y), cut)
     acc = _check_accuracy(accuracy)
     grid = check_rpm(rpm)
+    for name, flag in (("seed", seed), ("chatter", chatter)):  # a string "False" would be true
+        if not isinstance(flag, (bool, np.bool_)):
+            raise InputError(f"must be True or False, got {flag!r}", field=name)
     if not step > 1 or not (0 < rtol < 0.1):
         raise InputError("need step > 1 and 0 < rtol < 0.1", field="step/rtol")
     f, phi = _zoa_grid(sysm)
