@@ -327,6 +327,10 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     # the stable cut at 20000 rpm, 0.5 mm: the posterior 5 % limit there is near or above it
     k = np.argmin(np.abs(lobes["rpm"] - 20000))
     assert lobes["p05_mm"][k] > 0.45 and lobes["p95_mm"][k] < 0.95
+    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o5"),
+                 "--risk-after-chatter", "0.35"]) == 2
+    assert "--risk-after-chatter: must be ≤ the bound before any chatter" in capsys.readouterr().err
+    assert not (tmp_path / "o5").exists()
     assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o3"),
                  "--min-step", "-1"]) == 2
     assert "--min-step" in capsys.readouterr().err and not (tmp_path / "o3").exists()
@@ -514,6 +518,28 @@ def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
     p.write_text("rpm,depth_mm,result,record\n12000,0.8,stable,c1.wav\n")
     with pytest.raises(InputError, match="line 2: the table says stable, its record c1.wav says chatter"):
         read_test_cuts(p, teeth=4)
+
+
+def test_a_lower_risk_after_the_first_chatter():
+    # risk_after_chatter bounds the next cut's P(chatter) only once a cut has chattered: with stable cuts alone the
+    # proposal is the default's (same draws); after a chatter it is shallower, within the lower bound (or a step
+    # above stable cuts that crept, which the option leaves alone), and the proposal says which bound it used.
+    pr = cornelius_2024(0.1)
+    kw = dict(n_samples=300, lobe_samples=150, label_offset=(0, 0), label_growth=(0, 0))
+    stable = [TestCut(20000.0, 0.45e-3, True)]
+    a = update(pr, stable, rng=np.random.default_rng(4), **kw).next_cut
+    b = update(pr, stable, rng=np.random.default_rng(4), risk_after_chatter=0.1, **kw).next_cut
+    assert a == b and a["risk"] == 0.3
+    cuts = stable + [TestCut(20000.0, 0.8e-3, False, 1290.0)]
+    a = update(pr, cuts, rng=np.random.default_rng(4), **kw).next_cut
+    b = update(pr, cuts, rng=np.random.default_rng(4), risk_after_chatter=0.1, **kw).next_cut
+    assert a["risk"] == 0.3 and b["risk"] == 0.1 and "≤ 0.1" in b["description"]
+    assert b["p_chatter"] <= 0.1 + 1e-9 or b["stepped"], b
+    assert a["p_chatter"] > 0.1 and b["depth_m"] < a["depth_m"] or a["rpm"] != b["rpm"], (a, b)
+    r = update(pr, cuts, rng=np.random.default_rng(4), rule="risk", risk=0.2, risk_after_chatter=0.05, **kw).next_cut
+    assert r["risk"] == 0.05 and r["p_chatter"] <= 0.05 + 1e-9
+    with pytest.raises(InputError, match="risk_after_chatter"):
+        update(pr, cuts, rng=np.random.default_rng(4), risk_after_chatter=0.4, **kw)
 
 
 def test_a_doubtful_record_s_warning_reaches_update_s_report(tmp_path, capsys):

@@ -38,6 +38,9 @@ def register(sub) -> None:
                    help="next-cut rule: info = most reduction of the limit's band at the recommended speed with "
                    "P(chatter) ≤ risk (default); risk = most productive cut with P(chatter) ≤ risk")
     p.add_argument("--risk", help="largest P(chatter) of the next cut (default 0.3 for info, 0.1 for risk)")
+    p.add_argument("--risk-after-chatter",
+                   help="largest P(chatter) of the next cut once a cut has chattered (≤ --risk; default: --risk): "
+                   "fewer chattering cuts, a wider band (docs/design/shop.md)")
     p.add_argument("--min-step",
                    help="info rule: once two stable cuts at a speed are closer than e^STEP, a cut e^STEP above the "
                    "highest may be proposed even past --risk, so stable cuts do not creep (default 0.1 = 2 × the "
@@ -70,6 +73,13 @@ def run(args) -> int:
     risk = None if args.risk is None else check_number(args.risk, "--risk", above=0)
     if risk is not None and risk > 0.5:
         raise InputError(f"must be ≤ 0.5, got {args.risk}", file="command line", field="--risk")
+    rac = None if args.risk_after_chatter is None else check_number(args.risk_after_chatter, "--risk-after-chatter",
+                                                                      above=0)
+    from ..shop.update import DEFAULT_RISK
+
+    if rac is not None and rac > (risk if risk is not None else DEFAULT_RISK[args.rule]):
+        raise InputError(f"must be ≤ the bound before any chatter (--risk), got {args.risk_after_chatter}",
+                         file="command line", field="--risk-after-chatter")
     min_step = None if args.min_step is None else check_number(args.min_step, "--min-step", minimum=0)
     if min_step is not None and min_step > 0.5:
         raise InputError(f"must be ≤ 0.5 (a log step: ×1.65), got {args.min_step}", file="command line",
@@ -107,7 +117,8 @@ def run(args) -> int:
     cuts = read_test_cuts(args.cuts, teeth=prior.cutting.teeth) if args.cuts else []
     use_agg()
     post = update(prior, cuts, rng=np.random.default_rng(int(seed)), n_samples=int(n), method=args.method,
-                  rule=args.rule, risk=risk, forward=args.forward, min_step=min_step, **offset)
+                  rule=args.rule, risk=risk, forward=args.forward, min_step=min_step, risk_after_chatter=rac,
+                  **offset)
     write_update(post, out)
     rc, nc = post.recommended, post.next_cut
     print(f"{len(cuts)} test cuts; recommended {rc['rpm']:.0f} rpm at {1e3 * rc['depth_m']:.3f} mm "
