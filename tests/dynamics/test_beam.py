@@ -103,7 +103,7 @@ def test_mass_line_and_reciprocity():
     st.booleans(),
     st.floats(0, 0.05),
 )
-# Found by CI (2026-11-27): a thin neck between thick segments cost the chain 1e-7 at Σ βL 5.7. A chain result that
+# Found by CI (2026-11-27): a thin neck between thick segments cost the chain 1e-7 at Σ βL 5.5. A chain result that
 # fails reciprocity by more than CHAIN_RECIPROCITY now goes to the sweep.
 @example([(16.0, 90.0, 0.0), (5.0, 8.0, 0.0), (94.0, 30.0, 0.0), (6.0, 8.0, 0.0), (118.0, 85.0, 0.0)], False, 0.0)
 @example([(11.0, 79.0, 0.0), (5.0, 8.0, 0.0), (88.0, 22.0, 0.0), (6.0, 8.0, 0.0), (109.0, 73.0, 0.0)], False, 0.0)

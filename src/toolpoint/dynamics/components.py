@@ -289,7 +289,7 @@ def end_receptances(component: Component, freq_hz, ends: str = "both", *,
         Rc = _chain_receptance(m, w[idx])
         # The chain reaches the cross receptances by two routes (T21⁻¹ and T11T21⁻¹T22 − T12): they agree as far as
         # the chain kept its digits. A stiffness contrast (a thin neck between thick segments) costs digits that
-        # Σ βL does not see: 8 mm between 90 mm lost 1e-7 at Σ βL 5.7, where the sweep kept 2e-14. Where
+        # Σ βL does not see: 8 mm between 90 mm lost 1e-7 at Σ βL 5.5, where the sweep kept 6e-15. Where
         # reciprocity fails by more than CHAIN_RECIPROCITY, the sweep takes the frequency.
         asym = np.abs(Rc - np.swapaxes(Rc, 1, 2)).max(axis=(1, 2)) / np.abs(Rc).max(axis=(1, 2))
         ok = asym <= CHAIN_RECIPROCITY
