@@ -465,9 +465,9 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         throughout). The first chatter gives the bracket its upper side; a lower bound after it spends fewer
         tools on the rest, and buys that with a wider band: on EM16-50 in the whole loop (10 truths, 6 cuts) 0.1
         brought the chattering cuts from a median of 2 to 1 (0.10 of the cuts after the first chatter chattered,
-        against 0.30), and the band at the recommended speed from 0.27 to 0.33 wide; 0 of 10 truths converged
-        against 3 (``docs/design/shop.md``). A step above stable cuts that crept (``min_step``) is still proposed
-        past it.
+        against 0.25–0.30), and the band at the recommended speed from 0.23–0.27 to 0.32–0.33 wide; 0 of 10 truths
+        converged against 2–3 (``docs/design/shop.md``). A step above stable cuts that crept (``min_step``) is
+        still proposed past it.
 
     Returns
     -------
