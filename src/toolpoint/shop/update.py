@@ -728,14 +728,14 @@ def _sdm_log_ratio(prior, theta, rpm_cuts, grid, f):
     return out_c, out_g
 
 
-def _sdm_own_log_ratio(prior, z, u, f, lr_guess):
+def _sdm_own_log_ratio(prior, z, u, f, lr_guess, zoa=None):
     """ln(a_SDM / a_ZOA) of each sample (S, U) at the speeds u: its own SDM limit
     (:func:`~toolpoint.stability.sdm_limit_near`, from its zero-order limit times e^lr_guess); 0 where no lobe
-    reaches the speed."""
+    reaches the speed. ``zoa``: the samples' ``limit_at_speeds`` at u, when the caller has it."""
     from ..stability import sdm_limit_near
 
     th = prior.theta(z)
-    a_zoa, fc = limit_at_speeds(prior, th, u, f)  # (S, U)
+    a_zoa, fc = limit_at_speeds(prior, th, u, f) if zoa is None else zoa  # (S, U)
     guess = a_zoa * np.exp(np.broadcast_to(lr_guess, a_zoa.shape))
     own = np.full(a_zoa.shape, np.nan)
     for i in range(th.shape[0]):  # one model per sample: vectorised over its speeds
@@ -759,10 +759,12 @@ def _first_cut_own(prior, z, f, grid, lim, nxt, bound):
     shop.md``). It costs one ``sdm_limit_near`` per lobe sample at one speed: 4–8 s on EM16-50."""
     k = int(np.argmin(np.abs(grid - nxt["rpm"])))
     u = grid[k:k + 1]
-    a_zoa = limit_at_speeds(prior, prior.theta(z), u, f)[0][:, 0]
+    zoa = limit_at_speeds(prior, prior.theta(z), u, f)
+    a_zoa = zoa[0][:, 0]
     with np.errstate(divide="ignore", invalid="ignore"):
         guess = np.nanmedian(np.log(lim[:, k] / a_zoa))
-    own = a_zoa * np.exp(_sdm_own_log_ratio(prior, z, u, f, np.array([guess if np.isfinite(guess) else 0.0]))[:, 0])
+    lr = _sdm_own_log_ratio(prior, z, u, f, np.array([guess if np.isfinite(guess) else 0.0]), zoa=zoa)[:, 0]
+    own = a_zoa * np.exp(lr)
     own = np.where(np.isfinite(own), own, np.inf)
     d = nxt["depth_m"]
     p = float(np.mean(own <= d))
