@@ -328,7 +328,10 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                 if verbose:
                     print(f"   seed {seed}: converged after {r.converged_after}, {chat[-1]} chattering; cuts "
                           + " ".join(f"{c.rpm:.0f}/{1e3 * c.depth_m:.2f}{'s' if c.stable else 'C'}" for c in r.cuts)
-                          + f"; width {np.round(r.width, 2).tolist()}; coverage {np.round(r.coverage, 2).tolist()}",
+                          + f"; width {np.round(r.width, 2).tolist()}; coverage {np.round(r.coverage, 2).tolist()}"
+                          + ("; truth below the recommended depth after "
+                             + ",".join(str(n) for n, b in enumerate(r.below_recommended) if b)
+                             if any(r.below_recommended) else ""),
                           flush=True)
             conv = np.array(conv)
             p90 = np.sort(conv)[int(np.ceil(0.9 * conv.size)) - 1]  # inf where a tenth did not converge
