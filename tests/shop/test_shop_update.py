@@ -527,7 +527,7 @@ def test_the_first_cut_s_risk_holds_on_truths_from_the_prior():
     With the four references' ratio alone the first cuts claimed 0.28 and 0.37 of such truths chattered (8 seeds,
     100 truths each); with the samples' own SDM limits at the cut's speed 0.30 claimed, 0.28 realised. This test
     (60 speeds instead of 200, which costs a third less; 2026-11-27): 0.29 claimed, 0.39 realised without that
-    check; 0.30 and 0.29 with it. ~45 s CPU."""
+    check; 0.30 and 0.29 with it. 35 s alone (45 s before one BLAS controller per process)."""
     from toolpoint.shop.model import example_tool, sdm_limits
 
     pr = example_tool(0.15)

@@ -756,7 +756,8 @@ def _first_cut_own(prior, z, f, grid, lim, nxt, bound):
     productive — where it is likely too high. Measured (2026-11-27; 8–10 seeds, 100 truths from the prior each):
     first cuts that claimed P(chatter) 0.28 chattered for 0.37 of the truths on the example tool and 0.34 on
     EM16-50 (0.29 on the Cornelius case); with this check 0.28–0.30 claimed, 0.27–0.28 realised (``docs/design/
-    shop.md``). It costs one ``sdm_limit_near`` per lobe sample at one speed: 4–8 s on EM16-50."""
+    shop.md``). It costs one ``sdm_limit_near`` per lobe sample at one speed: 3.2 s CPU on EM16-50 (of a
+    17 s prior update; 2026-11-27, one BLAS controller per process)."""
     k = int(np.argmin(np.abs(grid - nxt["rpm"])))
     u = grid[k:k + 1]
     zoa = limit_at_speeds(prior, prior.theta(z), u, f)
