@@ -121,8 +121,12 @@ def run(args) -> int:
                   **offset)
     write_update(post, out)
     rc, nc = post.recommended, post.next_cut
+    low = rc["limit_p05_m"] > rc["depth_m"]  # the samples' own SDM limits put it lower
     print(f"{len(cuts)} test cuts; recommended {rc['rpm']:.0f} rpm at {1e3 * rc['depth_m']:.3f} mm "
-          f"(P(stable) {rc['p_stable']:.2f}); next test cut ({nc['rule']}) {nc['rpm']:.0f} rpm at "
+          f"(P(stable) {rc['p_stable']:.2f}"
+          + (f"; the band's 5 % limit {1e3 * rc['limit_p05_m']:.3f} mm, lowered by posterior samples' own SDM limits"
+             if low else "")
+          + f"); next test cut ({nc['rule']}) {nc['rpm']:.0f} rpm at "
           f"{1e3 * nc['depth_m']:.3f} mm, P(chatter) {nc['p_chatter']:.2f}"
           f"{' (a step above the stable cut there)' if nc.get('stepped') else ''}; wrote {out}/report.html")
     if cuts:

@@ -72,8 +72,13 @@ def _doc(post: Posterior) -> dict:
     return {
         "prior": post.prior.name,
         "recommended": {"rpm": round(rc["rpm"], 1), "depth_mm": round(1e3 * rc["depth_m"], 4),
-                        "p_stable": round(rc["p_stable"], 3), "limit_p50_mm": round(1e3 * rc["limit_p50_m"], 4),
-                        "limit_p95_mm": round(1e3 * rc["limit_p95_m"], 4)},
+                        "p_stable": round(rc["p_stable"], 3),
+                        "limit_p05_mm": round(1e3 * rc["limit_p05_m"], 4),
+                        "limit_p50_mm": round(1e3 * rc["limit_p50_m"], 4),
+                        "limit_p95_mm": round(1e3 * rc["limit_p95_m"], 4),
+                        # forward="sdm": the lobe samples' own SDM 5 % limit at this speed (the depth is the lower)
+                        "own_sdm_p05_mm": (None if rc["own_sdm_p05_m"] is None
+                                           else round(1e3 * rc["own_sdm_p05_m"], 4))},
         "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},
         "cuts": [{"rpm": c.rpm, "depth_mm": round(1e3 * c.depth_m, 6), "result": "stable" if c.stable else "chatter",
                   "chatter_hz": c.chatter_hz, "duration_s": c.duration_s,
@@ -159,6 +164,8 @@ def _html(post, doc, rows, png) -> str:
         "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}</style></head><body>"
         f"<h1>Test cuts → lobes: {e(post.prior.name)}</h1>"
         f"<p><b>Recommended</b>: {rc['rpm']:.0f} rpm at {rc['depth_mm']:.3f} mm (P(stable) {rc['p_stable']:.2f}; "
+        + (f"the band's 5 % limit {rc['limit_p05_mm']:.3f} mm, lowered by posterior samples' own SDM limits; "
+           if rc["limit_p05_mm"] > rc["depth_mm"] else "") +
         f"median limit {rc['limit_p50_mm']:.3f} mm).<br><b>Next test cut</b> ({e(nc['rule'])}: "
         f"{e(nc['description'])}): {nc['rpm']:.0f} rpm at {nc['depth_mm']:.3f} mm, P(chatter) "
         f"{nc['p_chatter']:.2f}.</p>{caveat}"
