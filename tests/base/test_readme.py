@@ -37,7 +37,9 @@ def _readme_table1() -> dict:
                       ("**hybrid**", "hybrid")):
         line = next(ln for ln in README.splitlines() if ln.startswith(f"| {name} |"))
         cells = [c.strip() for c in line.strip("|").split("|")][1:]
-        rows[key] = {"errors": cells[:4], "evaluations": int(cells[4].replace(",", ""))}
+        # one count, or the count and the one another CPU gives ("27,168 (28,400†)": the README's footnote)
+        rows[key] = {"errors": cells[:4], "evaluations": [int(v.replace(",", "")) for v in
+                                                          re.findall(r"\d[\d,]*", cells[4])]}
     return rows
 
 
@@ -54,4 +56,5 @@ def test_table1_numbers_are_what_reproduce_prints(tmp_path):
                 assert err < float(shown[1:]), (m, shown, err)
             else:  # printed with two significant digits
                 assert f"{err:.2g}" == shown, (m, shown, err)
-        assert doc["evaluations"] == pytest.approx(row["evaluations"], rel=0.02), m
+        assert any(doc["evaluations"] == pytest.approx(n, rel=0.02) for n in row["evaluations"]), \
+            (m, doc["evaluations"], row["evaluations"])

@@ -565,7 +565,7 @@ def test_the_recommended_depth_holds_on_truths_from_the_prior():
     calibrated: the speed is chosen where the lobe samples' and the four references' estimate looks most
     productive (8 seeds × 100 truths on 200 speeds: 0.138 of the truths below it); the depth checked by the own SDM
     limits of posterior samples that are not the lobe samples, 0.046 (``docs/design/shop.md``). Here (4 seeds × 150
-    truths, 100 speeds; 2026-11-27): 0.114 below the band's 5 % limit, 0.062 below the checked depth."""
+    truths, 100 speeds; 2026-11-27): 0.113 below the band's 5 % limit, 0.057 below the checked depth."""
     band, checked = [], []
     for post, truth_limits in _prior_updates(2000, 4, 100):
         rc = post.recommended
