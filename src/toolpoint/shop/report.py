@@ -76,7 +76,7 @@ def _doc(post: Posterior) -> dict:
                         "limit_p05_mm": round(1e3 * rc["limit_p05_m"], 4),
                         "limit_p50_mm": round(1e3 * rc["limit_p50_m"], 4),
                         "limit_p95_mm": round(1e3 * rc["limit_p95_m"], 4),
-                        # forward="sdm": the lobe samples' own SDM 5 % limit at this speed (the depth is the lower)
+                        # forward="sdm": held-out posterior samples' own SDM 5 % limit here (the depth: the lower)
                         "own_sdm_p05_mm": (None if rc["own_sdm_p05_m"] is None
                                            else round(1e3 * rc["own_sdm_p05_m"], 4))},
         "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},

@@ -49,8 +49,9 @@ Lobes: the posterior samples' zero-order limits on a speed grid (:func:`~toolpoi
 their 5/50/95 % quantiles and P(stable) = share of samples whose limit exceeds a depth.
 
 Recommended point: the speed that maximises n · a₀₅(n) (removal rate at a fixed feed per tooth and width)
-at the depth a₀₅ (P(stable) = 0.95); with ``forward="sdm"`` the depth is lowered to the lobe samples' own SDM
-5 % limit at that speed where that is lower (``update``). **Next test cut**, two rules:
+at the depth a₀₅ (P(stable) = 0.95); with ``forward="sdm"`` the depth is lowered to the own SDM 5 % limit, at
+that speed, of posterior samples other than the lobe samples where that is lower (``update``). **Next test
+cut**, two rules:
 
 * ``"info"`` (default): the cut that most reduces the expected log width ln(a₉₅/a₀₅) of the limit at
   the recommended speed, among cuts at the most productive speeds (the 6 best by n · a₅₀ and the
@@ -419,9 +420,11 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         cuts the prior's lobes are corrected by ``sdm_refs`` prior samples' ratios, and the first cut's
         P(chatter) is that of the lobe samples' own SDM limits at its speed (its depth lowered to the bound where
         they put it above: the references' estimate claimed 0.28 where 0.34–0.37 chattered). The recommended
-        depth is the lower of the band's 5 % limit and the lobe samples' own SDM 5 % limit at its speed, its
-        P(stable) theirs (``recommended["limit_p05_m"]``, ``["own_sdm_p05_m"]``): the speed is where the
-        references' estimate is most productive, so likely too high there. Limits: ``docs/design/shop.md``.
+        depth is the lower of the band's 5 % limit and the own SDM 5 % limit at its speed of up to
+        ``lobe_samples`` posterior samples that are not the lobe samples, its P(stable) theirs
+        (``recommended["limit_p05_m"]``, ``["own_sdm_p05_m"]``): the speed is where the lobe samples' estimate
+        is most productive, so likely too high there (on the example tool's prior 0.138 of truths lay below the
+        band's 5 % limit, 0.046 below the checked depth). Limits: ``docs/design/shop.md``.
     sdm_refs : int, default 4
         Reference samples of ``forward="sdm"`` (each costs one SDM lobe computation on the grid).
     miss_rate : float, default 0
