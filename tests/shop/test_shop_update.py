@@ -322,7 +322,7 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     assert 5000 <= doc["recommended"]["rpm"] <= 25000 and len(doc["cuts"]) == 3
     # the zero-order forward model has no SDM check: the recommended depth is the band's 5 % limit
     assert doc["recommended"]["depth_mm"] == doc["recommended"]["limit_p05_mm"]
-    assert doc["recommended"]["own_sdm_p05_mm"] is None
+    assert doc["recommended"]["own_sdm_p05_mm"] is None and doc["recommended"]["own_sdm_held_out"] is None
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "src='http" not in html and "<script src" not in html
     lobes = np.genfromtxt(out / "lobes.csv", delimiter=",", names=True)
@@ -711,6 +711,7 @@ def test_sdm_forward_model_follows_cuts_that_follow_the_sdm():
             assert np.all(post.limit_q_m[0] <= a_sdm) and np.all(a_sdm <= post.limit_q_m[2])
             # the recommended depth: the lower of the band's 5 % limit and held-out samples' own SDM 5 % limit
             assert rc["depth_m"] == min(rc["limit_p05_m"], rc["own_sdm_p05_m"]) and rc["p_stable"] >= 0.95
+            assert rc["own_sdm_held_out"] is True  # 150 of the 300 samples are not the lobe samples
         else:
             assert rc["own_sdm_p05_m"] is None and rc["depth_m"] == rc["limit_p05_m"]
     assert np.all(np.abs(med["sdm"] - 1) < 0.1), med

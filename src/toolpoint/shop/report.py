@@ -78,7 +78,8 @@ def _doc(post: Posterior) -> dict:
                         "limit_p95_mm": round(1e3 * rc["limit_p95_m"], 4),
                         # forward="sdm": held-out posterior samples' own SDM 5 % limit here (the depth: the lower)
                         "own_sdm_p05_mm": (None if rc["own_sdm_p05_m"] is None
-                                           else round(1e3 * rc["own_sdm_p05_m"], 4))},
+                                           else round(1e3 * rc["own_sdm_p05_m"], 4)),
+                        "own_sdm_held_out": rc["own_sdm_held_out"]},
         "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},
         "cuts": [{"rpm": c.rpm, "depth_mm": round(1e3 * c.depth_m, 6), "result": "stable" if c.stable else "chatter",
                   "chatter_hz": c.chatter_hz, "duration_s": c.duration_s,

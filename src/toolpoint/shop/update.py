@@ -424,7 +424,9 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         ``lobe_samples`` posterior samples that are not the lobe samples, its P(stable) theirs
         (``recommended["limit_p05_m"]``, ``["own_sdm_p05_m"]``): the speed is where the lobe samples' estimate
         is most productive, so likely too high there (on the example tool's prior 0.138 of truths lay below the
-        band's 5 % limit, 0.046 below the checked depth). Limits: ``docs/design/shop.md``.
+        band's 5 % limit, 0.046 below the checked depth). Where fewer than 100 samples are left beyond the lobe
+        samples (``n_samples`` < ``lobe_samples`` + 100) the lobe samples check it, which the choice did see
+        (0.081 there); ``recommended["own_sdm_held_out"]`` says which. Limits: ``docs/design/shop.md``.
     sdm_refs : int, default 4
         Reference samples of ``forward="sdm"`` (each costs one SDM lobe computation on the grid).
     miss_rate : float, default 0
@@ -595,7 +597,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     q05 = np.where(np.isfinite(q[0]), q[0], np.nan)
     j = int(np.nanargmax(grid * q05))
     rec = {"rpm": float(grid[j]), "depth_m": float(q05[j]), "p_stable": float(np.mean(lim[:, j] > q05[j])),
-           "limit_p05_m": float(q05[j]), "own_sdm_p05_m": None,
+           "limit_p05_m": float(q05[j]), "own_sdm_p05_m": None, "own_sdm_held_out": None,
            "limit_p50_m": float(q[1, j]), "limit_p95_m": float(q[2, j])}
     # once a cut has chattered the bracket has its upper side: the remaining cuts may be bounded lower
     bound = risk if risk_after_chatter is None or all(c.stable for c in cuts) else risk_after_chatter
@@ -790,7 +792,7 @@ def _recommended_own(prior, z, f, grid, lim, rec, lobe_samples=False):
     kq = int(math.floor(0.05 * own.size + 1e-9))
     srt = np.sort(own)
     q = float(srt[kq - 1]) if kq >= 1 else float(srt[0] * (1 - 1e-9))
-    out = dict(rec, own_sdm_p05_m=q if np.isfinite(q) else None)
+    out = dict(rec, own_sdm_p05_m=q if np.isfinite(q) else None, own_sdm_held_out=not lobe_samples)
     if np.isfinite(q) and q < rec["depth_m"]:
         out["depth_m"] = q
     out["p_stable"] = float(np.mean(own > out["depth_m"]))
