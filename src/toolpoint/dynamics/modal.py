@@ -475,9 +475,15 @@ class _Problem:
         cost = float(r @ r)
         J = self.jac(p)
         mu = 1e-3
+        d_max = np.zeros(p.size)
         for _ in range(10 * (p.size + 1)):  # at most; a converging fit needs far fewer
             H, g = J.T @ J, J.T @ r
-            d = np.diag(H).copy()
+            # Moré's scaling (MINPACK): the largest diagonal met so far, not the current one. A residual pole
+            # run to critical damping is flat in ln ω_d; scaled by that column's current ~0 norm, the step
+            # along it was ~1e5 with a round-off sign, and the model chosen flipped between CPUs (a 1e-15
+            # change of a blank's FRFs flipped it in 9 of 30 fits; docs/design/measurements.md)
+            d_max = np.maximum(d_max, np.diag(H))
+            d = d_max.copy()
             d[d <= 0] = 1.0  # a clipped parameter (zero column): no step
             try:
                 step = -np.linalg.solve(H + mu * np.diag(d), g)
