@@ -17,7 +17,9 @@ The detector (:func:`analyse_cut`):
    (spindles slow down under load; a shop's nominal speed is rarely exact);
 2. **segments** — frame energy in the band, split at a two-level (Otsu) threshold into air cut and
    cutting when the levels differ by ≥ ``activity_db`` (see *Automatic gain control* below for the loud
-   stretches without tooth passing that are air all the same); each cutting run gets an entry and an exit part
+   stretches without tooth passing that are air all the same; when no level splits, as under a loud coolant
+   that runs through air cut and cut, the prominence of the tooth-passing harmonics in the long frames splits it
+   instead); each cutting run gets an entry and an exit part
    (the first and last ``max(0.2 s, 10 rev)``, at most 20 % of it) and its middle is cut in windows of
    ``window_s`` judged one by one (neighbours with the same verdict merged);
 3. **harmonics removed** — every bin within ``2 Δf + 0.05 % f`` (the Hann window's main lobe, and the
@@ -92,9 +94,10 @@ The detector (:func:`analyse_cut`):
    cutting: developed chatter lowers the prominence too (heavy chatter at a pocket: 25–30 dB → 9–14 dB, the air
    5–7 dB), and shorter disagreements where the tool enters and leaves are left to the level. (b) The air cut as
    the reference of "new": the cut, recorded with less gain, stands less far above it (a simulated chatter line rose
-   42 dB over the air cut without gain control, 3 dB through one). Cutting adds sound to what ran in air, so a cut whose noise floor
-   lies under the air cut's was recorded with less gain: the air cut's spectrum is lowered by the 10th percentile
-   of the blocks' floor ratio when that is below 1 (``air_gain_db`` of each segment; a warning from −3 dB).
+   42 dB over the air cut without gain control, 3 dB through one). Cutting adds sound to what ran in air, so a
+   cut whose noise floor lies under the air cut's was recorded with less gain: the air cut's spectrum is lowered
+   by the 10th percentile of the blocks' floor ratio when that is below 1 (``air_gain_db`` of each segment; a
+   warning from −3 dB).
    Measured on 1 785 records of simulated cuts (``docs/design/shop.md``, *Automatic gain control*): without gain
    control 98.8 % right, no verdict changed; through a gain control of 0.05 s attack and 2 s release 89.5 % right
    with 113 false chatter before, 98.7 % and none after; of 0.5 s attack and release 86.2 % with 183 false
@@ -495,6 +498,15 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 best_sep, active = split[1], split[0]
     short_t = cs / rate
     min_air = max(0.5, 20 / f_nom, 1.5 * L / rate)  # an air cut is long enough to give a reference spectrum
+    if Ps.shape[0] >= 16 and best_sep == 0 and P.shape[0] >= 3:
+        # no level splits the record: a loud steady noise (flood coolant, an extraction fan) that runs through air
+        # cut and cut alike hides the cut's few dB. The tooth-passing harmonics still stand out in the cut only,
+        # read in the long frames (their lines stand 4× further out of a broadband noise than in the short ones)
+        prom_l = median_filter(_tooth_prominence_db(P, freq, teeth * f_nom, max(rpm_tolerance, 0.005), lo, hi), 3,
+                               mode="nearest")
+        split = _two_levels(np.interp(short_t, frame_t, prom_l), n_min, activity_db)
+        if split is not None:
+            active = split[0]
     if Ps.shape[0] >= 16 and best_sep > 0 and (~active).sum() >= n_min:
         # loud, but the tooth-passing harmonics stand out no more than in the air cut, for as long as an air cut
         # lasts: air cut. A recorder's automatic gain control levels air cut and cut, and the level alone then takes
