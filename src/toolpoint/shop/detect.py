@@ -83,27 +83,28 @@ The detector (:func:`analyse_cut`):
    one residue) and strong and sustained as above (its aliases: the candidates k ± N, k ± 2N). With two teeth
    every non-tooth harmonic has the same residue and such chatter cannot be told from runout on a spectrum.
 
-   *Automatic gain control.* A phone or a recorder with gain control levels the record: within its attack time
-   the cut is brought down to the air cut's loudness, and the air after the cut comes back up within its release
-   time. Two things go wrong without care. (a) The segments: the air before the cut is as loud as the cut, and
-   a split by level takes it for cutting (judged with no air to compare against: false chatter from fans).
-   Forced vibration at the tooth passing is what cutting adds, and its prominence within a frame (the median over
-   the first 8 tooth harmonics of the strongest line near k f_t over the median power within ±f_t/2 of it) does
-   not move with the gain: a loud stretch whose prominence stays within 2 dB of the air cut's own (smoothed over
-   9 short frames) for as long as an air cut lasts is air. Only then, and only inside what the level called
-   cutting: developed chatter lowers the prominence too (heavy chatter at a pocket: 25–30 dB → 9–14 dB, the air
-   5–7 dB), and shorter disagreements where the tool enters and leaves are left to the level. (b) The air cut as
+   *Automatic gain control.* A phone or a recorder with gain control levels the record: within its attack time the
+   cut is brought down to the air cut's loudness, and the air after the cut comes back up within its release time.
+   Two things go wrong without care. (a) The segments: the air before the cut is as loud as the cut, and a split by
+   level takes it for cutting (judged with no air to compare against: false chatter from fans). Forced vibration at
+   the tooth passing is what cutting adds, and its prominence within a frame (the median over the first 8 tooth
+   harmonics of the strongest line near k f_t over the median power within ±f_t/2 of it) does not move with the gain:
+   a loud stretch whose prominence stays within 2 dB of the air cut's own (smoothed over 9 short frames, or in the
+   long frames where the short ones do not resolve the tooth-passing harmonics) for as long as an air cut lasts is
+   air; where the loud level holds less tooth passing than the quiet one (the control lifted the air before the cut
+   above the cut), the prominence splits the record instead. The veto acts only then, and only inside what the level
+   called cutting: developed chatter lowers the prominence too (heavy chatter at a pocket: 25–30 dB → 9–14 dB, the
+   air 5–7 dB), and shorter disagreements where the tool enters and leaves are left to the level. (b) The air cut as
    the reference of "new": the cut, recorded with less gain, stands less far above it (a simulated chatter line rose
-   42 dB over the air cut without gain control, 3 dB through one). Cutting adds sound to what ran in air, so a
-   cut whose noise floor lies under the air cut's was recorded with less gain: the air cut's spectrum is lowered
-   by the 10th percentile of the blocks' floor ratio when that is below 1 (``air_gain_db`` of each segment; a
-   warning from −3 dB).
-   Measured on 1 785 records of simulated cuts (``docs/design/shop.md``, *Automatic gain control*): without gain
-   control 98.8 % right, no verdict changed; through a gain control of 0.05 s attack and 2 s release 89.5 % right
-   with 113 false chatter before, 98.7 % and none after; of 0.5 s attack and release 86.2 % with 183 false
+   42 dB over the air cut without gain control, 3 dB through one). Cutting adds sound to what ran in air, so a cut
+   whose noise floor lies under the air cut's was recorded with less gain: the air cut's spectrum is lowered by the
+   10th percentile of the blocks' floor ratio when that is below 1 (``air_gain_db`` of each segment; a warning from
+   −3 dB). Measured on 1 785 records of simulated cuts (``docs/design/shop.md``, *Automatic gain control*): without
+   gain control 98.8 % right, no verdict changed; through a gain control of 0.05 s attack and 2 s release 89.5 %
+   right with 113 false chatter before, 98.7 % and none after; of 0.5 s attack and release 86.2 % with 183 false
    before, 98.3 % and none after — a chatter that grows while the gain falls grows less on the record. The real
-   recording in ``examples/cuts`` has its cut's floor 3–6 dB under the air cut's (its lowest frequencies
-   6–10 dB): it was recorded with some gain control; its verdicts are unchanged.
+   recording in ``examples/cuts`` has its cut's floor 3–6 dB under the air cut's (its lowest frequencies 6–10 dB): it
+   was recorded with some gain control; its verdicts are unchanged.
 5. **once-per-revolution metric** (where the segment holds ≥ 10 revolutions): the signal resampled at
    64 points per revolution, R = 1 − E_sync/E_total (E_sync: energy of the revolution-synchronous mean,
    with its finite-average bias removed): 0 for a periodic (stable, noiseless) signal, → 1 for chatter
@@ -498,24 +499,34 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 best_sep, active = split[1], split[0]
     short_t = cs / rate
     min_air = max(0.5, 20 / f_nom, 1.5 * L / rate)  # an air cut is long enough to give a reference spectrum
-    if Ps.shape[0] >= 16 and best_sep == 0 and P.shape[0] >= 3:
+    # how far the tooth-passing harmonics stand out: in the short frames where they resolve them (≥ 8 bins between
+    # tooth-passing harmonics; smoothed over 9 frames), else in the long ones (a slow spindle's harmonics; smoothed
+    # over 3 frames and read at the short frames' times). Where no level splits the record, in the long frames
+    # always: their lines stand 4x further out of a broadband noise than in the short ones
+    prom = prom_long = None
+    if Ps.shape[0] >= 16 and P.shape[0] >= 3:
+        tol = max(rpm_tolerance, 0.005)
+        prom_long = np.interp(short_t, frame_t, median_filter(
+            _tooth_prominence_db(P, freq, teeth * f_nom, tol, lo, hi), 3, mode="nearest"))
+        prom = prom_long if teeth * f_nom < 8 * rate / Ls else median_filter(
+            _tooth_prominence_db(Ps, fs_, teeth * f_nom, tol, lo, hi), 9, mode="nearest")
+        if best_sep == 0:
+            prom = prom_long
+    if prom is not None and (best_sep == 0 or active.all() or
+                             (~active).any() and np.mean(prom[active]) < np.mean(prom[~active])):
         # no level splits the record: a loud steady noise (flood coolant, an extraction fan) that runs through air
-        # cut and cut alike hides the cut's few dB. The tooth-passing harmonics still stand out in the cut only,
-        # read in the long frames (their lines stand 4× further out of a broadband noise than in the short ones)
-        prom_l = median_filter(_tooth_prominence_db(P, freq, teeth * f_nom, max(rpm_tolerance, 0.005), lo, hi), 3,
-                               mode="nearest")
-        split = _two_levels(np.interp(short_t, frame_t, prom_l), n_min, activity_db)
+        # cut and cut alike hides the cut's few dB. Or the loud level is the one without tooth passing: a gain
+        # control lifted the air before the cut above the cut. The tooth-passing harmonics stand out in the cut only
+        split = _two_levels(prom, n_min, activity_db)
         if split is not None:
             active = split[0]
-    if Ps.shape[0] >= 16 and best_sep > 0 and (~active).sum() >= n_min:
+    elif prom is not None and (~active).sum() >= n_min:
         # loud, but the tooth-passing harmonics stand out no more than in the air cut, for as long as an air cut
         # lasts: air cut. A recorder's automatic gain control levels air cut and cut, and the level alone then takes
         # the air before the cut for cutting; the harmonics' prominence within a frame does not move with the gain.
-        # Only where it is at the air's own (its median + 2 dB, smoothed over 9 frames): developed chatter lowers
-        # it in the cut too (heavy chatter at a pocket: from 25–30 dB to 9–14 dB, the air's 5–7 dB), and shorter
+        # Only where it is at the air's own (its median + 2 dB): developed chatter lowers it in the cut too (heavy
+        # chatter at a pocket: from 25–30 dB to 9–14 dB in the short frames, the air's 5–7 dB), and shorter
         # disagreements (where the tool enters and leaves) are left to the level.
-        prom = median_filter(_tooth_prominence_db(Ps, fs_, teeth * f_nom, max(rpm_tolerance, 0.005), lo, hi), 9,
-                             mode="nearest")
         like_air = active & (prom <= np.median(prom[~active]) + _AIR_PROMINENCE_DB)
         if (active & ~like_air).sum() >= n_min:
             for s, e, v in _runs(like_air):
