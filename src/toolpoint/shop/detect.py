@@ -89,22 +89,21 @@ The detector (:func:`analyse_cut`):
    level takes it for cutting (judged with no air to compare against: false chatter from fans). Forced vibration at
    the tooth passing is what cutting adds, and its prominence within a frame (the median over the first 8 tooth
    harmonics of the strongest line near k f_t over the median power within ±f_t/2 of it) does not move with the gain:
-   a loud stretch whose prominence stays within 2 dB of the air cut's own (smoothed over 9 short frames, or in the
+   a loud stretch whose prominence stays within ±2 dB of the air cut's own (smoothed over 9 short frames, or in the
    long frames where the short ones do not resolve the tooth-passing harmonics) for as long as an air cut lasts is
-   air; where the loud level holds less tooth passing than the quiet one (the control lifted the air before the cut
-   above the cut), the prominence splits the record instead. The veto acts only then, and only inside what the level
-   called cutting: developed chatter lowers the prominence too (heavy chatter at a pocket: 25–30 dB → 9–14 dB, the
-   air 5–7 dB), and shorter disagreements where the tool enters and leaves are left to the level. (b) The air cut as
-   the reference of "new": the cut, recorded with less gain, stands less far above it (a simulated chatter line rose
-   42 dB over the air cut without gain control, 3 dB through one). Cutting adds sound to what ran in air, so a cut
-   whose noise floor lies under the air cut's was recorded with less gain: the air cut's spectrum is lowered by the
-   10th percentile of the blocks' floor ratio when that is below 1 (``air_gain_db`` of each segment; a warning from
-   −3 dB). Measured on 1 785 records of simulated cuts (``docs/design/shop.md``, *Automatic gain control*): without
-   gain control 98.8 % right, no verdict changed; through a gain control of 0.05 s attack and 2 s release 89.5 %
-   right with 113 false chatter before, 98.7 % and none after; of 0.5 s attack and release 86.2 % with 183 false
-   before, 98.3 % and none after — a chatter that grows while the gain falls grows less on the record. The real
-   recording in ``examples/cuts`` has its cut's floor 3–6 dB under the air cut's (its lowest frequencies 6–10 dB): it
-   was recorded with some gain control; its verdicts are unchanged.
+   air. The veto acts only then, and only inside what the level called cutting: developed chatter lowers the
+   prominence too (heavy chatter at a pocket: 25–30 dB → 9–14 dB, the air 5–7 dB), a spindle whose own lines ring in
+   air can raise the air's above the cut's, and shorter disagreements where the tool enters and leaves are left to
+   the level. (b) The air cut as the reference of "new": the cut, recorded with less gain, stands less far above it
+   (a simulated chatter line rose 42 dB over the air cut without gain control, 3 dB through one). Cutting adds sound
+   to what ran in air, so a cut whose noise floor lies under the air cut's was recorded with less gain: the air cut's
+   spectrum is lowered by the 10th percentile of the blocks' floor ratio when that is below 1 (``air_gain_db`` of
+   each segment; a warning from −3 dB). Measured on 1 785 records of simulated cuts (``docs/design/shop.md``,
+   *Automatic gain control*): without gain control 98.8 % right, no verdict changed; through a gain control of 0.05 s
+   attack and 2 s release 89.5 % right with 113 false chatter before, 98.7 % and none after; of 0.5 s attack and
+   release 86.2 % with 183 false before, 98.3 % and none after — a chatter that grows while the gain falls grows less
+   on the record. The real recording in ``examples/cuts`` has its cut's floor 3–6 dB under the air cut's (its lowest
+   frequencies 6–10 dB): it was recorded with some gain control; its verdicts are unchanged.
 5. **once-per-revolution metric** (where the segment holds ≥ 10 revolutions): the signal resampled at
    64 points per revolution, R = 1 − E_sync/E_total (E_sync: energy of the revolution-synchronous mean,
    with its finite-average bias removed): 0 for a periodic (stable, noiseless) signal, → 1 for chatter
@@ -139,7 +138,7 @@ _TRACK_AGREE = 1e-3
 _SIDELOBE = 0.0267  # the Hann window's first sidelobe, amplitude (−31.5 dB)
 _MAINS_REL = 2e-3  # mains frequency tolerance (grids hold 50/60 Hz within ±0.2 %)
 _GAIN_WARN_DB = -3.0  # a cut's floor this far under the air cut's: the recorder's gain changed (warned)
-_AIR_PROMINENCE_DB = 2.0  # a loud stretch whose tooth-passing harmonics stand out within this of the air's: air
+_AIR_PROMINENCE_DB = 2.0  # a loud stretch whose tooth-passing harmonics stand out as in the air (± this): air
 
 
 @dataclass(frozen=True)
@@ -512,11 +511,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             _tooth_prominence_db(Ps, fs_, teeth * f_nom, tol, lo, hi), 9, mode="nearest")
         if best_sep == 0:
             prom = prom_long
-    if prom is not None and (best_sep == 0 or active.all() or
-                             (~active).any() and np.mean(prom[active]) < np.mean(prom[~active])):
+    if prom is not None and best_sep == 0:
         # no level splits the record: a loud steady noise (flood coolant, an extraction fan) that runs through air
-        # cut and cut alike hides the cut's few dB. Or the loud level is the one without tooth passing: a gain
-        # control lifted the air before the cut above the cut. The tooth-passing harmonics stand out in the cut only
+        # cut and cut alike hides the cut's few dB. The tooth-passing harmonics stand out in the cut only
         split = _two_levels(prom, n_min, activity_db)
         if split is not None:
             active = split[0]
@@ -524,10 +521,11 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         # loud, but the tooth-passing harmonics stand out no more than in the air cut, for as long as an air cut
         # lasts: air cut. A recorder's automatic gain control levels air cut and cut, and the level alone then takes
         # the air before the cut for cutting; the harmonics' prominence within a frame does not move with the gain.
-        # Only where it is at the air's own (its median + 2 dB): developed chatter lowers it in the cut too (heavy
-        # chatter at a pocket: from 25–30 dB to 9–14 dB in the short frames, the air's 5–7 dB), and shorter
-        # disagreements (where the tool enters and leaves) are left to the level.
-        like_air = active & (prom <= np.median(prom[~active]) + _AIR_PROMINENCE_DB)
+        # Only where it is at the air's own (its median ± 2 dB): developed chatter lowers it in the cut too (heavy
+        # chatter at a pocket: from 25–30 dB to 9–14 dB in the short frames, the air's 5–7 dB), a spindle whose
+        # lines ring in air can raise the air's above the cut's, and shorter disagreements (where the tool enters
+        # and leaves) are left to the level.
+        like_air = active & (np.abs(prom - np.median(prom[~active])) <= _AIR_PROMINENCE_DB)
         if (active & ~like_air).sum() >= n_min:
             for s, e, v in _runs(like_air):
                 if v and short_t[e - 1] - short_t[s] >= min_air:
