@@ -785,11 +785,11 @@ def _judge(Pseg, nu1, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s,
     if ref is not None:
         # cutting adds sound to what ran in air (spindle, fans, room): a cut whose floor lies under the air cut's
         # was recorded with less gain (a recorder's automatic gain control), and the air cut is lowered to match,
-        # by as much as 90 % of the band's blocks allow
+        # by as much as 90 % of the band's blocks allow (at most 40 dB: a floor of digital silence is no gain)
         fl = _block_floor(np.vstack([p, ref]), keep)
         ratio = (fl[0] / fl[1])[keep & np.isfinite(fl[0]) & (fl[1] > 0)]
         if ratio.size:
-            gain = min(1.0, float(np.percentile(ratio, 10)))
+            gain = min(1.0, max(1e-4, float(np.percentile(ratio, 10))))
             ref = ref * gain
     if ref is not None:  # lines already in the air cut (fans, pumps) are not candidates
         k3 = np.ones(3)
