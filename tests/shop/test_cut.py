@@ -344,8 +344,9 @@ def _phone_agc(x, rate, attack_s, release_s, block=64):
 def test_a_record_levelled_by_automatic_gain_control_is_split_and_judged_right(attack_s, release_s):
     # A phone levels the cut to the air cut's loudness within its attack time and lifts the air after the cut back
     # within its release time, so the band's power no longer tells air from cut: the air before the cut sounded as
-    # loud as the cut, and split by level it was judged as cutting (false chatter in 5 of these 6 stable records
-    # before). The tooth-passing harmonics' prominence within each frame does not move with the gain.
+    # loud as the cut, and split by level it was judged as cutting (false chatter in 3 of these 6 stable records
+    # before, and the cut's bounds wrong in 6 of the 12). The tooth-passing harmonics' prominence within each frame
+    # does not move with the gain.
     for rpm, teeth, fc, seed in ((6000, 4, 1234.0, 0), (9000, 3, 1630.0, 1), (12000, 2, 2890.0, 2)):
         for chatter in (None, fc):
             x, rate, t0, t1 = shop_record(rpm=rpm, teeth=teeth, chatter_hz=chatter, chatter_amp=0.5, mode_hz=fc,
@@ -361,7 +362,7 @@ def test_a_record_levelled_by_automatic_gain_control_is_split_and_judged_right(a
 def test_a_loud_noise_through_air_cut_and_cut_does_not_hide_the_air_cut():
     # Flood coolant (broadband 300 Hz–8 kHz, as loud as the record: it runs before the tool enters) leaves the cut
     # under 4 dB louder than the air, so no level splits the record; judged as one cut without an air cut, the
-    # fans became chatter in 18 of 18 such stable records before (coolant.py in the session notes). The
+    # fans became chatter in all 9 stable records of this kind over 3 seeds before (docs/design/shop.md). The
     # tooth-passing harmonics, read in the long frames, still stand out in the cut only.
     from scipy import signal
 
