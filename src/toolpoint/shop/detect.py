@@ -502,15 +502,14 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     # tooth-passing harmonics; smoothed over 9 frames), else in the long ones (a slow spindle's harmonics; smoothed
     # over 3 frames and read at the short frames' times). Where no level splits the record, in the long frames
     # always: their lines stand 4x further out of a broadband noise than in the short ones
-    prom = prom_long = None
+    prom = None
     if Ps.shape[0] >= 16 and P.shape[0] >= 3:
         tol = max(rpm_tolerance, 0.005)
-        prom_long = np.interp(short_t, frame_t, median_filter(
-            _tooth_prominence_db(P, freq, teeth * f_nom, tol, lo, hi), 3, mode="nearest"))
-        prom = prom_long if teeth * f_nom < 8 * rate / Ls else median_filter(
-            _tooth_prominence_db(Ps, fs_, teeth * f_nom, tol, lo, hi), 9, mode="nearest")
-        if best_sep == 0:
-            prom = prom_long
+        if best_sep == 0 or teeth * f_nom < 8 * rate / Ls:
+            prom = np.interp(short_t, frame_t, median_filter(
+                _tooth_prominence_db(P, freq, teeth * f_nom, tol, lo, hi), 3, mode="nearest"))
+        else:
+            prom = median_filter(_tooth_prominence_db(Ps, fs_, teeth * f_nom, tol, lo, hi), 9, mode="nearest")
     if prom is not None and best_sep == 0:
         # no level splits the record: a loud steady noise (flood coolant, an extraction fan) that runs through air
         # cut and cut alike hides the cut's few dB. The tooth-passing harmonics stand out in the cut only
