@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from milling_sim import microphone  # noqa: E402
+from milling_sim import accelerometer, microphone  # noqa: E402
 from shop_synth import shop_record  # noqa: E402
 
 from toolpoint.io.records import read_cut_record  # noqa: E402
@@ -129,7 +129,9 @@ THRESHOLDS = ((0.05, 0.002, 6.0), (0.05, 0.002, 0.0), (0.05, 0.002, 3.0), (0.05,
 class _Score:
     """Verdicts of ``cut`` on simulated records against the SDM (and the simulation's own verdict), per threshold."""
 
-    def __init__(self):
+    def __init__(self, record=None):
+        self.record = record or shop_microphone  # the sensor: (res, rpm, teeth, rng, point) -> (samples, rate)
+        self.full_scale = 1.0 if self.record is shop_microphone else None  # a sound file's full scale; a DAQ's in m/s²
         self.right = dict.fromkeys(THRESHOLDS, 0)
         self.right_sim = dict.fromkeys(THRESHOLDS, 0)
         self.false_alarm = dict.fromkeys(THRESHOLDS, 0)
@@ -145,13 +147,13 @@ class _Score:
             if abs(depth[p] / lim[p] - 1) < 0.05:
                 self.skipped += 1
                 continue
-            x, rate = shop_microphone(res, float(rpm[p]), c.teeth, rng, point=p)
+            x, rate = self.record(res, float(rpm[p]), c.teeth, rng, point=p)
             chatter = bool(rho[p] > 1)
             self.n += 1
             self.sim_agree += chatter == (not res.stable[p])
             for thr in THRESHOLDS:
                 t0 = time.process_time()
-                r = analyse_cut(x, rate, rpm=float(rpm[p]), teeth=c.teeth, full_scale=1.0, dominance=thr[0],
+                r = analyse_cut(x, rate, rpm=float(rpm[p]), teeth=c.teeth, full_scale=self.full_scale, dominance=thr[0],
                                 alias_dominance=thr[1], growth_db=thr[2])
                 if thr == THRESHOLDS[0]:
                     self.cpu_cut += time.process_time() - t0
@@ -191,7 +193,7 @@ def _truth(pr, rng, random_cut=True):
                                    milling=str(rng.choice(["down", "up"])))
 
 
-def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01):
+def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="microphone"):
     """Verdicts of ``cut`` on microphone records of cuts simulated by ``toolpoint.simulation``; truth: the SDM.
 
     Each simulated cut starts on the steady cut with a kick of ``seed_level`` × the forced response (a shop cut's
@@ -205,7 +207,7 @@ def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01):
     """
     from toolpoint.stability import sdm_lobes, sdm_spectral_radius
 
-    sc = _Score()
+    sc = _Score(SENSORS[sensor])
     for case in ("cornelius", "example"):
         for seed in range(seed_start, seed_start + (2 if quick else truths)):
             rng = np.random.default_rng(seed)
@@ -218,12 +220,12 @@ def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01):
             R, A = np.meshgrid(speeds, depths)
             sc.add(mm, c, R.ravel(), A.ravel(), np.broadcast_to(lim, R.shape).ravel(), rho.ravel(), seed, seed_level,
                    rng)
-    sc.report(f"simulated records (toolpoint.simulation, seed level {seed_level:g}, {2 * (2 if quick else truths)} "
-              f"random truths (seeds {seed_start}…) of the Cornelius and example-tool priors, random immersion and "
-              f"up/down, 7 speeds x 7 depths")
+    sc.report(f"simulated {sensor} records (toolpoint.simulation, seed level {seed_level:g}, "
+              f"{2 * (2 if quick else truths)} random truths (seeds {seed_start}…) of the Cornelius and example-tool "
+              f"priors, random immersion and up/down, 7 speeds x 7 depths")
 
 
-def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01):
+def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01, sensor="microphone"):
     """``cut`` at the speeds a chatter-avoiding choice lands on: a tooth-passing harmonic j f_t on a mode.
 
     For each truth (drawn from each prior, its immersion and direction, seeds
@@ -235,7 +237,7 @@ def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01):
     from toolpoint.shop.model import sdm_limits
     from toolpoint.stability import sdm_spectral_radius
 
-    sc = _Score()
+    sc = _Score(SENSORS[sensor])
     for name, pr in priors.items():
         lo, hi = pr.rpm_range if pr.rpm_range is not None else (5000.0, 25000.0)
         for seed in range(seed_start, seed_start + (1 if quick else truths)):
@@ -255,7 +257,7 @@ def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01):
             A = L * np.tile([0.6, 0.8, 1.15, 1.4, 2.0], sp.size)
             rho = sdm_spectral_radius(mm, mm, c, rpm=R, depth=A)
             sc.add(mm, c, R, A, L, rho, seed, seed_level, rng)
-    sc.report(f"simulated records at pocket speeds (a tooth-passing harmonic on a mode; {', '.join(priors)}; "
+    sc.report(f"simulated {sensor} records at pocket speeds (a tooth-passing harmonic on a mode; {', '.join(priors)}; "
               f"{1 if quick else truths} truths each, seeds {seed_start}…; 5 depths 0.6–2 × the SDM limit")
 
 
@@ -288,6 +290,19 @@ def shop_microphone(res, rpm, teeth, rng, point=0):
     x, rate, *_ = microphone((t, d[:, 0], d[:, 1], f[:, 0], f[:, 1]), rpm=rpm, teeth=teeth,
                              seed=int(rng.integers(1 << 30)))
     return x, rate
+
+
+def shop_accelerometer(res, rpm, teeth, rng, point=0):
+    """tests/milling_sim.py's accelerometer on the spindle housing (force through a housing mode, the tool's
+    acceleration, bearing and imbalance lines, mains hum, offset and drift, sensor noise; 25.6 kS/s) of one cut."""
+    t = res.time_s[point] - res.time_s[point][0]
+    d, f = res.displacement_m[point], res.force_n[point]
+    x, rate, *_ = accelerometer((t, d[:, 0], d[:, 1], f[:, 0], f[:, 1]), rpm=rpm, teeth=teeth,
+                                seed=int(rng.integers(1 << 30)))
+    return x, rate
+
+
+SENSORS = {"microphone": shop_microphone, "accelerometer": shop_accelerometer}
 
 
 def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius", "example"), update_kw=None,
@@ -466,19 +481,22 @@ def main():
     ap.add_argument("--no-stop", action="store_true",
                     help="campaigns make all --max-cuts cuts (convergence read from the same sequence) and the "
                     "band's calibration after each cut is printed over all the truths")
+    ap.add_argument("--sensor", choices=("microphone", "accelerometer"), default="microphone",
+                    help="the record of the simulated cuts of the cut benchmark")
     ap.add_argument("--detector", default="{}", help="JSON of analyse_cut() options of the simulated shop")
     a = ap.parse_args()
     header()
     if a.only in (None, "cut"):
         bench_cut(a.quick)
-        bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level)
+        bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level, sensor=a.sensor)
         pockets = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
         if a.library_prior:
             from toolpoint.shop.prior import prior_from_library
 
             out, tool = a.library_prior.rsplit(":", 1)
             pockets[tool] = prior_from_library(out, tool)
-        bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level)
+        bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level,
+                          sensor=a.sensor)
     if a.only in (None, "forward"):
         bench_forward()
     if a.only in (None, "ceiling"):

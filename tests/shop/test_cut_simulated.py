@@ -4,14 +4,16 @@ simulated shop), truth from the SDM."""
 import numpy as np
 import pytest
 
-from milling_sim import microphone, simulate
+from milling_sim import accelerometer, microphone, simulate
+from toolpoint.io.records import read_cut_record
 from toolpoint.shop import analyse_cut
 from toolpoint.shop.model import cornelius_2024
 from toolpoint.stability import ModalModel, sdm_lobes
 
 
-@pytest.mark.slow
-def test_verdicts_on_simulated_records_follow_the_sdm_limit():
+def _cuts():
+    """The Cornelius et al. 2024 tool, nominal, at 9000 and 20000 rpm, 0.75 × (stable) and 1.3 × (chatter) its SDM
+    limit, simulated by tests/milling_sim.py: (rpm, expected verdict, simulation)."""
     pr = cornelius_2024()
     c = pr.cutting
     fn, k, z = np.array(pr.freq_hz), np.array(pr.stiffness_n_m), np.array(pr.damping)
@@ -21,24 +23,53 @@ def test_verdicts_on_simulated_records_follow_the_sdm_limit():
     phi_st, phi_ex = c.immersion_angles
     for rpm, a_lim in zip(speeds, lim):
         for rel, want in ((0.75, "stable"), (1.3, "chatter")):
-            sim = simulate(fn, k, z, teeth=4, kt=c.tangential_coeff, kr=c.radial_ratio, phi_st=phi_st,
-                           phi_ex=phi_ex, rpm=[rpm], depth_m=[rel * a_lim], revolutions=max(60, int(rpm / 100)),
-                           seed=3)[0]
-            x, rate, *_ = microphone(sim, rpm=rpm, teeth=4, seed=4)
-            r = analyse_cut(x, rate, rpm=rpm, teeth=4, full_scale=1.0)
-            assert r.verdict == want, (rpm, rel)
-            if want == "chatter":
-                # the chatter frequency, modulo tooth-passing aliases, is the simulated displacement's
-                t, xd, yd = sim[0], sim[1], sim[2]
-                h = xd.size // 2
-                sig = (xd + yd)[h:] - np.mean((xd + yd)[h:])
-                f = np.fft.rfftfreq(sig.size, t[1] - t[0])
-                p = np.abs(np.fft.rfft(sig * np.hanning(sig.size))) ** 2
-                kk = np.round(f * 60 / rpm)
-                p[(np.abs(f - kk * rpm / 60) < 3 * f[1] + 0.002 * f) | (f < 100)] = 0
-                f_true = f[np.argmax(p)]
-                alias = f_true + 4 * rpm / 60 * np.arange(-3, 4)
-                assert np.min(np.abs(r.chatter_hz - alias)) / f_true < 0.01
+            yield float(rpm), want, simulate(fn, k, z, teeth=4, kt=c.tangential_coeff, kr=c.radial_ratio,
+                                             phi_st=phi_st, phi_ex=phi_ex, rpm=[rpm], depth_m=[rel * a_lim],
+                                             revolutions=max(60, int(rpm / 100)), seed=3)[0]
+
+
+def _assert_simulated_chatter_hz(found_hz, sim, rpm, aliases):
+    """The chatter frequency found is the simulated displacement's, modulo tooth-passing aliases (|j| ≤ aliases)."""
+    t, xd, yd = sim[0], sim[1], sim[2]
+    h = xd.size // 2
+    sig = (xd + yd)[h:] - np.mean((xd + yd)[h:])
+    f = np.fft.rfftfreq(sig.size, t[1] - t[0])
+    p = np.abs(np.fft.rfft(sig * np.hanning(sig.size))) ** 2
+    kk = np.round(f * 60 / rpm)
+    p[(np.abs(f - kk * rpm / 60) < 3 * f[1] + 0.002 * f) | (f < 100)] = 0
+    f_true = f[np.argmax(p)]
+    alias = f_true + 4 * rpm / 60 * np.arange(-aliases, aliases + 1)
+    assert np.min(np.abs(found_hz - alias)) / f_true < 0.01
+
+
+@pytest.mark.slow
+def test_verdicts_on_simulated_records_follow_the_sdm_limit():
+    for rpm, want, sim in _cuts():
+        x, rate, *_ = microphone(sim, rpm=rpm, teeth=4, seed=4)
+        r = analyse_cut(x, rate, rpm=rpm, teeth=4, full_scale=1.0)
+        assert r.verdict == want, rpm
+        if want == "chatter":
+            _assert_simulated_chatter_hz(r.chatter_hz, sim, rpm, 3)
+
+
+@pytest.mark.slow
+def test_an_accelerometer_on_the_housing_hears_what_the_sdm_says(tmp_path):
+    """The same cuts heard by an accelerometer on the spindle housing (tests/milling_sim.py: the force through a
+    housing mode at 2.5 kHz, bearing and imbalance lines, mains hum, offset and drift, 25.6 kS/s), in m/s², through
+    a CSV file as a DAQ writes it. The chatter frequency is allowed a fourth alias: the housing mode and the ω² of
+    an acceleration favour far aliases (docs/design/shop.md, *Accelerometer records*)."""
+    for rpm, want, sim in _cuts():
+        x, rate, *_ = accelerometer(sim, rpm=rpm, teeth=4, seed=5)
+        path = tmp_path / f"acc_{rpm:.0f}_{want}.csv"
+        np.savetxt(path, np.column_stack([np.arange(x.size) / rate, x]), delimiter=",", fmt="%.9g",
+                   header="t_s,accel_m_s2", comments="")
+        rec = read_cut_record(path)
+        assert rec.rate_hz == pytest.approx(rate, rel=1e-6)
+        r = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=4, source=str(path))
+        assert r.verdict == want, rpm
+        assert abs(r.rpm / rpm - 1) < 5e-4
+        if want == "chatter":
+            _assert_simulated_chatter_hz(r.chatter_hz, sim, rpm, 4)
 
 
 @pytest.mark.slow
