@@ -4,6 +4,7 @@
         [--only cut|update|sampler|forward|ceiling|sdm-bands] [--shops zoa,noisy,sim] [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
+        [--sensor microphone|accelerometer]
 
 Prints the machine, date and load first; per case and shop the median cuts to converge, the fraction converged,
 the median (max) chattering cuts and the CPU per update (median, max); ``--verbose`` one line per seed.
@@ -11,7 +12,11 @@ the median (max) chattering cuts and the CPU per update (median, max); ``--verbo
 CPU time (time.process_time), not wall time: the machine is shared.
 
 1. ``cut``: CPU per second of 44.1 kHz audio on the real shop recording (examples/cuts) and on synthetic shop
-   records (tests/shop_synth.py); verdicts over a (speed, chatter amplitude) grid of synthetic records.
+   records (tests/shop_synth.py); verdicts over a (speed, chatter amplitude) grid of synthetic records; verdicts
+   against the SDM on cuts simulated by toolpoint.simulation over a random (speed, depth) grid and at pocket
+   speeds, heard by the tests' shop microphone or (``--sensor accelerometer``) by an accelerometer on the spindle
+   housing (tests/milling_sim.py: force through a housing mode, bearing and imbalance lines, mains hum, offset and
+   drift, 25.6 kS/s).
 2. ``update``: virtual campaigns (truth drawn from the prior, the next cut from the ``info`` rule) on the
    Cornelius et al. 2024 two-mode case and on the toolpoint example tool, over ``--seeds`` seeds, with two shops:
    ``zoa`` (cuts labelled by the true zero-order limit: the update's own model), ``noisy`` (the true limit
