@@ -311,7 +311,8 @@ SENSORS = {"microphone": shop_microphone, "accelerometer": shop_accelerometer}
 
 
 def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius", "example"), update_kw=None,
-                 max_cuts=10, verbose=False, seed_start=0, library_prior=None, detector=None, stop=True):
+                 max_cuts=10, verbose=False, seed_start=0, library_prior=None, detector=None, stop=True,
+                 sensor="microphone"):
     update_kw = dict(update_kw or {})
     n_s = update_kw.pop("n_samples", 600 if quick else 1000)
     n_l = update_kw.pop("lobe_samples", 300 if quick else 400)
@@ -334,8 +335,10 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
         for shop_name in shops:
             conv, chat, cpu, fails, runs = [], [], [], 0, []
             for seed in range(seed_start, seed_start + seeds):
+                # a sound file's full scale is 1; an accelerometer's record is in m/s²
+                det = detector if sensor == "microphone" else {"full_scale": None, **(detector or {})}
                 shop = {"zoa": None, "noisy": noisy_shop(prior), "sdm": sdm_shop(prior),
-                        "sim": simulated_shop(prior, record=shop_microphone, detector=detector)}[shop_name]
+                        "sim": simulated_shop(prior, record=SENSORS[sensor], detector=det)}[shop_name]
                 truth = sdm_limit(prior) if shop_name in ("sim", "sdm") else None
                 r = virtual_campaign(prior, rng=np.random.default_rng(seed), shop=shop, max_cuts=max_cuts,
                                      true_limit=truth, n_samples=n_s, lobe_samples=n_l, stop=stop, **update_kw)
@@ -487,7 +490,7 @@ def main():
                     help="campaigns make all --max-cuts cuts (convergence read from the same sequence) and the "
                     "band's calibration after each cut is printed over all the truths")
     ap.add_argument("--sensor", choices=("microphone", "accelerometer"), default="microphone",
-                    help="the record of the simulated cuts of the cut benchmark")
+                    help="the record of the simulated cuts (the cut benchmark and the update benchmark's sim shop)")
     ap.add_argument("--detector", default="{}", help="JSON of analyse_cut() options of the simulated shop")
     a = ap.parse_args()
     header()
@@ -516,7 +519,8 @@ def main():
         import json
 
         bench_update(a.seeds, a.quick, a.shops.split(","), a.cases.split(","), json.loads(a.update), a.max_cuts,
-                     a.verbose, a.seed_start, a.library_prior, json.loads(a.detector), stop=not a.no_stop)
+                     a.verbose, a.seed_start, a.library_prior, json.loads(a.detector), stop=not a.no_stop,
+                     sensor=a.sensor)
 
 
 if __name__ == "__main__":

@@ -89,3 +89,23 @@ def test_the_simulated_shop_labels_cuts_by_the_sdm_limit():
         f_t = 4 * rpm / 60  # chatter is seen at f_c + j f_t; some alias lies near one of the two modes
         alias = cut.chatter_hz + f_t * np.arange(-3, 4)
         assert np.min(np.abs(alias[:, None] / np.array(pr.freq_hz)[None, :] - 1)) < 0.15
+
+
+@pytest.mark.slow
+def test_the_simulated_shop_labels_cuts_heard_by_a_housing_accelerometer():
+    """The whole loop's shop with an accelerometer record in m/s² (no full scale) instead of the microphone."""
+    from toolpoint.shop.campaign import sdm_limit, simulated_shop
+
+    def housing(res, rpm, teeth, rng):
+        t = res.time_s[0] - res.time_s[0][0]
+        d, f = res.displacement_m[0], res.force_n[0]
+        x, rate, *_ = accelerometer((t, d[:, 0], d[:, 1], f[:, 0], f[:, 1]), rpm=rpm, teeth=teeth,
+                                    seed=int(rng.integers(1 << 30)))
+        return x, rate
+
+    pr = cornelius_2024(0.1)
+    shop = simulated_shop(pr, revolutions=200, record=housing, detector={"full_scale": None})
+    theta = pr.theta(np.zeros((1, pr.sigma.size)))[0]
+    a = float(sdm_limit(pr)(theta, [14000.0])[0])
+    assert shop(theta, 14000.0, 0.7 * a, np.random.default_rng(1)).stable
+    assert not shop(theta, 14000.0, 1.4 * a, np.random.default_rng(2)).stable

@@ -120,7 +120,8 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
         :class:`~toolpoint.simulation.time_domain.SimulationResult` (one point); default
         :func:`microphone_record` of the tool's velocity.
     detector : dict, optional
-        Options of :func:`toolpoint.shop.analyse_cut`.
+        Options of :func:`toolpoint.shop.analyse_cut` (``full_scale`` 1.0 unless given: a sound file's; ``None``
+        for a record in physical units, an accelerometer's m/s²).
     seed_level : float, default 0.01
         Kick of the modes at the start of the cut, relative to the forced response: a shop cut's modes are
         excited by the entry and the cutting noise (the simulation's own 1e-6 measures linear growth, and a cut
@@ -149,7 +150,7 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
         res = simulate_milling(mm, mm, cut, rpm=[float(rpm)], depth_m=[float(depth_m)], revolutions=revs,
                                seed=int(rng.integers(1 << 30)), seed_level=seed_level)
         x, fs = make(res, float(rpm), cut.teeth, rng)
-        r = analyse_cut(x, fs, rpm=float(rpm), teeth=cut.teeth, full_scale=1.0, **opts)
+        r = analyse_cut(x, fs, rpm=float(rpm), teeth=cut.teeth, **{"full_scale": 1.0, **opts})
         return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz,
                        duration_s=revs * 60.0 / float(rpm), warnings=tuple(r.criterion.get("warnings", ())))
     return shop
