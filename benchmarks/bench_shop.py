@@ -199,7 +199,7 @@ def _truth(pr, rng, random_cut=True):
 
 
 def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="microphone"):
-    """Verdicts of ``cut`` on microphone records of cuts simulated by ``toolpoint.simulation``; truth: the SDM.
+    """Verdicts of ``cut`` on records (``sensor``) of cuts simulated by ``toolpoint.simulation``; truth: the SDM.
 
     Each simulated cut starts on the steady cut with a kick of ``seed_level`` × the forced response (a shop cut's
     modes are excited by the entry and the cutting noise; the simulation's own default, 1e-6, only measures the
@@ -208,7 +208,8 @@ def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="micro
     ``seed_start``…, each
     with a random radial immersion (0.1/0.25/0.5/1) and up/down milling; 7 speeds (5000–25000 rpm) × 7 depths
     (0.2–3 × the median SDM limit), 250 revolutions from the steady cut, heard by tests/milling_sim.py's
-    microphone (room noise, fans, spindle lines). Points within ±5 % of the SDM limit left out.
+    microphone (room noise, fans, spindle lines) or its housing accelerometer (``sensor="accelerometer"``). Points
+    within ±5 % of the SDM limit left out.
     """
     from toolpoint.stability import sdm_lobes, sdm_spectral_radius
 
