@@ -12,7 +12,8 @@ Points are simulated one after another with a Python loop over time: a test help
 ``microphone`` turns a simulated cut into a shop record: the tool's velocity (x' + y') plus 0.3 × the force's
 derivative, resampled to 44.1 kHz behind an anti-aliasing filter (as a sound card: spindle harmonics above
 22 kHz do not fold into the band; ``toolpoint.simulation.to_audio_rate``), between air cuts, with the room noise,
-fan tones and spindle lines of ``shop_synth`` (tests/shop_synth.py).
+fan tones and spindle lines of ``shop_synth`` (tests/shop_synth.py). ``accelerometer`` hears it as an accelerometer
+on the spindle housing does, in m/s² (its docstring gives each size and where it comes from).
 """
 
 import numpy as np
