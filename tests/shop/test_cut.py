@@ -288,6 +288,22 @@ def test_a_housing_record_of_a_slot_without_chatter_is_stable(chip_noise, seeds)
             assert r.verdict == "stable", (rpm, seed, r.chatter_hz)
 
 
+def test_the_step_ratio_matches_a_brute_force_fit_and_tells_a_ramp_from_a_step():
+    from toolpoint.shop.detect import _STEP_RATIO, _step_ratio
+
+    rng = np.random.default_rng(0)
+    n = 30
+    ramp = np.linspace(0, 10, n) + rng.normal(0, 0.5, n)  # chatter growing: a ramp in dB
+    step = np.where(np.arange(n) < 12, 0.0, 8.0) + rng.normal(0, 0.5, n)  # a line jumping with the load
+    for y, want_step in ((ramp, False), (step, True)):
+        k = np.arange(n) - 0.5 * (n - 1)
+        line = y - y.mean() - (k @ (y - y.mean())) / (k @ k) * k
+        best = min(np.sum((y[:m] - y[:m].mean()) ** 2) + np.sum((y[m:] - y[m:].mean()) ** 2) for m in range(2, n - 1))
+        r = _step_ratio((10 ** (y / 10))[:, None], slice(0, 1))
+        assert r == pytest.approx(best / np.sum(line**2), rel=1e-9)
+        assert (r < _STEP_RATIO) == want_step
+
+
 def test_a_record_with_a_non_finite_sample_is_refused_through_the_api():
     # the file readers refuse it; a notebook's array reaches analyse_cut directly (it was judged "stable" before)
     x, rate, *_ = shop_record(rpm=6000, teeth=4, air_s=0.3, cut_s=0.6, seed=5)

@@ -975,7 +975,7 @@ def _step_ratio(Pseg, bins) -> float:
     m = np.arange(2, n - 1)  # the step after frame m - 1; ≥ 2 frames on each side
     s1, q1 = c1[m - 1], c2[m - 1]
     s2, q2 = c1[-1] - s1, c2[-1] - q1
-    rss = (q1 - s1**2 / m) + (q2 - s2**2 / (n - m))
+    rss = np.maximum((q1 - s1**2 / m) + (q2 - s2**2 / (n - m)), 0.0)  # ≥ 0: the cumulative sums round
     return float(rss.min() / max(rss_line, 1e-12))
 
 
