@@ -105,7 +105,6 @@ def microphone(sim, *, rpm, teeth, rate=44100.0, air_s=0.7, noise=0.02, fans=(61
     return out / (1.2 * np.max(np.abs(out))), rate, t0, t1
 
 
-
 def accelerometer(sim, *, rpm, teeth, rate=25600.0, air_s=0.7, seed=0, housing_hz=2500.0, housing_zeta=0.04,
                   housing_kg=10.0, tool_share=0.01, noise=5e-3, chip_noise=0.02, imbalance_mm_s=0.5, bearing=0.02,
                   preload_n=200.0, balls=17, ball_ratio=0.193, mains_hz=50.0, mains=0.1, offset=0.5, drift=0.2,

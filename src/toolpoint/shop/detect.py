@@ -70,8 +70,8 @@ The detector (:func:`analyse_cut`):
      harmonic to measure "strong" against (a slot with an even number of teeth), such a hump passed for chatter.
      Synthetic housing records of an ideal slot (housing mode 1.5–4 kHz, ζ 2–8 %): 78 of 216 called chatter
      without the test, 21 with it (a mode of ζ 2 % at 1.5 kHz is 60 Hz wide, a few bins at these frame lengths).
-     The real recording's chatter stands 31 dB out, developed chatter of simulated records 2–60 dB (the broad ones
-     have aliases).
+     The real recording's chatter stands 31 dB out; developed chatter of simulated records from 2 dB, median 40 dB
+     (the broad ones have aliases).
 
    *Growing lines.* Instability is growth: a forced line is steady, a free vibration left by the entry decays,
    chatter grows until the tool leaves the cut. When the main test finds no chatter, a significant new line
