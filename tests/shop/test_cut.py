@@ -107,6 +107,7 @@ def test_real_shop_recording_air_entry_cut_chatter_exit():
     assert rec.rate_hz == 44100 and rec.channel == "mean of 2"
     res = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
     assert res.spindle_found and abs(res.rpm * 2 / 60 - 215.3) < 0.3
+    assert res.criterion["speed_elsewhere_rpm"] is None  # the tooth passing stands out at the speed found
     # its spindle runs faster out of the cut: the first two tooth-passing harmonics read 215.6–215.8 Hz at the
     # entry and the exit, 215.3 in the cut (peaks of 1.5 s frames, read by hand) — 0.1–0.2 %, more than the
     # mask's 0.05 %: tracked (the verdicts below are those of the fixed mask too)
@@ -258,6 +259,27 @@ def _housing_slot_record(rpm, seed, chip_noise):
     z = np.zeros_like(t)
     x, rate, *_ = accelerometer((t, z, z, z - 300.0, z + 120.0), rpm=rpm, teeth=4, seed=seed, chip_noise=chip_noise)
     return x, rate
+
+
+@pytest.mark.parametrize("rpm", [5850.0, 6800.0, 7150.0])
+def test_a_nominal_speed_several_percent_off_is_warned_with_the_speed_in_the_record(rpm):
+    """A nominal speed off by more than the search range (an override, another program's speed) leaves the
+    tooth-passing harmonics outside their masks, where they can be judged as chatter. The real recording's spindle
+    ran at 6460 rpm: given 5850, 6800 or 7150 rpm (−9 % … +11 %), its tooth-passing harmonics stand out there and
+    not within ±3 % of the nominal, and `cut` says so; at 6500 rpm it does not."""
+    rec = read_cut_record(REAL)
+    res = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=2, full_scale=rec.full_scale)
+    assert abs(res.criterion["speed_elsewhere_rpm"] / 6460.0 - 1) < 0.002
+    assert any("check the speed the spindle ran at" in w for w in res.criterion["warnings"])
+
+
+def test_a_stable_record_given_a_wrong_speed_is_warned_and_the_right_speed_is_not():
+    x, rate, _, _ = shop_record(rpm=6000, teeth=4, chatter_hz=None, mode_hz=1234.0, seed=1)
+    right = analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0)
+    assert right.criterion["speed_elsewhere_rpm"] is None and right.verdict == "stable"
+    for nominal in (5600.0, 6300.0):  # −6.7 %, +5 %
+        wrong = analyse_cut(x, rate, rpm=nominal, teeth=4, full_scale=1.0)
+        assert abs(wrong.criterion["speed_elsewhere_rpm"] / 6000.0 - 1) < 1e-3, nominal
 
 
 def test_the_spindle_speed_is_read_from_a_record_with_few_harmonics():

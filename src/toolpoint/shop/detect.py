@@ -16,7 +16,9 @@ The detector (:func:`analyse_cut`):
    most power relative to the spectral floor, searched within ``rpm_tolerance`` of the nominal speed
    (spindles slow down under load; a shop's nominal speed is rarely exact), then read again from the peaks of its
    lowest tooth-passing harmonics, or of its lowest spindle harmonics where those do not stand out (a record with
-   few harmonics — an accelerometer on the housing of a slot cut — leaves the comb a main lobe off);
+   few harmonics — an accelerometer on the housing of a slot cut — leaves the comb a main lobe off). A nominal
+   speed several % off (an override) is warned where the four lowest tooth-passing harmonics stand out at a
+   speed within ±25 % of it, outside the tolerance, much more than within it (``speed_elsewhere_rpm``);
 2. **segments** — frame energy in the band, split at a two-level (Otsu) threshold into air cut and
    cutting when the levels differ by ≥ ``activity_db`` (see *Automatic gain control* below for the loud
    stretches without tooth passing that are air all the same; when no level splits, as under a loud coolant
@@ -154,6 +156,9 @@ _SIDELOBE = 0.0267  # the Hann window's first sidelobe, amplitude (−31.5 dB)
 _MAINS_REL = 2e-3  # mains frequency tolerance (grids hold 50/60 Hz within ±0.2 %)
 _LINE_DB = 5.0  # a peak without tooth-passing aliases stands this far over the bins 3–4 away: a line, not a hump
 _GAIN_WARN_DB = -3.0  # a cut's floor this far under the air cut's: the recorder's gain changed (warned)
+_ELSEWHERE_REL = 0.25  # nominal speeds this far off are checked for (a tooth-passing comb at ±N/(N±1) is not)
+_ELSEWHERE_DB = 13.0  # … where the tooth-passing harmonics stand this far over the floor (mean of the four lowest)
+_ELSEWHERE_GAIN_DB = 10.0  # … and this much higher than within the tolerance: warned (see _speed_elsewhere)
 _AIR_PROMINENCE_DB = 2.0  # a loud stretch whose tooth-passing harmonics stand out as in the air (± this): air
 
 
@@ -592,8 +597,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             f_s = f_nom
         else:
             f_s = _refine_speed(freq, logp, floor, inband, f_s, f_nom, teeth, rpm_tolerance, df)
+        elsewhere = _speed_elsewhere(freq, logp, floor, f_nom, teeth, rpm_tolerance, df)
     else:
-        f_s, spindle_found = f_nom, True
+        f_s, spindle_found, elsewhere = f_nom, True, None
     # the speed per cutting frame: spindles slow under load and their speed wanders; where it wanders by more than
     # the mask allows, each judged part masks the harmonics over the range of speeds its frames ran at
     track, wander = None, 0.0
@@ -651,6 +657,12 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         chatter_hz = longest.chatter_hz
         rec, alts = harmonizer_rpm(chatter_hz, teeth, 60 * f_s)
     warns = []
+    if elsewhere is not None:
+        f_e, db_e, db_n = elsewhere
+        warns.append(f"the tooth-passing harmonics stand {db_e:.0f} dB over the floor at {60 * f_e:.0f} rpm "
+                     f"({100 * (f_e / f_nom - 1):+.1f} % from the nominal {rpm:g} rpm), {db_n:.0f} dB within "
+                     f"±{100 * rpm_tolerance:g} % of it, where the record was judged: check the speed the spindle ran "
+                     "at (an override?) — or heavy chatter made that comb")
     if chatter_hz is not None and ref is None:  # without an air cut a steady tone is judged by its strength alone
         for mains in (50.0, 60.0):
             k = max(1, round(chatter_hz / mains))
@@ -668,7 +680,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                  "mask_hz": f"2*{df:.4g} + {_MASK_REL:g}*f", "frame_s": L / rate, "band_hz": [lo, hi],
                  "spindle_multiples_removed": True,
                  "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None,
-                 "speed_wander": round(wander, 6), "speed_tracked": track is not None, "warnings": warns}
+                 "speed_wander": round(wander, 6), "speed_tracked": track is not None,
+                 "speed_elsewhere_rpm": None if elsewhere is None else round(60 * elsewhere[0], 1), "warnings": warns}
     return CutAnalysis(verdict, chatter_hz, tuple(segments), float(rpm), 60 * f_s, spindle_found, int(teeth), rec,
                        alts, criterion, frame_t, freq, P)
 
@@ -704,6 +717,35 @@ def _harmonic_mask(freq, inband, f_lo, f_hi, df):
     pad = 2 * df + _MASK_REL * freq
     near = (k >= 1) & (freq >= k * f_lo - pad) & (freq <= k * f_hi + pad)
     return inband & ~near, inband & near
+
+
+def _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df):
+    """A spindle frequency within ±``_ELSEWHERE_REL`` of the nominal ``f_nom`` but outside ±``tol``, where the four
+    lowest tooth-passing harmonics k N f (k ≤ 4) stand ≥ ``_ELSEWHERE_DB`` over the floor on average and
+    ≥ ``_ELSEWHERE_GAIN_DB`` higher than at the best speed within ``tol``: (f Hz, its dB, the best within tol's dB),
+    else None.
+
+    Why: a nominal speed several % off (a spindle override, another program's speed) leaves the tooth-passing
+    harmonics outside their masks, and they are judged as chatter: on simulated records of stable cuts, a nominal
+    5 % high turned 123 of 128 microphone records at the pocket speeds "chatter". The tooth-passing harmonics are
+    the strongest forced lines of a cut; a speed where they stand out much more than within the tolerance is the
+    speed the spindle ran at. Heavy chatter can make such a comb too (its family f_c + j f_t on a housing
+    accelerometer of a slot cut, which has no tooth passing of its own), so it is a warning, not a refusal. Measured
+    on the saved simulated records (``docs/design/shop.md``, *Records*).
+    """
+    step = df / (16.0 * teeth)  # a quarter bin at the 4th tooth-passing harmonic
+    f = np.arange(f_nom * (1 - _ELSEWHERE_REL), f_nom * (1 + _ELSEWHERE_REL), step)
+    fk = f[:, None] * teeth * np.arange(1, 5)[None, :]
+    t = np.interp(fk, freq, logp - floor, right=0.0).mean(axis=1)  # mean ln-power excess over the floor
+    inside = np.abs(f / f_nom - 1) <= tol
+    if not inside.any() or inside.all():
+        return None
+    t_in = float(t[inside].max())
+    j = int(np.argmax(np.where(inside, -np.inf, t)))
+    db = 10.0 / math.log(10.0)
+    if t[j] * db >= _ELSEWHERE_DB and (t[j] - t_in) * db >= _ELSEWHERE_GAIN_DB:
+        return float(f[j]), float(t[j] * db), t_in * db
+    return None
 
 
 def _refine_speed(freq, logp, floor, inband, f0, f_nom, teeth, tol, df):
