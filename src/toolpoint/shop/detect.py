@@ -156,7 +156,7 @@ _SIDELOBE = 0.0267  # the Hann window's first sidelobe, amplitude (−31.5 dB)
 _MAINS_REL = 2e-3  # mains frequency tolerance (grids hold 50/60 Hz within ±0.2 %)
 _LINE_DB = 5.0  # a peak without tooth-passing aliases stands this far over the bins 3–4 away: a line, not a hump
 _GAIN_WARN_DB = -3.0  # a cut's floor this far under the air cut's: the recorder's gain changed (warned)
-_ELSEWHERE_REL = 0.25  # nominal speeds this far off are checked for (a tooth-passing comb at ±N/(N±1) is not)
+_ELSEWHERE_REL = 0.25  # nominal speeds up to this far off are checked for (the range measured)
 _ELSEWHERE_DB = 13.0  # … where the tooth-passing harmonics stand this far over the floor (mean of the four lowest)
 _ELSEWHERE_GAIN_DB = 10.0  # … and this much higher than within the tolerance: warned (see _speed_elsewhere)
 _AIR_PROMINENCE_DB = 2.0  # a loud stretch whose tooth-passing harmonics stand out as in the air (± this): air
@@ -731,7 +731,7 @@ def _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df):
     the strongest forced lines of a cut; a speed where they stand out much more than within the tolerance is the
     speed the spindle ran at. Heavy chatter can make such a comb too (its family f_c + j f_t on a housing
     accelerometer of a slot cut, which has no tooth passing of its own), so it is a warning, not a refusal. Measured
-    on the saved simulated records (``docs/design/shop.md``, *Records*).
+    on the saved simulated records (``docs/design/shop.md``, *A nominal speed several % off*).
     """
     step = df / (16.0 * teeth)  # a quarter bin at the 4th tooth-passing harmonic
     f = np.arange(f_nom * (1 - _ELSEWHERE_REL), f_nom * (1 + _ELSEWHERE_REL), step)
