@@ -359,6 +359,13 @@ def test_records_one_column_needs_rate_and_uff58(tmp_path):
     with pytest.raises(InputError, match="channel"):
         read_cut_record(two)
     assert read_cut_record(two, channel=1).samples[5] == pytest.approx(-x[5])
+    # a spreadsheet's export in a decimal-comma locale: cells split at ';', "0,25" is 0.25
+    sheet = tmp_path / "sheet.csv"
+    sheet.write_text("Zeit [s];Beschleunigung [m/s²]\n" + "".join(
+        f"{k / rate:.9f};{v:.9g}\n".replace(".", ",") for k, v in enumerate(x)), encoding="utf-8")
+    r = read_cut_record(sheet)
+    assert abs(r.rate_hz - rate) < 1e-6 * rate
+    np.testing.assert_allclose(r.samples, x, rtol=1e-6, atol=1e-9)
 
 
 def test_a_weak_growing_line_is_chatter_a_steady_or_decaying_one_is_not():

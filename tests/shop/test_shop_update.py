@@ -280,6 +280,36 @@ def test_bad_tables_name_the_field(tmp_path, text, field):
         read_test_cuts(p)
 
 
+def test_a_spreadsheet_s_table_reads_as_the_plain_one(tmp_path):
+    """Semicolons between cells and the decimal comma (a spreadsheet's CSV in a German or French locale), capitalised
+    column names: the same cuts as the plain table, not 'missing column rpm'."""
+    plain, sheet = tmp_path / "plain.csv", tmp_path / "sheet.csv"
+    plain.write_text("rpm,depth_mm,result,chatter_hz\n20000,0.5,stable,\n20000,0.95,chatter,1290.5\n")
+    sheet.write_text("\ufeffRPM;Depth_mm;Result;Chatter_Hz\n20000;0,5;stable;\n20000;0,95;Chatter;1290,5\n",
+                     encoding="utf-8")
+    a, b = read_test_cuts(plain), read_test_cuts(sheet)
+    assert [(c.rpm, c.depth_m, c.stable, c.chatter_hz) for c in a] == [(c.rpm, c.depth_m, c.stable, c.chatter_hz)
+                                                                       for c in b]
+    assert b[1].depth_m == pytest.approx(0.95e-3) and b[1].chatter_hz == 1290.5
+
+
+def test_a_depth_far_outside_the_prior_s_lobes_is_warned(tmp_path, capsys):
+    """A depth typed in m into depth_mm (0.0005 for 0.5 mm) is 1/300 of the lobes: the label tells the posterior next
+    to nothing, so the slip would pass unseen — said on stderr, naming the line; a plain table is not warned."""
+    prior = tmp_path / "prior.toml"
+    prior.write_text(PRIOR_TOML)
+    cuts = tmp_path / "cuts.csv"
+    cuts.write_text("rpm,depth_mm,result\n20000,0.0005,stable\n20000,0.5,stable\n")
+    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o"),
+                 "--samples", "200"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "cuts.csv: line 2: warning: depth 0.0005 mm" in err[0] and "in mm?" in err[0]
+    cuts.write_text("rpm,depth_mm,result\n20000,0.5,stable\n")
+    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o2"),
+                 "--samples", "200"]) == 0
+    assert capsys.readouterr().err == ""
+
+
 PRIOR_TOML = """name = "two modes"
 [cut]
 teeth = 4

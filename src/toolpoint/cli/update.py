@@ -137,7 +137,25 @@ def run(args) -> int:
     for c in cuts:  # a label that rests on a doubtful record: said where the user looks
         for w in c.warnings:
             print(f"{args.cuts}: line {c.line}: warning: {w}", file=sys.stderr)
+    for c, w in _depth_units(post):
+        print(f"{args.cuts}: line {c.line}: warning: {w}", file=sys.stderr)
     return 0
+
+
+def _depth_units(post, factor: float = 30.0):
+    """(cut, warning) for depths more than ``factor`` × outside the prior's lobes (below its smallest 5 % limit,
+    above its largest 95 %): a depth typed in m or µm into ``depth_mm``, or a column mixed up. Only said: a label
+    that far from every lobe tells the posterior next to nothing, so a slip would otherwise pass unseen."""
+    import numpy as np
+
+    q = np.where(np.isfinite(post.prior_limit_q_m) & (post.prior_limit_q_m > 0), post.prior_limit_q_m, np.nan)
+    lo, hi = np.nanmin(q[0]), np.nanmax(q[2])
+    for c in post.cuts:
+        if c.depth_m < lo / factor or c.depth_m > hi * factor:
+            low = c.depth_m < lo / factor
+            yield c, (f"depth {1e3 * c.depth_m:g} mm is {f'under 1/{factor:g} of' if low else f'over {factor:g} ×'} "
+                      f"the prior's {'smallest 5 %' if low else 'largest 95 %'} limit "
+                      f"({1e3 * (lo if low else hi):.3g} mm): is the depth_mm column in mm?")
 
 
 def _pair(value: str, flag: str, form: str, first: tuple, second: tuple) -> tuple:

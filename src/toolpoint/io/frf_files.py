@@ -802,14 +802,24 @@ _WRITERS = {".csv": write_csv_frf, ".uff": write_uff58, ".unv": write_uff58, ".u
 
 def numeric_lines(text: list[str]):
     """(line number, cells) of a text table's data lines: comments (``#``, ``%``) and blank lines skipped, cells split
-    at commas (else at white space), header lines before the first number skipped. The one line splitter of the
-    column readers (impact records, cut records)."""
+    at semicolons (a spreadsheet's export where the comma is the decimal mark: ``0,5;1,25`` is 0.5 and 1.25), else at
+    commas, else at white space; header lines before the first number skipped. The one line splitter of the column
+    readers (impact records, cut records).
+
+    Examples
+    --------
+    >>> list(numeric_lines(["t;acc", "0,0;1,5", "0,1;-2"])), list(numeric_lines(["0.0, 1.5", "0.1\t-2"]))
+    ([(2, ['0.0', '1.5']), (3, ['0.1', '-2'])], [(1, ['0.0', '1.5']), (2, ['0.1', '-2'])])
+    """
     started = False
     for n, line in enumerate(text, 1):
         s = line.strip()
         if not s or s[0] in "#%":
             continue
-        cells = [c.strip() for c in (s.split(",") if "," in s else s.split())]
+        if ";" in s:
+            cells = [c.strip().replace(",", ".") for c in s.split(";")]
+        else:
+            cells = [c.strip() for c in (s.split(",") if "," in s else s.split())]
         if not started and not _is_number(cells[0]):
             continue  # a header line
         started = True

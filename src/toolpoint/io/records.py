@@ -192,7 +192,8 @@ def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecor
                 raise InputError(f"line {n}: {c!r} is not a number", file=p, field=f"column {j}")
         rows.append(cells)
     if not rows:
-        raise InputError("no data rows", file=p, field="data")
+        raise InputError("no data rows (no line of numbers; cells split at ';', ',' or white space)", file=p,
+                         field="data")
     a = np.array(rows, dtype=float)
     if a.shape[1] == 1:
         if rate_hz is None:

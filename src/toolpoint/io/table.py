@@ -12,10 +12,13 @@ from __future__ import annotations
 
 import csv
 import os
+import re
 import stat
 from pathlib import Path
 
 from ..errors import InputError
+
+_DECIMAL_COMMA = re.compile(r"\s*[+-]?\d*,\d+(?:[eE][+-]?\d+)?\s*")  # "-0,5", ",5", "1,25e-3"
 
 __all__ = ["read_rows", "read_table", "csv_safe", "csv_unsafe", "check_regular_file"]
 
@@ -23,7 +26,9 @@ __all__ = ["read_rows", "read_table", "csv_safe", "csv_unsafe", "check_regular_f
 def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, list[str]]]:
     """The non-blank rows of a CSV file with their line numbers (1-based, as an editor shows them).
 
-    UTF-8 with or without a byte-order mark; a row whose cells are all blank is skipped.
+    UTF-8 with or without a byte-order mark; a row whose cells are all blank is skipped. Cells are split at commas,
+    or at semicolons where the first line holds more of them (a spreadsheet's export in a locale whose decimal mark
+    is the comma: there ``0,5`` is read as ``0.5``).
 
     Parameters
     ----------
@@ -45,6 +50,9 @@ def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, 
     >>> _ = p.write_text("a,b\\n\\n1,2\\n")
     >>> read_rows(p)
     [(1, ['a', 'b']), (3, ['1', '2'])]
+    >>> _ = p.write_text("rpm;depth_mm;result\\n20000;0,5;stable\\n")
+    >>> read_rows(p)
+    [(1, ['rpm', 'depth_mm', 'result']), (2, ['20000', '0.5', 'stable'])]
     """
     p = Path(path)
     if p.is_dir():
@@ -53,8 +61,20 @@ def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, 
         check_regular_file(p, what=what)
     try:
         with open(p, newline="", encoding="utf-8-sig") as fh:
-            reader = csv.reader(fh)
-            return [(reader.line_num, row) for row in reader if any(c.strip() for c in row)]
+            first = ""
+            for first in fh:  # the first non-blank line decides the delimiter
+                if first.strip():
+                    break
+            fh.seek(0)
+            if fh.read(1) != "\ufeff":  # utf-8-sig already skipped a BOM; seek(0) brought it back
+                fh.seek(0)
+            semi = first.count(";") > first.count(",")
+            reader = csv.reader(fh, delimiter=";" if semi else ",")
+            rows = [(reader.line_num, row) for row in reader if any(c.strip() for c in row)]
+            if semi:  # a spreadsheet that writes ';' between cells writes ',' as the decimal mark
+                rows = [(n, [c.replace(",", ".") if _DECIMAL_COMMA.fullmatch(c) else c for c in r])
+                        for n, r in rows]
+            return rows
     except FileNotFoundError:
         raise InputError(f"cannot read {what}: file not found", file=p) from None
     except UnicodeDecodeError as err:

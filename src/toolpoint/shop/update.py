@@ -117,7 +117,8 @@ class TestCut:
 
 def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
     """Read a test-cut table: CSV ``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz``,
-    ``duration_s`` (how long the tool cut, s) and ``record``.
+    ``duration_s`` (how long the tool cut, s) and ``record``; column names in any case, cells split at commas or
+    (a spreadsheet's export with the decimal comma) semicolons (:func:`toolpoint.io.table.read_rows`).
 
     A ``record`` (path relative to the table) is analysed by :func:`toolpoint.shop.analyse_cut` (needs
     ``teeth``): it gives ``result`` and ``chatter_hz`` where the table leaves them empty, and ``duration_s``
@@ -134,6 +135,9 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
 
     p = Path(path)
     header, rows = read_table(p, what="the test-cut table")
+    # "RPM", "Depth_mm", "Result" as a spreadsheet capitalises them: the names are matched without case
+    header = [h.lower() for h in header]
+    rows = [(line, {(k.lower() if isinstance(k, str) else k): v for k, v in row.items()}) for line, row in rows]
     for need in ("rpm", "depth_mm"):
         if need not in header:
             raise InputError(f"missing column {need!r} (columns: {', '.join(header) or 'none'})", file=p, field=need)
