@@ -493,3 +493,40 @@ def test_chatter_on_a_mains_harmonic_without_an_air_cut_is_flagged():
     assert res.verdict == "stable" and res.criterion["warnings"] == []
     res = hummed(0.0, chatter_hz=1234.0)  # chatter off the mains harmonics: no warning
     assert res.verdict == "chatter" and abs(res.chatter_hz / 1234.0 - 1) < 0.01 and res.criterion["warnings"] == []
+
+
+def test_the_spectra_computed_in_chunks_are_those_of_all_frames_at_once():
+    """The frames are windowed and transformed a chunk at a time (10 min of audio held 3.8 GB at once): the same
+    power spectra as the textbook all-frames computation, to rounding."""
+    from toolpoint.shop.detect import _stft
+
+    x = np.random.default_rng(3).standard_normal(20_011)
+    L, hop = 512, 128
+    n = 1 + (x.size - L) // hop
+    w = np.hanning(L)
+    frames = x[np.arange(L)[None, :] + hop * np.arange(n)[:, None]]
+    direct = np.abs(np.fft.rfft(frames * w, axis=1)) ** 2 / np.sum(w * w)
+    for chunk in (L, 5 * L + 7, 1 << 21):
+        p, centres = _stft(x, L, hop, chunk=chunk)
+        np.testing.assert_allclose(p, direct, rtol=1e-12, atol=1e-12 * direct.max())
+        np.testing.assert_array_equal(centres, np.arange(n) * hop + L / 2)
+
+
+def test_running_out_of_memory_is_one_line_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    """A record too long for the machine's memory (a whole session's recording): one line saying so and what to make
+    smaller, exit 2, no traceback, no output file."""
+    import toolpoint.shop as shop
+
+    x, rate, *_ = shop_record(rpm=6000, teeth=4, seed=1)
+    rec = tmp_path / "r.csv"
+    np.savetxt(rec, np.c_[np.arange(x.size) / rate, x], delimiter=",")
+
+    def too_big(*a, **k):
+        raise MemoryError("Unable to allocate 91.0 MiB for an array with shape (24009, 497) and data type float64")
+
+    monkeypatch.setattr(shop, "analyse_cut", too_big)
+    out = tmp_path / "cut.json"
+    assert main(["cut", str(rec), "--rpm", "6000", "--teeth", "4", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "not enough memory" in err and "shorter record" in err
+    assert not out.exists()

@@ -169,6 +169,11 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"toolpoint {args.command}: interrupted", file=sys.stderr)
         return 130
+    except MemoryError as err:  # a record or a job too large for this machine: one line, what to make smaller
+        what = " ".join(str(err).split()) or "no detail"
+        print(f"toolpoint {args.command}: error: not enough memory ({what}); give a shorter record or a smaller job "
+              "(fewer samples, speeds or points)", file=sys.stderr)
+        return 2
     except OSError as err:  # the operating system's refusals (full disk, permission, name too long): one line
         name = InputError("", file=err.filename).file if err.filename else "file system"
         print(f"toolpoint {args.command}: error: {name}: {err.strerror or err}", file=sys.stderr)

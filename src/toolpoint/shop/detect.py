@@ -354,14 +354,20 @@ def check_record(samples, rate_hz: float, rpm: float, teeth: int, *, full_scale:
                          f"{peak:.4g}; record with less gain", file=source, field="samples")
 
 
-def _stft(x, L, hop):
-    """Power spectra of Hann-windowed frames, (frames, bins), scaled to a one-sided PSD in (unit²/Hz)·rate."""
+def _stft(x, L, hop, chunk=1 << 21):
+    """Power spectra of Hann-windowed frames, (frames, bins), scaled to a one-sided PSD in (unit²/Hz)·rate.
+
+    The frames are a strided view of ``x``, windowed and transformed ``chunk`` samples' worth at a time: all of them
+    at once held ~14 copies of the record (3.8 GB for 10 min of 44.1 kHz audio), this the spectra and one chunk."""
     n_frames = 1 + (x.size - L) // hop
-    idx = np.arange(L)[None, :] + hop * np.arange(n_frames)[:, None]
     w = np.hanning(L)
-    frames = x[idx] * w
-    spec = np.fft.rfft(frames, axis=1)
-    p = (spec.real ** 2 + spec.imag ** 2) / np.sum(w ** 2)
+    norm = np.sum(w ** 2)
+    frames = np.lib.stride_tricks.sliding_window_view(x, L)[::hop][:n_frames]
+    p = np.empty((n_frames, L // 2 + 1))
+    step = max(1, chunk // L)
+    for s in range(0, n_frames, step):
+        spec = np.fft.rfft(frames[s:s + step] * w, axis=1)
+        p[s:s + step] = (spec.real ** 2 + spec.imag ** 2) / norm
     return p, (np.arange(n_frames) * hop + L / 2)
 
 
