@@ -530,3 +530,28 @@ def test_running_out_of_memory_is_one_line_and_writes_nothing(tmp_path, capsys, 
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "not enough memory" in err and "shorter record" in err
     assert not out.exists()
+
+
+def test_a_record_is_known_by_its_first_bytes(tmp_path, capsys):
+    """A WAV renamed .csv or without a suffix is read as audio; a MATLAB .mat file (or HDF5, TDMS) is refused with one
+    line that says how to export the signal, not as 'not a UTF-8 text file'."""
+    import shutil
+
+    import scipy.io
+    import soundfile as sf
+
+    x, rate, *_ = shop_record(rpm=6000, teeth=4, seed=2)
+    wav = tmp_path / "cut.wav"
+    sf.write(wav, x / np.abs(x).max() * 0.5, int(rate), subtype="PCM_24")
+    ref = read_cut_record(wav)
+    for name in ("cut.csv", "cut"):
+        shutil.copy(wav, tmp_path / name)
+        r = read_cut_record(tmp_path / name)
+        assert r.rate_hz == ref.rate_hz and np.array_equal(r.samples, ref.samples)
+    mat = tmp_path / "cut.mat"
+    scipy.io.savemat(mat, {"acc": x, "fs": rate})
+    with pytest.raises(InputError, match="MATLAB .mat file.*audiowrite"):
+        read_cut_record(mat)
+    assert main(["cut", str(mat), "--rpm", "6000", "--teeth", "4"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "cut.mat" in err

@@ -98,7 +98,12 @@ def read_cut_record(path: str | os.PathLike, *, rate_hz: float | None = None, ch
     if not p.exists():
         raise InputError("file not found", file=p)
     suffix = p.suffix.lower()
-    if suffix in AUDIO_SUFFIXES:
+    kind = _sniff(p)
+    if kind in _NOT_READ:
+        raise InputError(f"{_NOT_READ[kind]}: toolpoint reads audio (WAV, FLAC, OGG, MP3), text columns and UFF58; "
+                         "export the signal as one of those (MATLAB: audiowrite, or writematrix([t(:) x(:)], "
+                         "'cut.csv'))", file=p, field="data")
+    if suffix in AUDIO_SUFFIXES or kind == "audio":  # a recorder's file renamed or without its suffix
         rec = _read_audio(p, channel)
     elif suffix in _UFF_SUFFIXES:
         rec = _read_uff(p, channel)
@@ -116,6 +121,31 @@ def read_cut_record(path: str | os.PathLike, *, rate_hz: float | None = None, ch
         k = int(np.flatnonzero(~np.isfinite(rec.samples))[0])
         raise InputError(f"sample {k} is not finite", file=p, field="data")
     return rec
+
+
+_NOT_READ = {"mat": "a MATLAB .mat file", "hdf5": "an HDF5 file (MATLAB -v7.3, or a DAQ's)",
+             "tdms": "a LabVIEW TDMS file"}
+
+
+def _sniff(p: Path) -> str | None:
+    """What the file's first bytes say it is: ``audio`` (RIFF/WAVE, FLAC, Ogg, MP3, AIFF), or a
+    container toolpoint does not read (``mat``, ``hdf5``, ``tdms``); None: anything else (text, UFF)."""
+    try:
+        with open(p, "rb") as fh:
+            head = fh.read(128)
+    except OSError:
+        return None  # the reader that opens it names the reason
+    if head[:4] == b"RIFF" and head[8:12] == b"WAVE" or head[:4] in (b"fLaC", b"OggS", b"ID3\x03", b"ID3\x04") \
+            or head[:4] == b"FORM" and head[8:12] in (b"AIFF", b"AIFC") \
+            or len(head) > 1 and head[0] == 0xFF and head[1] & 0xE0 == 0xE0:  # an MP3 frame (no ID3 tag)
+        return "audio"
+    if head.startswith(b"MATLAB 5.0 MAT-file") or head.startswith(b"MATLAB 7.3 MAT-file"):
+        return "hdf5" if head.startswith(b"MATLAB 7.3") else "mat"
+    if head.startswith(b"\x89HDF\r\n\x1a\n"):
+        return "hdf5"
+    if head.startswith(b"TDSm"):
+        return "tdms"
+    return None
 
 
 def _pick(data: np.ndarray, channel: int | None, p: Path, what: str) -> tuple[np.ndarray, str]:
