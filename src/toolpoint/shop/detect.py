@@ -156,6 +156,7 @@ _SIDELOBE = 0.0267  # the Hann window's first sidelobe, amplitude (−31.5 dB)
 _MAINS_REL = 2e-3  # mains frequency tolerance (grids hold 50/60 Hz within ±0.2 %)
 _LINE_DB = 5.0  # a peak without tooth-passing aliases stands this far over the bins 3–4 away: a line, not a hump
 _GAIN_WARN_DB = -3.0  # a cut's floor this far under the air cut's: the recorder's gain changed (warned)
+_STEADY_WARN_DB = 6.0  # dB: a chatter line of a record without an air cut that grew less is warned of
 _ELSEWHERE_REL = 0.25  # nominal speeds up to this far off are checked for (the range measured)
 _ELSEWHERE_DB = 13.0  # … where the tooth-passing harmonics stand this far over the floor (mean of the four lowest)
 _ELSEWHERE_GAIN_DB = 10.0  # … and this much higher than within the tolerance: warned (see _speed_elsewhere)
@@ -670,12 +671,22 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                      f"±{100 * rpm_tolerance:g} % of it, where the record was judged: check the speed the spindle ran "
                      "at (an override?) — or heavy chatter made that comb")
     if chatter_hz is not None and ref is None:  # without an air cut a steady tone is judged by its strength alone
+        n_warn = len(warns)
         for mains in (50.0, 60.0):
             k = max(1, round(chatter_hz / mains))
             if abs(chatter_hz - k * mains) <= 2 * df + _MAINS_REL * chatter_hz:
                 warns.append(f"chatter at {chatter_hz:.1f} Hz sits on the mains harmonic {k} x {mains:g} Hz and the "
                              "record holds no air cut to tell hum from chatter: record the spindle running in air "
                              "before the cut")
+        g = longest.growth_db
+        if len(warns) == n_warn and (g is None or g < _STEADY_WARN_DB):
+            # the real recording's first 6.5 s, the spindle in air alone, were "chatter at 1770.7 Hz" (a line of the
+            # machine's own, steady: +0.3 dB): a line that neither grows nor has an air cut to be compared with is
+            # chatter by its strength alone
+            warns.append(f"chatter at {chatter_hz:.1f} Hz is a steady line (it grew {0.0 if g is None else g:+.1f} dB) "
+                         "and the record holds no air cut: a tone the machine makes by itself (a spindle bearing, a "
+                         "fan, a pump) would look the same; record 1–2 s of the spindle running in air before the cut "
+                         "to tell them apart")
     low = min((sg.air_gain_db for sg in judged), default=0.0)
     if low <= _GAIN_WARN_DB:
         warns.append(f"the cut's noise floor lies {-low:.1f} dB under the air cut's over 90 % of the band: the "
