@@ -576,3 +576,28 @@ def test_the_real_spindle_in_air_alone_is_not_chatter_said_without_a_doubt(start
     a, b = int(7.2 * rec.rate_hz), int(16.0 * rec.rate_hz)
     cut = analyse_cut(rec.samples[a:b], rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
     assert cut.verdict == "chatter" and not any("steady line" in w for w in cut.criterion["warnings"])
+
+
+def test_a_daq_s_time_column_printed_to_its_digits_and_in_ms(tmp_path):
+    """A DAQ's CSV at 25.6 kHz with the time printed to 1 µs has steps of 39 and 40 µs: read, at the rate of the first
+    and last rows; the same in ms under a "Time (ms)" header; a missing sample, a time printed with too few digits
+    to increase, are refused naming the line."""
+    rate = 25600.0
+    t = 12.345 + np.arange(int(0.5 * rate)) / rate
+    x = np.sin(2 * np.pi * 400 * t)
+    us = tmp_path / "daq.csv"
+    np.savetxt(us, np.c_[t, x], delimiter=",", fmt=["%.6f", "%.6g"], header="Time (s),Accel (g)", comments="")
+    assert read_cut_record(us).rate_hz == pytest.approx(rate, rel=1e-6)
+    ms = tmp_path / "daq_ms.csv"
+    np.savetxt(ms, np.c_[1e3 * t, x], delimiter=",", fmt=["%.3f", "%.6g"], header="Time (ms),Accel (g)", comments="")
+    r = read_cut_record(ms)
+    assert r.rate_hz == pytest.approx(rate, rel=1e-6) and r.samples.size == t.size
+    gap = tmp_path / "gap.csv"
+    np.savetxt(gap, np.delete(np.c_[t, x], 5000, axis=0), delimiter=",", fmt=["%.6f", "%.6g"], header="t,a",
+               comments="")
+    with pytest.raises(InputError, match=r"line 5002: a time step of 7\.[89]e-05 s where the steps are 3\.9e-05 s"):
+        read_cut_record(gap)
+    coarse = tmp_path / "coarse.csv"
+    np.savetxt(coarse, np.c_[t, x], delimiter=",", fmt=["%.4f", "%.6g"], header="t,a", comments="")
+    with pytest.raises(InputError, match="line 3: the time .* does not increase: printed with too few digits"):
+        read_cut_record(coarse)

@@ -18,6 +18,7 @@ table must have one signal column.
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -210,7 +211,7 @@ def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecor
     from .frf_files import _is_number, _read_text, numeric_lines
 
     text, _ = _read_text(p)
-    rows = []
+    rows, lines = [], []
     width = None
     for n, cells in numeric_lines(text):
         if width is None:
@@ -221,6 +222,7 @@ def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecor
             if not _is_number(c):
                 raise InputError(f"line {n}: {c!r} is not a number", file=p, field=f"column {j}")
         rows.append(cells)
+        lines.append(n)
     if not rows:
         raise InputError("no data rows (no line of numbers; cells split at ';', ',' or white space)", file=p,
                          field="data")
@@ -230,10 +232,51 @@ def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecor
             raise InputError("one column of samples: give the sampling rate (--rate HZ)", file=p, field="rate_hz")
         x, ch = a[:, 0], "0"
         return CutRecord(x, float(rate_hz), os.fspath(p), ch)
-    t = a[:, 0]
-    d = np.diff(t)
-    if t.size < 2 or not np.all(d > 0) or np.ptp(d) > 1e-3 * np.mean(d):
-        raise InputError("first column must be time in s, increasing in equal steps (one column of samples "
-                         "needs --rate instead)", file=p, field="time_s")
+    unit, scale = _time_unit(text, lines[0])
+    t = a[:, 0] * scale
+    _check_time(t, lines, p, unit)
     x, ch = _pick(a[:, 1:], channel, p, "the table")
     return CutRecord(x, float((t.size - 1) / (t[-1] - t[0])), os.fspath(p), ch)
+
+
+_TIME_UNITS = {"ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "s": 1.0}
+_UNIT_IN_NAME = re.compile(r"(?:[\[(]\s*|_)(ms|us|µs|μs|s)\s*[\])]?\s*$", re.IGNORECASE)
+
+
+def _time_unit(text: list[str], first: int) -> tuple[str, float]:
+    """The time column's unit from the header line above the data (``Time (ms)``, ``t [us]``, ``time_ms``;
+    default s) and its factor to s; ``first`` is the first data line's number (1-based)."""
+    for line in reversed(text[:first - 1]):
+        s = line.strip()
+        if not s or s[0] in "#%":
+            continue
+        name = (s.split(";") if ";" in s else s.split(",") if "," in s else s.split())[0]
+        m = _UNIT_IN_NAME.search(name.strip().strip('"'))
+        if m:
+            u = m.group(1).lower()
+            return u, _TIME_UNITS.get(u, 1.0)
+        break
+    return "s", 1.0
+
+
+def _check_time(t: np.ndarray, lines: list[int], p: Path, unit: str) -> None:
+    """The time column must increase in equal steps, to the digits it was printed with: a DAQ's export at 25.6 kHz
+    with the time to 1 µs has steps of 39 and 40 µs. Refused: a step ≤ 0 (too few digits, or not a time), and a step
+    more than half a step off the median step (samples missing or doubled)."""
+    hint = " (one column of samples needs --rate instead)"
+    if t.size < 2:
+        raise InputError("first column must be time, increasing in equal steps: one row" + hint, file=p,
+                         field="time_s")
+    d = np.diff(t)
+    bad = np.flatnonzero(~(d > 0))
+    if bad.size:
+        k = int(bad[0]) + 1
+        raise InputError(f"line {lines[k]}: the time ({t[k] / _TIME_UNITS[unit]:.9g} {unit}) does not increase: "
+                         "printed with too few digits for the sampling rate, or not a time column" + hint, file=p,
+                         field="time_s")
+    dt = float(np.median(d))
+    bad = np.flatnonzero(np.abs(d / dt - 1) > 0.5)
+    if bad.size:
+        k = int(bad[0]) + 1
+        raise InputError(f"line {lines[k]}: a time step of {d[k - 1]:.6g} s where the steps are {dt:.6g} s: samples "
+                         "missing or doubled?" + hint, file=p, field="time_s")
