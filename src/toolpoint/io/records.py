@@ -1,14 +1,16 @@
 """Records of a cut: microphone audio, accelerometer or displacement time histories → one channel of samples.
 
-Formats (by extension):
+Formats (by extension, or by the first bytes: audio renamed or without its suffix is audio; MATLAB ``.mat``, HDF5
+and TDMS files are refused saying how to export the signal):
 
 * audio ``.wav .flac .ogg .mp3`` (and whatever else libsndfile reads: ``.aiff``, ``.au``) through the
   ``soundfile`` package (libsndfile ≥ 1.1 for MP3; the wheels of soundfile ≥ 0.12.1 bundle 1.2);
 * ``.uff .unv .uf``: universal files, datasets 58 of function type 1 (time response); the sampling
   step is the abscissa increment;
-* anything else: a text table (comma, tab or space separated, optional header, ``#``/``%`` comments).
-  Several columns: the first is time in s when it increases evenly (the rate follows from it), the
-  others are channels; one column: samples, and the rate must be given.
+* anything else: a text table (comma, semicolon with the decimal comma, tab or space separated, optional header,
+  ``#``/``%`` comments). Several columns: the first is time — in s, or in ms or µs where the header says so
+  (``Time (ms)``) — increasing in equal steps to the digits it was printed with (the rate follows from the first
+  and last rows), the others are channels; one column: samples, and the rate must be given.
 
 The channel is chosen by ``channel`` (0-based among the signal columns / audio channels); without it
 a multichannel audio file is averaged (a stereo microphone's two channels hear the same cut) and a
