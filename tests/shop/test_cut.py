@@ -601,3 +601,19 @@ def test_a_daq_s_time_column_printed_to_its_digits_and_in_ms(tmp_path):
     np.savetxt(coarse, np.c_[t, x], delimiter=",", fmt=["%.4f", "%.6g"], header="t,a", comments="")
     with pytest.raises(InputError, match="line 3: the time .* does not increase: printed with too few digits"):
         read_cut_record(coarse)
+
+
+def test_a_slow_spindle_s_stable_verdict_says_its_masks_cover_the_band():
+    """Below ~800 rpm the spindle harmonics lie closer than their masks are wide (±2 bins of a 0.4 s frame): chatter
+    there goes unheard (0 of 8 synthetic chattering cuts at 600 rpm), so a 'stable' verdict is warned of; at 3000 rpm
+    it is not."""
+    for rpm, warned in ((600.0, True), (3000.0, False)):
+        for fc in (None, 777.0):
+            x, rate, *_ = shop_record(rpm=rpm, teeth=4, chatter_hz=fc, chatter_amp=0.5, seed=0,
+                                      air_s=max(1.0, 1500 / rpm), cut_s=max(2.0, 2400 / rpm))
+            r = analyse_cut(x, rate, rpm=rpm, teeth=4, full_scale=1.0)
+            said = any("their masks cover" in w for w in r.criterion["warnings"])
+            if fc is None or not warned:
+                assert r.verdict == ("chatter" if fc else "stable") and said == (warned and r.verdict == "stable"), rpm
+            else:  # the chatter unheard at 600 rpm: not a silent 'stable'
+                assert r.verdict == "chatter" or said
