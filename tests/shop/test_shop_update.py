@@ -535,6 +535,36 @@ def test_stable_cuts_climb_by_the_boundary_width_not_by_the_risk_quantile():
             assert len(st) >= 2 and st[-1] < st[-2] * np.exp(0.1), runs
 
 
+def test_the_next_cut_does_not_repeat_an_outcome_the_shop_already_has():
+    """A cut no deeper than a stable one at its speed (or no shallower than a chattering one) ends as that one did;
+    the likelihood, which takes each cut's fuzzy boundary as independent, would count it as news. The info rule does
+    not propose one; where every candidate would be one it proposes as before and says so."""
+    from toolpoint.shop.update import _next_info
+
+    rng = np.random.default_rng(0)
+    grid = np.linspace(10000, 12000, 21)
+    lim = 1e-3 * np.exp(0.1 * rng.standard_normal((400, 1)) + 0.05 * rng.standard_normal((400, grid.size)))
+    lim *= (1 + 0.3 * np.exp(-0.5 * ((grid - 11000) / 300) ** 2))[None, :]  # the productive speeds near 11000 rpm
+    j = int(np.argmax(grid * np.quantile(lim, 0.05, axis=0)))
+    args = (lim, grid, j, 0.3, 0.05, 0.002)
+    free = _next_info(*args, cuts=(), skip_repeats=True)
+    assert not free["repeat"]
+    # a stable cut deeper than the rule's pick, at its speed (these samples are not conditioned on it): without the
+    # skip the rule proposes the shallower cut there, a repeat; with it, not
+    cut = TestCut(free["rpm"], 1.05 * free["depth_m"], True)
+    for skip in (False, True):
+        nxt = _next_info(*args, cuts=(cut,), skip_repeats=skip)
+        repeat = abs(nxt["rpm"] / cut.rpm - 1) <= 0.005 and nxt["depth_m"] <= cut.depth_m
+        assert repeat != skip and not nxt["repeat"] and nxt["p_chatter"] <= 0.3
+    # stable cuts above the risk bound at every speed: nothing new within it; proposed as before, and said
+    deep = tuple(TestCut(float(r), 2e-3, True) for r in grid)
+    every = _next_info(*args, cuts=deep, skip_repeats=True)
+    assert every["repeat"] and "repeats one already made" in every["description"]
+    before = _next_info(*args, cuts=deep, skip_repeats=False)
+    assert {k: v for k, v in every.items() if k not in ("repeat", "description")} == \
+        {k: v for k, v in before.items() if k not in ("repeat", "description")}
+
+
 def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
     import soundfile as sf
 

@@ -128,7 +128,9 @@ def run(args) -> int:
              if low else "")
           + f"); next test cut ({nc['rule']}) {nc['rpm']:.0f} rpm at "
           f"{1e3 * nc['depth_m']:.3f} mm, P(chatter) {nc['p_chatter']:.2f}"
-          f"{' (a step above the stable cut there)' if nc.get('stepped') else ''}; wrote {out}/report.html")
+          f"{' (a step above the stable cut there)' if nc.get('stepped') else ''}"
+          f"{' (it repeats a cut already made there: none within the bound would be new)' if nc.get('repeat') else ''}"
+          f"; wrote {out}/report.html")
     if rc["own_sdm_held_out"] is False:  # the check by samples the speed's choice saw: said, not hidden
         print(f"note: the recommended depth was checked by the lobe samples themselves ({int(n)} posterior "
               "samples leave fewer than 100 beyond them); --samples 1000 checks it by held-out samples")

@@ -72,6 +72,8 @@ cut**, two rules:
   8 → 5 cuts); stepping only after a creep gave 4.5 cuts, 1 chattering and 6 cuts, 1 chattering on those seeds
   (on seeds 20–39 neither rule met the targets, with δ = 0; with the label offset above, seeds 40–59 gave 5 cuts,
   1 chattering and 6 cuts, 1 chattering, seeds 20–39 more than 6 cuts on both: ``docs/design/shop.md``);
+  A candidate whose heard outcome an earlier cut at its speed already gave (no deeper than a stable one, no
+  shallower than a chattering one) is not proposed (``skip_repeats``);
 * ``"risk"``: the most productive cut (max n · a) whose P(chatter) ≤ ``risk`` (default 0.1) — the depth
   a_risk(n), the ``risk`` quantile of the limit.
 """
@@ -386,7 +388,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "zoa", sdm_refs: int = 4,
            min_step: float | None = None, sdm_train: int = 0, miss_rate: float = 0.0,
            label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
-           cut_duration_s: float = 1.0, risk_after_chatter: float | None = None) -> Posterior:
+           cut_duration_s: float = 1.0, risk_after_chatter: float | None = None,
+           skip_repeats: bool = True) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -468,6 +471,16 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     cut_duration_s : float, default 1.0
         Duration (s) of the cuts whose :class:`TestCut` does not state it, and of the next cut. Shorter is the
         safer guess (chatter had less time to grow, so a stable label says less).
+    skip_repeats : bool, default True
+        ``"info"`` rule: no candidate at the speed of an earlier cut (±0.5 %) that is no deeper than a stable cut there,
+        or no shallower than a chattering one — the shop already knows how it ends. The likelihood takes each cut's
+        fuzzy boundary (``boundary_width``) as independent of the others', so it counts such a repeat as news, and
+        the rule used to propose it: in the whole loop 59 of 360 Cornelius cuts and 45 of 240 EM28-80 cuts
+        (``update``'s defaults, truths 20–79 and 20–59) were such repeats (3 and 7 of them chattered: near the limit
+        a label is not certain). Skipping them changed 7 of 60 Cornelius campaigns and 2 of 40 EM28-80 ones: within
+        6 cuts 34 → 36 of 60 and 18 → 18 of 40, at most one chattering cut 30 → 30 and 37 → 38
+        (``docs/design/shop.md``). Where every candidate repeats, the rule proposes as without it. False: as before
+        2026-11-28.
     min_step : float, optional
         ``"info"`` rule: once the two highest stable cuts at a speed are closer than e^min_step (the risk bound
         crept), a cut e^min_step above the highest is a candidate even where it exceeds ``risk`` (default 0.1 =
@@ -629,7 +642,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
             return off_pick[:, None] + growth_offset(prior, th_pick, grid[ks], fc, g_pick, t_next)
 
         nxt = _next_info(lim, grid, j, bound, boundary_width, label_noise, chatter_cost, cuts, min_step, miss_rate,
-                         offset)
+                         offset, skip_repeats)
     if forward == "sdm":
         # the recommended depth checked by the own SDM limits of posterior samples that the choice of its speed did
         # not see: the lobe samples' tail is light at the speed where they look most productive (their own 5 %
@@ -876,12 +889,13 @@ def _wquantile_width(vals_sorted, w):
 
 
 def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), min_step=0.0, miss_rate=0.0,
-               offset=None):
+               offset=None, skip_repeats=False):
     """The ``"info"`` rule: min expected relative band width at the recommended speed, P(chatter) ≤ risk —
     or a step of ``min_step`` (log) above the highest stable cut at that speed (±0.5 %), when the two highest
     stable cuts there are closer than that (the risk bound crept) and it stops short of the step (module
-    docstring). ``offset(ks) -> (S, len(ks))``: each sample's label offset at the speeds grid[ks] (the outcome
-    heard is that of a_lim e^δ; the risk is the cut's own, at a_lim)."""
+    docstring). ``skip_repeats``: no candidate whose outcome an earlier cut at its speed already gave.
+    ``offset(ks) -> (S, len(ks))``: each sample's label offset at the speeds grid[ks] (the outcome heard is that of
+    a_lim e^δ; the risk is the cut's own, at a_lim)."""
     from scipy.special import ndtr
 
     if offset is None:
@@ -903,15 +917,21 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
         if not ok.any():
             continue
         depths = depths[ok]
-        n_capped = depths.size
         near = [c for c in cuts if abs(c.rpm / grid[k] - 1) <= 0.005]
+        if skip_repeats and near:
+            a_lo = max((c.depth_m for c in near if c.stable), default=0.0)
+            a_hi = min((c.depth_m for c in near if not c.stable), default=np.inf)
+            depths = depths[(depths > a_lo) & (depths < a_hi)]
+        n_capped = depths.size
         st = sorted(c.depth_m for c in near if c.stable)
         a_s = st[-1] if st else None
         crept = len(st) >= 2 and st[-1] < st[-2] * math.exp(min_step)
-        if min_step > 0 and a_s is not None and crept and depths[-1] < a_s * math.exp(min_step):
+        if min_step > 0 and a_s is not None and crept and (not depths.size or depths[-1] < a_s * math.exp(min_step)):
             step = a_s * math.exp(min_step)
             if not any(not c.stable and c.depth_m <= step for c in near):  # not past a chatter already heard
                 depths = np.r_[depths, step]
+        if not depths.size:
+            continue
         with np.errstate(divide="ignore"):
             x = (np.log(lim[None, :, k]) - np.log(depths[:, None])) / width  # (C, S)
         ps = eps + (1 - 2 * eps) * ndtr(np.where(np.isfinite(x), x, 50.0))
@@ -925,11 +945,15 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
         for i, (d, pst, e) in enumerate(zip(depths, p_stable, exp_w)):
             cand.append((float(e + chatter_cost * (1 - pst)), -float(grid[k] * d), int(k), float(d), float(1 - pst),
                          i >= n_capped))
+    if not cand:  # every candidate repeats a known outcome (skip_repeats): as without the skip, and said
+        out = _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost, cuts, min_step, miss_rate, offset)
+        out["description"] += " (every such cut repeats one already made at its speed: this one too)"
+        return dict(out, repeat=True)
     cand = [c for c in cand if c[4] <= risk + 1e-9 or c[5]] or cand
     e, _, k, d, pc, stepped = min(cand)
     now = float(_wquantile_width(ts, np.ones((1, ts.size)))[0])
     return {"rule": "info", "risk": risk, "rpm": float(grid[k]), "depth_m": d, "p_chatter": pc,
-            "expected_log_width": e, "log_width_now": now, "stepped": bool(stepped),
+            "expected_log_width": e, "log_width_now": now, "stepped": bool(stepped), "repeat": False,
             "description": "the cut that most reduces the expected relative 5–95 % width of the limit at the "
                            f"recommended speed, among productive speeds, with P(chatter) ≤ {risk:g}"
                            + (f" or, where two stable cuts crept, a step of ×{math.exp(min_step):.3f} above the highest"
