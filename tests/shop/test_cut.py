@@ -617,3 +617,33 @@ def test_a_slow_spindle_s_stable_verdict_says_its_masks_cover_the_band():
                 assert r.verdict == ("chatter" if fc else "stable") and said == (warned and r.verdict == "stable"), rpm
             else:  # the chatter unheard at 600 rpm: not a silent 'stable'
                 assert r.verdict == "chatter" or said
+
+
+def test_digital_silence_a_dropout_is_refused_and_a_recorder_s_lead_in_is_cut_off(tmp_path, capsys):
+    """Runs of one value (zeros, a held sample) are no sound a microphone makes. Inside the real recording (0.3 s of
+    zeros at 12 s, a link's dropout) they were the record's quiet level: its air cut became cutting and a machine line
+    "chatter at 2329.9 Hz" — refused, naming the time. Before and after the signal (a recorder started early) they are
+    cut off: the same verdict, chatter frequency and segments as the recording itself, at the record's own times."""
+    import soundfile as sf
+
+    rec = read_cut_record(REAL)
+    x, rate = rec.samples, rec.rate_hz
+    ref = analyse_cut(x, rate, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=1.0)
+    drop = x.copy()
+    drop[int(12.0 * rate):int(12.3 * rate)] = 0.0
+    with pytest.raises(InputError, match=r"a dropout: digital silence for 0.3 s at 12.000–12.300 s"):
+        analyse_cut(drop, rate, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=1.0)
+    wav = tmp_path / "drop.wav"
+    sf.write(wav, drop, int(rate), subtype="FLOAT")
+    assert main(["cut", str(wav), "--rpm", "6500", "--teeth", "2", "--out", str(tmp_path / "c.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "drop.wav" in err and "dropout" in err
+    assert not (tmp_path / "c.json").exists()
+    lead = np.r_[np.zeros(int(0.8 * rate)), x, np.zeros(int(0.5 * rate))]
+    res = analyse_cut(lead, rate, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=1.0)
+    assert res.verdict == ref.verdict == "chatter" and abs(res.chatter_hz / ref.chatter_hz - 1) < 1e-3
+    assert [g.kind for g in res.segments] == [g.kind for g in ref.segments]
+    t0 = 0.8 + 0.0131  # the zeros added and the MP3 decoder's own 13 ms at the start
+    for g, h in zip(res.segments, ref.segments):
+        assert abs(g.start_s - t0 - max(h.start_s - 0.0131, 0)) < 0.1 and g.verdict == h.verdict
+    assert res.criterion["digital_silence_s"][0] == [0.0, pytest.approx(t0, abs=1e-3)]

@@ -137,7 +137,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.fft import next_fast_len
@@ -356,6 +356,37 @@ def check_record(samples, rate_hz: float, rpm: float, teeth: int, *, full_scale:
                          f"{peak:.4g}; record with less gain", file=source, field="samples")
 
 
+_SILENCE_S = 0.02  # s: a run of equal samples this long is digital silence (a real record's noise never holds still)
+
+
+def _live_part(x, rate, source):
+    """(k0, k1): the record without digital silence at its start and end (runs of ≥ 20 ms of one value: zeros, or a
+    held sample); a run inside it is a dropout, refused with its time — as the quiet level of the record it made the
+    real recording's air cut look like cutting and its machine lines "chatter" (0.3 s of zeros at 12 s)."""
+    n = max(2, int(round(_SILENCE_S * rate)))
+    same = np.r_[False, x[1:] == x[:-1], False]
+    edges = np.flatnonzero(np.diff(same.astype(np.int8)))
+    starts, ends = edges[0::2], edges[1::2] + 1  # runs of equal samples: x[start:end] (end exclusive)
+    keep = ends - starts >= n
+    starts, ends = starts[keep], ends[keep]
+    k0 = int(ends[0]) if starts.size and starts[0] == 0 else 0
+    k1 = int(starts[-1]) if starts.size and ends[-1] == x.size else x.size
+    inner = [(a, b) for a, b in zip(starts, ends) if a > 0 and b < x.size]
+    if inner:
+        a, b = inner[0]
+        at = f"{(b - a) / rate:.3g} s at {a / rate:.3f}–{b / rate:.3f} s" + (f" (and {len(inner) - 1} more)"
+                                                                          if len(inner) > 1 else "")
+        if abs(x[a]) >= 0.99 * np.max(np.abs(x)):  # held at the extreme: the input stage saturated
+            raise InputError(f"clipped: the signal held at its extreme level for {at}; record with less gain",
+                             file=source, field="samples")
+        raise InputError(f"a dropout: digital silence for {at} (the recorder or its link lost the signal); judge the "
+                         "parts before and after it as records of their own, or record again", file=source,
+                         field="samples")
+    if k1 - k0 < n:
+        raise InputError("silent record (no signal)", file=source, field="samples")
+    return k0, k1
+
+
 def _stft(x, L, hop, chunk=1 << 21):
     """Power spectra of Hann-windowed frames, (frames, bins), scaled to a one-sided PSD in (unit²/Hz)·rate.
 
@@ -500,6 +531,19 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     check_record(x, rate_hz, rpm, teeth, full_scale=full_scale, source=source)
     if not (math.isfinite(growth_db) and growth_db >= 0):
         raise InputError(f"must be ≥ 0 dB (0: no growth test), got {growth_db!r}", file=source, field="growth_db")
+    k0, k1 = _live_part(x, float(rate_hz), source)
+    if k0 > 0 or k1 < x.size:
+        # digital silence before or after the signal (a recorder started before its input was live): judged without
+        # it — as the low level of the record it made the air cut look like cutting — and the times kept the record's
+        kw = dict(rpm=rpm, teeth=teeth, rpm_tolerance=rpm_tolerance, band_hz=band_hz, window_s=window_s,
+                  activity_db=activity_db, rise_db=rise_db, dominance=dominance, alias_dominance=alias_dominance,
+                  growth_db=growth_db, alpha=alpha, full_scale=full_scale, source=source)
+        res = analyse_cut(x[k0:k1], rate_hz, **kw)
+        t0 = k0 / float(rate_hz)
+        segs = tuple(replace(g, start_s=g.start_s + t0, end_s=g.end_s + t0) for g in res.segments)
+        crit = dict(res.criterion, digital_silence_s=[[0.0, round(t0, 4)], [round(k1 / rate_hz, 4),
+                                                                                round(x.size / rate_hz, 4)]])
+        return replace(res, segments=segs, criterion=crit, time_s=res.time_s + t0)
     rate = float(rate_hz)
     x = x - x.mean()
     dur = x.size / rate
