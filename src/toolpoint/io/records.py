@@ -100,6 +100,9 @@ def read_cut_record(path: str | os.PathLike, *, rate_hz: float | None = None, ch
         raise InputError("is a folder, not a record", file=p)
     if not p.exists():
         raise InputError("file not found", file=p)
+    from .table import check_regular_file
+
+    check_regular_file(p, what="record")  # before the first bytes are read: a FIFO would block for ever
     suffix = p.suffix.lower()
     kind = _sniff(p)
     if kind in _NOT_READ:
