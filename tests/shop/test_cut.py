@@ -647,3 +647,16 @@ def test_digital_silence_a_dropout_is_refused_and_a_recorder_s_lead_in_is_cut_of
     for g, h in zip(res.segments, ref.segments):
         assert abs(g.start_s - t0 - max(h.start_s - 0.0131, 0)) < 0.1 and g.verdict == h.verdict
     assert res.criterion["digital_silence_s"][0] == [0.0, pytest.approx(t0, abs=1e-3)]
+
+
+def test_a_speed_given_in_rev_per_s_is_named():
+    """'--rpm 107.7' for a spindle at 6460 rpm (107.7 rev/s): no spindle harmonics near 107.7 rpm, and the comb at
+    60 × that stands out in the real recording — said, with the speed; at the right speed nothing of the kind."""
+    rec = read_cut_record(REAL)
+    res = analyse_cut(rec.samples, rec.rate_hz, rpm=107.7, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
+    said = [w for w in res.criterion["warnings"] if "rev/s" in w]
+    assert not res.spindle_found and len(said) == 1
+    rpm = float(said[0].split("but near ")[1].split(" rpm")[0])
+    assert abs(rpm / 6460 - 1) < 0.01
+    ok = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
+    assert not any("rev/s" in w for w in ok.criterion["warnings"])

@@ -637,6 +637,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     mean_p = P[cutting].mean(axis=0)
     logp = np.log(mean_p + 1e-300)
     floor = np.log(_block_floor(mean_p[None, :], inband)[0] + 1e-300)
+    rev_s = None
     if rpm_tolerance > 0:
         ftop = min(hi, 40 * f_nom)
         step = df / (4 * max(1.0, ftop / f_nom))
@@ -647,6 +648,14 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         spindle_found = bool(score[best] > 0.5)  # the comb's mean log-excess: e^0.5, 2.2 dB over the floor
         if not spindle_found:
             f_s = f_nom
+            # a speed given in rev/s (Hz) where rpm was asked: the comb at 60 × the nominal (the real recording at
+            # "--rpm 108" was "stable, harmonics not found", its spindle running at 6460 rpm)
+            f60 = 60.0 * f_nom
+            if 4 * teeth * f60 * (1 + rpm_tolerance) < hi:
+                g0s = np.arange(f60 * (1 - rpm_tolerance), f60 * (1 + rpm_tolerance) + step, df / 4)
+                s60 = _comb_score(freq, logp, floor, g0s, min(hi, 40 * f60))
+                if s60.max() > 0.5:
+                    rev_s = float(g0s[int(np.argmax(s60))])
         else:
             f_s = _refine_speed(freq, logp, floor, inband, f_s, f_nom, teeth, rpm_tolerance, df)
         elsewhere = _speed_elsewhere(freq, logp, floor, f_nom, teeth, rpm_tolerance, df)
@@ -654,7 +663,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         f_s, spindle_found, elsewhere = f_nom, True, None
     # the speed per cutting frame: spindles slow under load and their speed wanders; where it wanders by more than
     # the mask allows, each judged part masks the harmonics over the range of speeds its frames ran at
-    track, wander = None, 0.0
+    track, wander = None, 0.0  # (rev_s set above where the comb stood out at 60 × the nominal)
     if rpm_tolerance > 0 and cutting.size >= 3:
         t_f, f_f = _track_speed(P[cutting], frame_t[cutting], freq, inband, f_s, teeth * f_s, rpm_tolerance, df)
         if t_f.size >= 3:
@@ -709,6 +718,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         chatter_hz = longest.chatter_hz
         rec, alts = harmonizer_rpm(chatter_hz, teeth, 60 * f_s)
     warns = []
+    if rev_s is not None:
+        warns.append(f"no spindle harmonics stand out near {rpm:g} rpm, but near {60 * rev_s:.0f} rpm (60 × that) "
+                     "they do: was the speed given in rev/s? Give it in rpm")
     if elsewhere is not None:
         f_e, db_e, db_n = elsewhere
         warns.append(f"the tooth-passing harmonics stand {db_e:.0f} dB over the floor at {60 * f_e:.0f} rpm "
