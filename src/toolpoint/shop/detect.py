@@ -652,8 +652,10 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             # "--rpm 108" was "stable, harmonics not found", its spindle running at 6460 rpm)
             f60 = 60.0 * f_nom
             if 4 * teeth * f60 * (1 + rpm_tolerance) < hi:
-                g0s = np.arange(f60 * (1 - rpm_tolerance), f60 * (1 + rpm_tolerance) + step, df / 4)
-                s60 = _comb_score(freq, logp, floor, g0s, min(hi, 40 * f60))
+                top60 = min(hi, 40 * f60)
+                st60 = df / (4 * max(1.0, top60 / f60))  # a quarter bin at the highest harmonic, as above
+                g0s = np.arange(f60 * (1 - rpm_tolerance), f60 * (1 + rpm_tolerance) + st60, st60)
+                s60 = _comb_score(freq, logp, floor, g0s, top60)
                 if s60.max() > 0.5:
                     rev_s = float(g0s[int(np.argmax(s60))])
         else:
@@ -663,7 +665,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         f_s, spindle_found, elsewhere = f_nom, True, None
     # the speed per cutting frame: spindles slow under load and their speed wanders; where it wanders by more than
     # the mask allows, each judged part masks the harmonics over the range of speeds its frames ran at
-    track, wander = None, 0.0  # (rev_s set above where the comb stood out at 60 × the nominal)
+    track, wander = None, 0.0
     if rpm_tolerance > 0 and cutting.size >= 3:
         t_f, f_f = _track_speed(P[cutting], frame_t[cutting], freq, inband, f_s, teeth * f_s, rpm_tolerance, df)
         if t_f.size >= 3:
