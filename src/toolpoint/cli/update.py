@@ -151,6 +151,8 @@ def _depth_units(post, factor: float = 30.0):
     import numpy as np
 
     q = np.where(np.isfinite(post.prior_limit_q_m) & (post.prior_limit_q_m > 0), post.prior_limit_q_m, np.nan)
+    if np.isnan(q[0]).all() or np.isnan(q[2]).all():  # no lobe on the grid: nothing to compare with
+        return
     lo, hi = np.nanmin(q[0]), np.nanmax(q[2])
     for c in post.cuts:
         if c.depth_m < lo / factor or c.depth_m > hi * factor:
