@@ -660,3 +660,18 @@ def test_a_speed_given_in_rev_per_s_is_named():
     assert abs(rpm / 6460 - 1) < 0.01
     ok = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
     assert not any("rev/s" in w for w in ok.criterion["warnings"])
+
+
+def test_stereo_channels_in_opposite_polarity_are_not_averaged_away(tmp_path):
+    """A swapped lead inverts one channel: the mean of the real recording's channels was then its quantisation
+    residue, refused as "clipped at 1.5e-05". Said as it is, naming --channel; either channel alone is the record."""
+    import soundfile as sf
+
+    x, rate = sf.read(REAL)
+    inv = tmp_path / "inv.wav"
+    sf.write(inv, np.c_[x[:, 0], -x[:, 0]], rate, subtype="PCM_16")
+    with pytest.raises(InputError, match="channels cancel when averaged.*--channel"):
+        read_cut_record(inv)
+    one = read_cut_record(inv, channel=1)
+    res = analyse_cut(one.samples, one.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=one.full_scale)
+    assert res.verdict == "chatter" and abs(res.chatter_hz / 1067.4 - 1) < 0.002

@@ -161,7 +161,16 @@ def _pick(data: np.ndarray, channel: int | None, p: Path, what: str) -> tuple[np
         if n == 1:
             return data[:, 0], "0"
         if what == "audio":
-            return data.mean(axis=1), f"mean of {n}"
+            mean = data.mean(axis=1)
+            # channels in opposite polarity (a swapped lead, an interface's inverted input) cancel in the mean: the
+            # real recording with one channel inverted averaged to its quantisation residue and was refused as
+            # "clipped at 1.5e-05". Said as it is, with what to give instead
+            each = float(np.mean(np.var(data, axis=0)))
+            if each > 0 and float(np.var(mean)) < 0.1 * each:
+                raise InputError(f"the {n} audio channels cancel when averaged (the mean keeps "
+                                 f"{100 * np.var(mean) / each:.2g} % of their power: one is inverted?); choose one "
+                                 f"with --channel (0..{n - 1})", file=p, field="channel")
+            return mean, f"mean of {n}"
         raise InputError(f"{n} signal columns: choose one with --channel (0..{n - 1})", file=p, field="channel")
     if not (0 <= channel < n):
         raise InputError(f"channel {channel} does not exist ({what} has {n}: 0..{n - 1})", file=p, field="channel")
