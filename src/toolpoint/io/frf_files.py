@@ -627,10 +627,13 @@ def _read_lines(path) -> list[str]:
 
 
 def _read_text(path) -> tuple[list[str], bool]:
-    """(lines of a UTF-8 text file, whether it ends without a line break: its last line may be cut)."""
+    """(lines of a UTF-8 (or UTF-16 with its byte-order mark) text file, whether it ends without a line break: its
+    last line may be cut)."""
     _check_readable(path)
     try:
-        text = Path(path).read_text(encoding="utf-8-sig")
+        raw = Path(path).read_bytes()
+        # UTF-16 with its byte-order mark: a spreadsheet's "Unicode text" export
+        text = raw.decode("utf-16") if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise InputError("not a UTF-8 text file", file=path) from None
     except OSError as exc:

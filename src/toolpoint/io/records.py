@@ -143,7 +143,8 @@ def _sniff(p: Path) -> str | None:
         return None  # the reader that opens it names the reason
     if head[:4] == b"RIFF" and head[8:12] == b"WAVE" or head[:4] in (b"fLaC", b"OggS", b"ID3\x03", b"ID3\x04") \
             or head[:4] == b"FORM" and head[8:12] in (b"AIFF", b"AIFC") \
-            or len(head) > 1 and head[0] == 0xFF and head[1] & 0xE0 == 0xE0:  # an MP3 frame (no ID3 tag)
+            or len(head) > 1 and head[0] == 0xFF and head[1] & 0xE6 == 0xE2:  # an MPEG layer III frame (no ID3
+        # tag); not FF FE, the byte-order mark of a UTF-16 text file (a spreadsheet's "Unicode text" export)
         return "audio"
     if head.startswith(b"MATLAB 5.0 MAT-file") or head.startswith(b"MATLAB 7.3 MAT-file"):
         return "hdf5" if head.startswith(b"MATLAB 7.3") else "mat"
