@@ -287,10 +287,16 @@ def test_a_spreadsheet_s_table_reads_as_the_plain_one(tmp_path):
     plain.write_text("rpm,depth_mm,result,chatter_hz\n20000,0.5,stable,\n20000,0.95,chatter,1290.5\n")
     sheet.write_text("\ufeffRPM;Depth_mm;Result;Chatter_Hz\n20000;0,5;stable;\n20000;0,95;Chatter;1290,5\n",
                      encoding="utf-8")
-    a, b = read_test_cuts(plain), read_test_cuts(sheet)
-    assert [(c.rpm, c.depth_m, c.stable, c.chatter_hz) for c in a] == [(c.rpm, c.depth_m, c.stable, c.chatter_hz)
-                                                                       for c in b]
-    assert b[1].depth_m == pytest.approx(0.95e-3) and b[1].chatter_hz == 1290.5
+    # and its "Unicode text": UTF-16 with its byte-order mark, tab-separated
+    uni = tmp_path / "sheet.txt"
+    uni.write_text("RPM\tDepth_mm\tResult\tChatter_Hz\n20000\t0,5\tstable\t\n20000\t0,95\tchatter\t1290,5\n",
+                   encoding="utf-16")
+    a = read_test_cuts(plain)
+    for other in (sheet, uni):
+        b = read_test_cuts(other)
+        assert [(c.rpm, c.depth_m, c.stable, c.chatter_hz) for c in a] == \
+            [(c.rpm, c.depth_m, c.stable, c.chatter_hz) for c in b], other
+        assert b[1].depth_m == pytest.approx(0.95e-3) and b[1].chatter_hz == 1290.5
 
 
 def test_a_depth_far_outside_the_prior_s_lobes_is_warned(tmp_path, capsys):

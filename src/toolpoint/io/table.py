@@ -26,9 +26,9 @@ __all__ = ["read_rows", "read_table", "csv_safe", "csv_unsafe", "check_regular_f
 def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, list[str]]]:
     """The non-blank rows of a CSV file with their line numbers (1-based, as an editor shows them).
 
-    UTF-8 with or without a byte-order mark; a row whose cells are all blank is skipped. Cells are split at commas,
-    or at semicolons where the first line holds more of them (a spreadsheet's export in a locale whose decimal mark
-    is the comma: there ``0,5`` is read as ``0.5``).
+    UTF-8 with or without a byte-order mark, or UTF-16 with it; a row whose cells are all blank is skipped. Cells are
+    split at commas, or at semicolons or tabs where the first line holds more of them than commas (a spreadsheet's
+    export; there, in a locale whose decimal mark is the comma, ``0,5`` is read as ``0.5``).
 
     Parameters
     ----------
@@ -60,18 +60,21 @@ def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, 
     if p.exists():
         check_regular_file(p, what=what)
     try:
-        with open(p, newline="", encoding="utf-8-sig") as fh:
+        with open(p, "rb") as fb:  # UTF-16 with its byte-order mark: a spreadsheet's "Unicode text" export
+            enc = "utf-16" if fb.read(2) in (b"\xff\xfe", b"\xfe\xff") else "utf-8-sig"
+        with open(p, newline="", encoding=enc) as fh:
             first = ""
             for first in fh:  # the first non-blank line decides the delimiter
                 if first.strip():
                     break
             fh.seek(0)
-            if fh.read(1) != "\ufeff":  # utf-8-sig already skipped a BOM; seek(0) brought it back
+            if fh.read(1) != "\ufeff":  # the codec already skipped a BOM; seek(0) brought it back
                 fh.seek(0)
-            semi = first.count(";") > first.count(",")
-            reader = csv.reader(fh, delimiter=";" if semi else ",")
+            delim = max((",", ";", "\t"), key=first.count) if first.count(",") < max(first.count(";"),
+                                                                                     first.count("\t")) else ","
+            reader = csv.reader(fh, delimiter=delim)
             rows = [(reader.line_num, row) for row in reader if any(c.strip() for c in row)]
-            if semi:  # a spreadsheet that writes ';' between cells writes ',' as the decimal mark
+            if delim != ",":  # a spreadsheet that writes ';' or a tab between cells may write ',' as the decimal mark
                 rows = [(n, [c.replace(",", ".") if _DECIMAL_COMMA.fullmatch(c) else c for c in r])
                         for n, r in rows]
             return rows
