@@ -552,10 +552,11 @@ def test_a_record_is_known_by_its_first_bytes(tmp_path, capsys):
         shutil.copy(wav, tmp_path / name)
         r = read_cut_record(tmp_path / name)
         assert r.rate_hz == ref.rate_hz and np.array_equal(r.samples, ref.samples)
-    # a spreadsheet's "Unicode text": UTF-16 (its byte-order mark FF FE is no MP3 frame), tab-separated
+    # a spreadsheet's "Unicode text": UTF-16 (its byte-order mark FF FE is no MP3 frame), tab-separated, here with the
+    # decimal comma of a German locale
     u16 = tmp_path / "cut.txt"
-    u16.write_text("Time (s)\tp\n" + "".join(f"{k / rate:.7f}\t{v:.7g}\n" for k, v in enumerate(x[:4410])),
-                   encoding="utf-16")
+    u16.write_text("Zeit (s)\tp\n" + "".join(f"{k / rate:.7f}\t{v:.7g}\n".replace(".", ",")
+                                             for k, v in enumerate(x[:4410])), encoding="utf-16")
     r = read_cut_record(u16)
     assert abs(r.rate_hz / rate - 1) < 1e-6 and np.allclose(r.samples, x[:4410], rtol=1e-6, atol=1e-9)
     mat = tmp_path / "cut.mat"

@@ -629,13 +629,15 @@ def _read_lines(path) -> list[str]:
 def _read_text(path) -> tuple[list[str], bool]:
     """(lines of a UTF-8 (or UTF-16 with its byte-order mark) text file, whether it ends without a line break: its
     last line may be cut)."""
+    from .table import text_encoding
+
     _check_readable(path)
     try:
         raw = Path(path).read_bytes()
-        # UTF-16 with its byte-order mark: a spreadsheet's "Unicode text" export
-        text = raw.decode("utf-16") if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else raw.decode("utf-8-sig")
+        enc = text_encoding(raw)
+        text = raw.decode(enc)
     except UnicodeDecodeError:
-        raise InputError("not a UTF-8 text file", file=path) from None
+        raise InputError(f"not a {'UTF-16' if enc == 'utf-16' else 'UTF-8'} text file", file=path) from None
     except OSError as exc:
         raise InputError(f"cannot read file ({exc.strerror or exc})", file=path) from None
     return text.splitlines(), bool(text) and text[-1] not in "\r\n"
@@ -805,22 +807,25 @@ _WRITERS = {".csv": write_csv_frf, ".uff": write_uff58, ".unv": write_uff58, ".u
 
 def numeric_lines(text: list[str]):
     """(line number, cells) of a text table's data lines: comments (``#``, ``%``) and blank lines skipped, cells split
-    at semicolons (a spreadsheet's export where the comma is the decimal mark: ``0,5;1,25`` is 0.5 and 1.25), else at
-    commas, else at white space; header lines before the first number skipped. The one line splitter of the column
-    readers (impact records, cut records).
+    at semicolons (a spreadsheet's export where the comma is the decimal mark: ``0,5;1,25`` is 0.5 and 1.25) or, where
+    a line holds both tabs and commas, at tabs (the same, as "Unicode text"), else at commas, else at white space;
+    header lines before the first number skipped. The one line splitter of the column readers (impact records, cut
+    records).
 
     Examples
     --------
-    >>> list(numeric_lines(["t;acc", "0,0;1,5", "0,1;-2"])), list(numeric_lines(["0.0, 1.5", "0.1\t-2"]))
+    >>> list(numeric_lines(["t;acc", "0,0;1,5", "0,1;-2"])), list(numeric_lines(["0.0, 1.5", "0.1\\t-2"]))
     ([(2, ['0.0', '1.5']), (3, ['0.1', '-2'])], [(1, ['0.0', '1.5']), (2, ['0.1', '-2'])])
+    >>> list(numeric_lines(["t\\tacc", "0,0\\t1,5"]))
+    [(2, ['0.0', '1.5'])]
     """
     started = False
     for n, line in enumerate(text, 1):
         s = line.strip()
         if not s or s[0] in "#%":
             continue
-        if ";" in s:
-            cells = [c.strip().replace(",", ".") for c in s.split(";")]
+        if ";" in s or ("\t" in s and "," in s):  # a spreadsheet's cells: ',' there is the decimal mark
+            cells = [c.strip().replace(",", ".") for c in s.split(";" if ";" in s else "\t")]
         else:
             cells = [c.strip() for c in (s.split(",") if "," in s else s.split())]
         if not started and not _is_number(cells[0]):

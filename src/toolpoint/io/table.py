@@ -20,7 +20,19 @@ from ..errors import InputError
 
 _DECIMAL_COMMA = re.compile(r"\s*[+-]?\d*,\d+(?:[eE][+-]?\d+)?\s*")  # "-0,5", ",5", "1,25e-3"
 
-__all__ = ["read_rows", "read_table", "csv_safe", "csv_unsafe", "check_regular_file"]
+__all__ = ["read_rows", "read_table", "text_encoding", "csv_safe", "csv_unsafe", "check_regular_file"]
+
+
+def text_encoding(head: bytes) -> str:
+    """The codec of a text file from its first two bytes: ``utf-16`` after a UTF-16 byte-order mark (a spreadsheet's
+    "Unicode text" export), else ``utf-8-sig`` (UTF-8 with or without its mark). The one rule of the text readers.
+
+    Examples
+    --------
+    >>> text_encoding("a,b".encode("utf-16")), text_encoding(b"a,")
+    ('utf-16', 'utf-8-sig')
+    """
+    return "utf-16" if head[:2] in (b"\xff\xfe", b"\xfe\xff") else "utf-8-sig"
 
 
 def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, list[str]]]:
@@ -60,8 +72,8 @@ def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, 
     if p.exists():
         check_regular_file(p, what=what)
     try:
-        with open(p, "rb") as fb:  # UTF-16 with its byte-order mark: a spreadsheet's "Unicode text" export
-            enc = "utf-16" if fb.read(2) in (b"\xff\xfe", b"\xfe\xff") else "utf-8-sig"
+        with open(p, "rb") as fb:
+            enc = text_encoding(fb.read(2))
         with open(p, newline="", encoding=enc) as fh:
             first = ""
             for first in fh:  # the first non-blank line decides the delimiter
@@ -81,7 +93,8 @@ def read_rows(path: str | os.PathLike, *, what: str = "CSV") -> list[tuple[int, 
     except FileNotFoundError:
         raise InputError(f"cannot read {what}: file not found", file=p) from None
     except UnicodeDecodeError as err:
-        raise InputError(f"cannot read {what}: not UTF-8 text (byte {err.start})", file=p) from None
+        raise InputError(f"cannot read {what}: not {'UTF-16' if enc == 'utf-16' else 'UTF-8'} text (byte {err.start})",
+                         file=p) from None
     except (OSError, csv.Error) as err:
         raise InputError(f"cannot read {what}: {getattr(err, 'strerror', None) or err}", file=p) from None
 
