@@ -1,7 +1,7 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|update|sampler|forward|ceiling|sdm-bands] [--shops zoa,noisy,sim] [--cases cornelius,example]
+        [--only cut|inside|update|sampler|forward|ceiling|sdm-bands] [--shops zoa,noisy,sim] [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
         [--sensor microphone|accelerometer]
@@ -17,6 +17,8 @@ CPU time (time.process_time), not wall time: the machine is shared.
    speeds, heard by the tests' shop microphone or (``--sensor accelerometer``) by an accelerometer on the spindle
    housing (tests/milling_sim.py: force through a housing mode, bearing and imbalance lines, mains hum, offset and
    drift, 25.6 kS/s).
+   ``inside``: records taken inside a chattering cut, without air cut (windows of the real recording's chattering
+   stretch; synthetic cuts whose chatter waxes and wanes).
 2. ``update``: virtual campaigns (truth drawn from the prior, the next cut from the ``info`` rule) on the
    Cornelius et al. 2024 two-mode case and on the toolpoint example tool, over ``--seeds`` seeds, with two shops:
    ``zoa`` (cuts labelled by the true zero-order limit: the update's own model), ``noisy`` (the true limit
@@ -123,6 +125,42 @@ def bench_cut(quick):
             fa[ad] += r.verdict == "chatter"
     print(f"stable synthetic records with a stray tone switched on with the cut (300–4000 Hz, 0.01–0.05 of full "
           f"scale): false chatter {fa[0.002]}/{n} with the alias rule (alias_dominance 0.002), {fa[0.0]}/{n} without")
+
+
+def bench_cut_inside(quick):
+    """Records taken inside a chattering cut (no air cut): windows of the real recording's chattering stretch under
+    two readings of its speed and teeth, and synthetic cuts without air whose chatter waxes and wanes."""
+    print("\n## cut: records inside the cut (no air cut)")
+    rec = read_cut_record(REAL)
+    x, rate = rec.samples, rec.rate_hz
+    starts = np.arange(9.6, 14.01, 0.4 if quick else 0.2)
+    for kw in (dict(rpm=6500, teeth=2, rpm_tolerance=0.05), dict(rpm=6460, teeth=4)):
+        n = ok = 0
+        for a in starts:
+            for d in (2, 3, 4, 5, 6):
+                if a + d > 16.1:
+                    continue
+                r = analyse_cut(x[int(a * rate):int((a + d) * rate)], rate, full_scale=rec.full_scale, **kw)
+                n += 1
+                ok += r.verdict == "chatter" and abs(r.chatter_hz / 1067.3 - 1) < 0.01
+        print(f"real recording, windows of 2–6 s starting {starts[0]:.1f}–{starts[-1]:.1f} s inside its chattering "
+              f"stretch, {kw['rpm']} rpm and {kw['teeth']} teeth given: {ok}/{n} chatter at 1067.3 Hz ±1 %")
+    combos = ((6000, 4, 1234.0), (9000, 3, 1630.0), (12000, 2, 2890.0), (3000, 4, 731.0), (18000, 6, 2345.0))
+    n = ok = 0
+    for seed in range(1 if quick else 3):
+        for rpm, teeth, fc in combos:
+            for chatter in (None, fc):
+                for swing in (0.0, 10.0, 16.0):
+                    for amp in ((0.5, 2.0, 5.0) if chatter else (0.5,)):
+                        y, rate_y, *_ = shop_record(rpm=rpm, teeth=teeth, chatter_hz=chatter, chatter_amp=amp,
+                                                    mode_hz=fc, air_s=0.0, cut_s=5.0, chatter_swing_db=swing,
+                                                    fans=(), seed=seed)
+                        r = analyse_cut(y, rate_y, rpm=rpm, teeth=teeth, full_scale=1.0)
+                        n += 1
+                        ok += (r.verdict == "stable" if chatter is None else
+                               r.verdict == "chatter" and abs(r.chatter_hz / fc - 1) < 0.01)
+    print(f"synthetic cuts without air (tests/shop_synth.py: 5 speeds and tooth counts, chatter 0.5–5 x the tooth-"
+          f"passing line waxing and waning by 0, 10, 16 dB, stable ones, no fans): {ok}/{n} right")
 
 
 # (dominance, alias_dominance, growth_db): the default first; without the growth test; its rise at 3 and 10 dB;
@@ -474,7 +512,7 @@ def main():
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=("cut", "update", "sampler", "forward", "ceiling", "sdm-bands"))
+    ap.add_argument("--only", choices=("cut", "inside", "update", "sampler", "forward", "ceiling", "sdm-bands"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -506,6 +544,8 @@ def main():
             pockets[tool] = prior_from_library(out, tool)
         bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level,
                           sensor=a.sensor)
+    if a.only in (None, "inside"):
+        bench_cut_inside(a.quick)
     if a.only in (None, "forward"):
         bench_forward()
     if a.only in (None, "ceiling"):

@@ -23,8 +23,12 @@ import numpy as np
 
 def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_amp=1.0, air_s=1.0, cut_s=2.0,
                 fans=(617.0, 1813.0), fan_amp=0.3, noise=0.05, mode_hz=None, speed_droop=0.0, speed_wander=0.0,
-                wander_hz=0.5, speed_step=0.0, seed=0):
-    """(samples, rate, cut start s, cut end s)."""
+                wander_hz=0.5, speed_step=0.0, air_lines=0.02, chatter_swing_db=0.0, swing_hz=0.4, seed=0):
+    """(samples, rate, cut start s, cut end s).
+
+    ``air_lines``: the spindle's k-th harmonic in air, ``air_lines``/k (0.3–1: a spindle that rings in air).
+    ``chatter_swing_db``: developed chatter waxes and wanes by this much (peak to peak, dB) at ``swing_hz``, as the
+    real recording's chatter line does (±5 dB over a second or two, ``examples/cuts``)."""
     rng = np.random.default_rng(seed)
     n = int((2 * air_s + cut_s) * rate)
     t = np.arange(n) / rate
@@ -44,7 +48,7 @@ def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_a
         spin = None
     for k in range(1, kmax + 1):  # loops over harmonics (tens), not samples
         tooth = k % teeth == 0
-        a_air = 0.02 / k
+        a_air = air_lines / k
         a_cut = (1.0 if tooth else 0.1) / (k / teeth) ** 1.2
         arg = 2 * np.pi * k * f_s * t if spin is None else k * spin
         x += (a_air + a_cut * ramp) * np.sin(arg + phases[k])
@@ -60,6 +64,8 @@ def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_a
         x += 0.5 * (t >= t0) * np.exp(-te / 0.05) * np.sin(2 * np.pi * mode_hz * te)
     if chatter_hz is not None:
         grow = np.clip((t - t0 - 0.1) / 0.3, 0, 1) * ramp
+        if chatter_swing_db:
+            grow = grow * 10 ** (chatter_swing_db / 40 * np.sin(2 * np.pi * swing_hz * t + rng.uniform(0, 2 * np.pi)))
         wander = 1 + 1e-3 * np.sin(2 * np.pi * 0.7 * t)
         phase = 2 * np.pi * np.cumsum(chatter_hz * wander) / rate
         x += chatter_amp * grow * np.sin(phase)
