@@ -866,7 +866,8 @@ def _lines_held(S_loud, S_q, freq, keep, harm, f_s, df, top=8, line_db=10.0, hel
     """How much of the loud part's sound in lines the quiet part holds too, weaker: of the ``top`` local peaks of
     ``S_loud`` among the ``keep`` bins (off the spindle harmonics) standing most (≥ ``line_db``) over its own floor, the
     share, weighted by that excess, of those that stand ≥ ``held_db`` over the quiet part's own floor at the same
-    frequency (±1 bin), and no further than over the loud part's. 0 when the loud part has no such line.
+    frequency (±1 bin), and ≥ ``louder_db`` less far than over the loud part's floor. 0 when the loud part has no such
+    line.
 
     Floors are each spectrum's own, so a recorder's gain does not move the share, plus what the Hann window leaks from
     the spindle harmonics (``harm`` bins, :func:`_leakage`): a spindle that rings in air leaks into a chatter line a
