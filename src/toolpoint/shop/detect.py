@@ -43,7 +43,10 @@ The detector (:func:`analyse_cut`):
    developed chatter near a tooth harmonic, with its aliases and its own harmonics, is a comb a little off
    the spindle's, and on the real recording in ``examples/cuts`` that comb read the spindle 0.9 % slow during
    the chatter while its first two tooth harmonics did not move. The cost: chatter within the speed range
-   plus the pad of a harmonic is masked (it cannot be told from the moving harmonic on a spectrum);
+   plus the pad of a harmonic is masked (it cannot be told from the moving harmonic on a spectrum). Where the
+   tooth-passing harmonics hold steady at a speed more than the mask's 0.05 % from the comb's, theirs is the speed:
+   the comb followed a chatter family (2–3 s inside the real recording's chatter at 2 teeth: 6386 rpm, the harmonics
+   at 6459);
 4. **the chatter test** in the averaged (Welch) power spectrum P of a segment, with the floor F the
    median of the unmasked bins in blocks of 32 bins (corrected for the median of χ²_ν/ν) plus what the
    Hann window leaks from the two nearest spindle harmonics (×4; strong harmonics' sidelobes are not tones):
@@ -135,7 +138,7 @@ The detector (:func:`analyse_cut`):
    spindle that rings in air for cutting where heavy chatter lowers the cut's prominence to the air's (simulated at
    25 000 rpm: 9 and 12 dB); the chatter is not in that air. (b)'s "weaker" keeps a fan, which stands as far or
    further over the air's floor than over the cut's, from making air of the cut. Measured (``docs/design/shop.md``):
-   windows of 2–6 s inside the real chattering stretch 49 → 59 of 65 chatter at 1067 Hz (2 teeth at 6500 rpm given),
+   windows of 2–6 s inside the real chattering stretch 49 → 60 of 65 chatter at 1067 Hz (2 teeth at 6500 rpm given),
    55 → 65 of 65 (4 teeth at 6460 rpm); no verdict, chatter frequency or segment count moved on 1 789 simulated
    records, nor on 1 786 through two gain controls.
 5. **once-per-revolution metric** (where the segment holds ≥ 10 revolutions): the signal resampled at
@@ -634,13 +637,36 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         elsewhere = _speed_elsewhere(freq, logp, floor, f_nom, teeth, rpm_tolerance, df)
     else:
         f_s, spindle_found, elsewhere = f_nom, True, None
+    # the speed per cutting frame: spindles slow under load and their speed wanders; where it wanders by more than
+    # the mask allows, each judged part masks the harmonics over the range of speeds its frames ran at
+    f_comb = f_s
+
+    def tracked(frames):
+        """(the speed track (times s, Hz) or None, its wander, the spindle frequency Hz) over these frames."""
+        if rpm_tolerance > 0 and frames.size >= 3:
+            t_f, f_f = _track_speed(P[frames], frame_t[frames], freq, inband, f_comb, teeth * f_comb, rpm_tolerance,
+                                    df)
+            if t_f.size >= 3:
+                wan = float(np.max(np.abs(f_f / np.median(f_f) - 1)))
+                if wan > _TRACK_REL:
+                    return (t_f, f_f), wan, float(np.median(f_f))
+                if abs(np.median(f_f) / f_comb - 1) > _TRACK_REL:
+                    # steady, but not where the comb put it: the comb followed a chatter family (2–3 s inside the
+                    # real recording's chattering stretch at 2 teeth: 6386 rpm, its tooth-passing harmonics steady at
+                    # 6459 rpm)
+                    return None, wan, float(np.median(f_f))
+                return None, wan, f_comb
+        return None, 0.0, f_comb
+
+    track, wander, f_s = tracked(cutting)
     if cand is not None and ref is not None:
         # quiet runs whose tooth passing stands out as in the cut (_split) are cutting when they hold the cut's lines
         # off the spindle harmonics — its chatter, waning — as well, each in the long frames wholly inside it. A
         # spindle's own lines can stand out in air as far as heavy chatter leaves the cut's tooth passing
         # (simulated at 25 000 rpm: 9 and 12 dB); the chatter is not in the air, and a frame that reaches into the
         # cut hears it. A run without a whole long frame is shorter than an air cut: a pause in the cut either way
-        keep0, harm0 = _harmonic_mask(freq, inband, f_s, f_s, df)
+        keep0, harm0 = _harmonic_mask(freq, inband, f_s, f_s, df)  # at the median speed: chatter a wrong reading
+        # of the speed in a frame or two would mask is the line looked for
         S_cut = P[cutting].mean(axis=0)
         accepted = np.zeros_like(cand)
         for s, e, v in _runs(cand):
@@ -652,16 +678,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             again = parts(finish(accepted))
             if again[3] is not None:
                 runs, air, ref, cutting = again
-    # the speed per cutting frame: spindles slow under load and their speed wanders; where it wanders by more than
-    # the mask allows, each judged part masks the harmonics over the range of speeds its frames ran at
-    track, wander = None, 0.0
-    if rpm_tolerance > 0 and cutting.size >= 3:
-        t_f, f_f = _track_speed(P[cutting], frame_t[cutting], freq, inband, f_s, teeth * f_s, rpm_tolerance, df)
-        if t_f.size >= 3:
-            wander = float(np.max(np.abs(f_f / np.median(f_f) - 1)))
-            if wander > _TRACK_REL:
-                track = (t_f, f_f)
-                f_s = float(np.median(f_f))
+                track, wander, f_s = tracked(cutting)
 
     # 3. harmonic mask: all multiples of the spindle frequency
     keep, harm = _harmonic_mask(freq, inband, f_s, f_s, df)
