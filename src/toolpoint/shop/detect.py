@@ -140,7 +140,11 @@ The detector (:func:`analyse_cut`):
    further over the air's floor than over the cut's, from making air of the cut. Measured (``docs/design/shop.md``):
    windows of 2–6 s inside the real chattering stretch 49 → 60 of 65 chatter at 1067 Hz (2 teeth at 6500 rpm given),
    55 → 65 of 65 (4 teeth at 6460 rpm); no verdict, chatter frequency or segment count moved on 1 789 simulated
-   records, nor on 1 786 through two gain controls.
+   records, nor on 1 786 through two gain controls. *The level upside down*: a phone's gain control brought the real
+   recording's chattering cut under its air by the band's median power, and the split took the air for the cut
+   ("chatter at 1770.7 Hz", a machine line). Where the loud part's tooth passing stands ≤ 3 dB over noise and the
+   quiet part's ≥ 4 dB and ≥ 3 dB further, the quiet part is the cut, unless the air this leaves holds the cut's lines
+   off the spindle harmonics at all (≥ 6 dB over its floor): now chatter at 1067.4 Hz, the air first.
 5. **once-per-revolution metric** (where the segment holds ≥ 10 revolutions): the signal resampled at
    64 points per revolution, R = 1 − E_sync/E_total (E_sync: energy of the revolution-synchronous mean,
    with its finite-average bias removed): 0 for a periodic (stable, noiseless) signal, → 1 for chatter
@@ -183,6 +187,8 @@ _ELSEWHERE_DB = 13.0  # … where the tooth-passing harmonics stand this far ove
 _ELSEWHERE_GAIN_DB = 10.0  # … and this much higher than within the tolerance: warned (see _speed_elsewhere)
 _CUT_PROMINENCE_DB = 4.0  # dB over noise: a quiet stretch whose tooth-passing harmonics stand out this far, and half
 #   as far as in the loud part, is cutting (see _split)
+_AIR_EXCESS_DB = 3.0  # dB over noise: a loud part whose tooth-passing harmonics stand out no further has none …
+_SWAP_DB = 3.0  # … and a quiet part whose stand out this much further is the cut: a level upside down (see _split)
 _AIR_PROMINENCE_DB = 2.0  # a loud stretch whose tooth-passing harmonics stand out as in the air (± this): air
 
 
@@ -586,8 +592,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                          "record length", file=source, field="band_hz")
 
     # 1. segments: air cut vs cutting
-    active, cand, finish, short_t, min_air = _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth,
-                                                    rpm_tolerance, activity_db)
+    active, cand, finish, swap, short_t, min_air = _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth,
+                                                          rpm_tolerance, activity_db)
 
     def frames_in(ta, tb):
         """Frames lying (to a quarter frame) inside [ta, tb]; at least the one nearest its middle."""
@@ -608,35 +614,40 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         raise InputError("no cutting found in the record (only air cut)", file=source, field="samples")
 
     # 2. spindle frequency: comb search on the mean spectrum of the cutting frames
-    mean_p = P[cutting].mean(axis=0)
-    logp = np.log(mean_p + 1e-300)
-    floor = np.log(_block_floor(mean_p[None, :], inband)[0] + 1e-300)
-    rev_s = None
-    if rpm_tolerance > 0:
-        ftop = min(hi, 40 * f_nom)
-        step = df / (4 * max(1.0, ftop / f_nom))
-        f0s = np.arange(f_nom * (1 - rpm_tolerance), f_nom * (1 + rpm_tolerance) + step, step)
-        score = _comb_score(freq, logp, floor, f0s, ftop)
-        best = int(np.argmax(score))
-        f_s = float(f0s[best])
-        spindle_found = bool(score[best] > 0.5)  # the comb's mean log-excess: e^0.5, 2.2 dB over the floor
-        if not spindle_found:
-            f_s = f_nom
-            # a speed given in rev/s (Hz) where rpm was asked: the comb at 60 × the nominal (the real recording at
-            # "--rpm 108" was "stable, harmonics not found", its spindle running at 6460 rpm)
-            f60 = 60.0 * f_nom
-            if 4 * teeth * f60 * (1 + rpm_tolerance) < hi:
-                top60 = min(hi, 40 * f60)
-                st60 = df / (4 * max(1.0, top60 / f60))  # a quarter bin at the highest harmonic, as above
-                g0s = np.arange(f60 * (1 - rpm_tolerance), f60 * (1 + rpm_tolerance) + st60, st60)
-                s60 = _comb_score(freq, logp, floor, g0s, top60)
-                if s60.max() > 0.5:
-                    rev_s = float(g0s[int(np.argmax(s60))])
+    def spindle(frames):
+        """(f_s Hz, spindle found, the speed in rev/s the comb finds at 60 × or None, a speed elsewhere or None)."""
+        mean_p = P[frames].mean(axis=0)
+        logp = np.log(mean_p + 1e-300)
+        floor = np.log(_block_floor(mean_p[None, :], inband)[0] + 1e-300)
+        rev_s = None
+        if rpm_tolerance > 0:
+            ftop = min(hi, 40 * f_nom)
+            step = df / (4 * max(1.0, ftop / f_nom))
+            f0s = np.arange(f_nom * (1 - rpm_tolerance), f_nom * (1 + rpm_tolerance) + step, step)
+            score = _comb_score(freq, logp, floor, f0s, ftop)
+            best = int(np.argmax(score))
+            f_s = float(f0s[best])
+            spindle_found = bool(score[best] > 0.5)  # the comb's mean log-excess: e^0.5, 2.2 dB over the floor
+            if not spindle_found:
+                f_s = f_nom
+                # a speed given in rev/s (Hz) where rpm was asked: the comb at 60 × the nominal (the real recording at
+                # "--rpm 108" was "stable, harmonics not found", its spindle running at 6460 rpm)
+                f60 = 60.0 * f_nom
+                if 4 * teeth * f60 * (1 + rpm_tolerance) < hi:
+                    top60 = min(hi, 40 * f60)
+                    st60 = df / (4 * max(1.0, top60 / f60))  # a quarter bin at the highest harmonic, as above
+                    g0s = np.arange(f60 * (1 - rpm_tolerance), f60 * (1 + rpm_tolerance) + st60, st60)
+                    s60 = _comb_score(freq, logp, floor, g0s, top60)
+                    if s60.max() > 0.5:
+                        rev_s = float(g0s[int(np.argmax(s60))])
+            else:
+                f_s = _refine_speed(freq, logp, floor, inband, f_s, f_nom, teeth, rpm_tolerance, df)
+            elsewhere = _speed_elsewhere(freq, logp, floor, f_nom, teeth, rpm_tolerance, df)
         else:
-            f_s = _refine_speed(freq, logp, floor, inband, f_s, f_nom, teeth, rpm_tolerance, df)
-        elsewhere = _speed_elsewhere(freq, logp, floor, f_nom, teeth, rpm_tolerance, df)
-    else:
-        f_s, spindle_found, elsewhere = f_nom, True, None
+            f_s, spindle_found, elsewhere = f_nom, True, None
+        return f_s, spindle_found, rev_s, elsewhere
+
+    f_s, spindle_found, rev_s, elsewhere = spindle(cutting)
     # the speed per cutting frame: spindles slow under load and their speed wanders; where it wanders by more than
     # the mask allows, each judged part masks the harmonics over the range of speeds its frames ran at
     f_comb = f_s
@@ -659,6 +670,20 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         return None, 0.0, f_comb
 
     track, wander, f_s = tracked(cutting)
+    if swap is not None:
+        # the quiet part with tooth passing is the cut and the loud part without it the air (_split), unless that
+        # air holds the cut's lines off the spindle harmonics at all (≥ 6 dB over its floor): then the loud part
+        # was cutting too (a housing accelerometer on a slot hears no tooth passing, but its bearings' lines rise
+        # with the load)
+        alt = parts(swap)
+        if alt[2] is not None and alt[3] is not None:
+            g = spindle(alt[3])
+            keep_g, harm_g = _harmonic_mask(freq, inband, g[0], g[0], df)
+            if _lines_held(P[alt[3]].mean(axis=0), alt[2], freq, keep_g, harm_g, g[0], df, louder_db=-np.inf) < 0.5:
+                runs, air, ref, cutting = alt
+                f_s, spindle_found, rev_s, elsewhere = g
+                f_comb, cand = f_s, None
+                track, wander, f_s = tracked(cutting)
     if cand is not None and ref is not None:
         # quiet runs whose tooth passing stands out as in the cut (_split) are cutting when they hold the cut's lines
         # off the spindle harmonics — its chatter, waning — as well, each in the long frames wholly inside it. A
@@ -802,7 +827,7 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
     # tooth-passing harmonics; smoothed over 9 frames), else in the long ones (a slow spindle's harmonics; smoothed
     # over 3 frames and read at the short frames' times). Where no level splits the record, in the long frames
     # always: their lines stand 4x further out of a broadband noise than in the short ones
-    prom = None
+    prom = swap = None
     like_cut = np.zeros_like(active)
     tol = max(rpm_tolerance, 0.005)
     if Ps.shape[0] >= 16 and P.shape[0] >= 3:
@@ -837,6 +862,14 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
             for s, e, v in _runs(active):
                 if not v and float(np.median(prom[s:e])) - base >= max(_CUT_PROMINENCE_DB, 0.5 * ex_cut):
                     like_cut[s:e] = True
+            # the level upside down: no tooth passing in the loud part, clear tooth passing in the quiet one. A
+            # phone's gain control brought the real recording's chattering cut down under its air by the band's
+            # median power (−22 dB in air, −29 to −34 in the cut through a 0.05 s / 2 s control); the loud part's
+            # tooth passing 2–3 dB over noise, the quiet part's 7–8. A candidate for the other way round, confirmed in
+            # analyse_cut: the air it would make must not hold the cut's lines
+            if like_cut.any() and ex_cut <= _AIR_EXCESS_DB and \
+                    float(np.median(prom[like_cut])) - base >= ex_cut + _SWAP_DB:
+                swap = like_cut.copy()
 
         def veto(act):
             # loud, but the tooth-passing harmonics stand out no more than in the air cut, for as long as an air cut
@@ -861,7 +894,8 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
             def finish(accepted):
                 return veto(pre | accepted)
         active = veto(active)
-    return active, (like_cut if like_cut.any() else None), (finish if like_cut.any() else None), short_t, min_air
+    return (active, (like_cut if like_cut.any() else None), (finish if like_cut.any() else None), swap, short_t,
+            min_air)
 
 
 def _air_cut_runs(active, short_t, min_air, dur):
