@@ -29,7 +29,7 @@ def test_stable_cut_with_fans_and_runout_is_stable():
     entry = next(s for s in res.segments if s.kind == "entry")
     exit_ = next(s for s in res.segments if s.kind == "exit")
     assert abs(entry.start_s - t0) < 0.2 and abs(exit_.end_s - t1) < 0.2
-    assert res.spindle_found and abs(res.rpm / 6000 - 1) < 1e-3
+    assert abs(res.rpm / 6000 - 1) < 1e-3
 
 
 @pytest.mark.parametrize("rpm,teeth,fc", [(6000, 4, 1234.0), (9100, 2, 2620.0), (3150, 3, 812.0)])
@@ -106,7 +106,7 @@ def test_real_shop_recording_air_entry_cut_chatter_exit():
     rec = read_cut_record(REAL)
     assert rec.rate_hz == 44100 and rec.channel == "mean of 2"
     res = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
-    assert res.spindle_found and abs(res.rpm * 2 / 60 - 215.3) < 0.3
+    assert abs(res.rpm * 2 / 60 - 215.3) < 0.3
     assert res.criterion["speed_elsewhere_rpm"] is None  # the tooth passing stands out at the speed found
     # its spindle runs faster out of the cut: the first two tooth-passing harmonics read 215.6–215.8 Hz at the
     # entry and the exit, 215.3 in the cut (peaks of 1.5 s frames, read by hand) — 0.1–0.2 %, more than the
@@ -266,20 +266,33 @@ def test_a_nominal_speed_several_percent_off_is_warned_with_the_speed_in_the_rec
     """A nominal speed off by more than the search range (an override, another program's speed) leaves the
     tooth-passing harmonics outside their masks, where they can be judged as chatter. The real recording's spindle
     ran at 6460 rpm: given 5850, 6800 or 7150 rpm (−9 % … +11 %), its tooth-passing harmonics stand out there and
-    not within ±3 % of the nominal, and `cut` says so; at 6500 rpm it does not."""
+    not within ±3 % of the nominal, and `cut` says so: a warning (heavy chatter can make a comb elsewhere), or at
+    6800 rpm, where no comb stands out within the range and no chatter line ≥ 20 dB out at the nominal speed, a
+    refusal naming rpm and the speed; at 6500 rpm it does not."""
     rec = read_cut_record(REAL)
-    res = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=2, full_scale=rec.full_scale)
+    try:
+        res = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=2, full_scale=rec.full_scale)
+    except InputError as exc:  # no comb within the range, and no chatter line ≥ 20 dB out at the nominal speed
+        assert rpm == 6800.0 and exc.field == "rpm" and "give the speed the spindle ran at" in str(exc)
+        assert abs(float(str(exc).split(" dB over the floor at ")[1].split(" rpm")[0]) / 6460.0 - 1) < 0.002
+        return
     assert abs(res.criterion["speed_elsewhere_rpm"] / 6460.0 - 1) < 0.002
-    assert any("check the speed the spindle ran at" in w for w in res.criterion["warnings"])
+    said = [w for w in res.criterion["warnings"] if "the spindle ran at" in w]
+    assert len(said) == 1, res.criterion["warnings"]
 
 
 def test_a_stable_record_given_a_wrong_speed_is_warned_and_the_right_speed_is_not():
     x, rate, _, _ = shop_record(rpm=6000, teeth=4, chatter_hz=None, mode_hz=1234.0, seed=1)
     right = analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0)
     assert right.criterion["speed_elsewhere_rpm"] is None and right.verdict == "stable"
-    for nominal in (5600.0, 6300.0):  # −6.7 %, +5 %
-        wrong = analyse_cut(x, rate, rpm=nominal, teeth=4, full_scale=1.0)
-        assert abs(wrong.criterion["speed_elsewhere_rpm"] / 6000.0 - 1) < 1e-3, nominal
+    for nominal in (5600.0, 6300.0):  # −6.7 %, +5 %: warned, or refused where no comb stands out in the range
+        try:
+            wrong = analyse_cut(x, rate, rpm=nominal, teeth=4, full_scale=1.0)
+            named = wrong.criterion["speed_elsewhere_rpm"]
+        except InputError as exc:  # a stable cut judged at a speed whose harmonics are not heard: no verdict
+            assert exc.field == "rpm" and "the spindle ran at" in str(exc), nominal
+            named = float(str(exc).split(" dB over the floor at ")[1].split(" rpm")[0])
+        assert abs(named / 6000.0 - 1) < 1e-3, nominal
 
 
 def test_the_spindle_speed_is_read_from_a_record_with_few_harmonics():
@@ -658,15 +671,50 @@ def test_digital_silence_a_dropout_is_refused_and_a_recorder_s_lead_in_is_cut_of
 
 def test_a_speed_given_in_rev_per_s_is_named():
     """'--rpm 107.7' for a spindle at 6460 rpm (107.7 rev/s): no spindle harmonics near 107.7 rpm, and the comb at
-    60 × that stands out in the real recording — said, with the speed; at the right speed nothing of the kind."""
+    60 × that stands out in the real recording — refused, naming rpm and the speed; at the right speed nothing of the
+    kind."""
     rec = read_cut_record(REAL)
-    res = analyse_cut(rec.samples, rec.rate_hz, rpm=107.7, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
-    said = [w for w in res.criterion["warnings"] if "rev/s" in w]
-    assert not res.spindle_found and len(said) == 1
-    rpm = float(said[0].split("but near ")[1].split(" rpm")[0])
+    with pytest.raises(InputError, match="rev/s") as exc:
+        analyse_cut(rec.samples, rec.rate_hz, rpm=107.7, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
+    assert exc.value.field == "rpm"
+    rpm = float(str(exc.value).split("but near ")[1].split(" rpm")[0])
     assert abs(rpm / 6460 - 1) < 0.01
     ok = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
     assert not any("rev/s" in w for w in ok.criterion["warnings"])
+
+
+def test_a_record_that_does_not_hear_the_spindle_is_refused_not_judged(tmp_path, capsys):
+    """White noise (a microphone left unplugged, a wrong file) was "chatter" in 7 of 12 records of 20 s: without
+    spindle harmonics "strong" (against the strongest harmonic) holds for any noise peak, and one significant peak
+    in ~20 windows passed. Refused, naming rpm. A record whose spindle is not heard keeps its verdict only where a
+    chatter line stands ≥ 20 dB out, with a warning — the real recording (6460 rpm) given 8000 rpm, whose best comb
+    lay at the range's edge (7760 rpm, where it was read and judged), saying where the harmonics do stand out. A
+    speed given exactly (tolerance 0) is read there alone."""
+    import soundfile as sf
+
+    rate = 44100.0
+    for seed in range(3):
+        x = np.random.default_rng(seed).normal(0.0, 1e-3, int(10 * rate))
+        with pytest.raises(InputError, match="no spindle harmonics stand out") as exc:
+            analyse_cut(x, rate, rpm=6500, teeth=2)
+        assert exc.value.field == "rpm"
+        with pytest.raises(InputError, match="no spindle harmonics stand out"):
+            analyse_cut(x, rate, rpm=6500, teeth=2, rpm_tolerance=0.0)
+    wav = tmp_path / "noise.wav"
+    sf.write(wav, x, int(rate), subtype="FLOAT")
+    out = tmp_path / "c.json"
+    assert main(["cut", str(wav), "--rpm", "6500", "--teeth", "2", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "noise.wav" in err and "rpm" in err and not out.exists()
+
+    rec = read_cut_record(REAL)
+    a, b = 0, int(20 * rec.rate_hz)  # air, cut, chatter
+    res = analyse_cut(rec.samples[a:b], rec.rate_hz, rpm=8000, teeth=2, full_scale=rec.full_scale)
+    said = [w for w in res.criterion["warnings"] if "range's edge" in w]
+    assert len(said) == 1 and res.verdict == "chatter" and abs(res.chatter_hz / 1067.3 - 1) < 0.01
+    assert abs(float(said[0].split("; at ")[1].split(" rpm")[0]) / 6460 - 1) < 0.005
+    ok = analyse_cut(rec.samples[a:b], rec.rate_hz, rpm=6460, teeth=2, rpm_tolerance=0.0, full_scale=rec.full_scale)
+    assert ok.verdict == "chatter" and abs(ok.chatter_hz / 1067.3 - 1) < 0.01
 
 
 def test_stereo_channels_in_opposite_polarity_are_not_averaged_away(tmp_path):
@@ -743,3 +791,28 @@ def test_the_real_recording_through_a_phone_s_gain_control_keeps_its_air_cut(att
     assert 6.0 < entry.start_s < 7.5
     assert res.verdict == "chatter" and abs(res.chatter_hz / 1067.3 - 1) < 0.01
     assert any("gain control" in w for w in res.criterion["warnings"])
+
+
+def test_the_tone_test_holds_its_false_alarm_rate_on_noise():
+    """The tone test's level t_α against what it claims: parts of n Hann frames of white noise, judged as `_judge`
+    judges them (the block-median floor over the unmasked bins), exceed it in about α of the parts. The χ² level with
+    Welch's ν used before held α = 0.1 for 0.29–0.38 of these parts (its floor's own error and the overlapping
+    frames' heavier tail ignored) and fails this."""
+    from toolpoint.shop import detect as d
+
+    rate, f_nom = 44100.0, 6500 / 60
+    L = 16336  # the frames analyse_cut takes at 6500 rpm, hop a quarter
+    hop = L // 4
+    x = np.random.default_rng(7).normal(size=int(240 * rate))
+    P, _ = d._stft(x, L, hop)
+    freq = np.fft.rfftfreq(L, 1 / rate)
+    df = rate / L
+    keep, _ = d._harmonic_mask(freq, (freq >= 54) & (freq <= 10_000), f_nom, f_nom, df)
+    nu1, thr = d._welch_dof(L, hop), d._tone_threshold(L, hop)
+    for n in (4, 10):
+        parts = P[: P.shape[0] // n * n].reshape(-1, n, P.shape[1]).mean(axis=1)
+        floor = d._block_floor(parts, keep) / d._chi2_median_ratio(nu1(n))
+        zmax = np.where(keep, parts / floor, 0.0).max(axis=1)
+        for alpha, lo, hi in ((0.1, 0.03, 0.16), (0.01, 0.0, 0.03)):
+            rate_seen = float(np.mean(zmax > thr(n, int(keep.sum()), alpha)))
+            assert lo <= rate_seen <= hi, (n, alpha, rate_seen, parts.shape[0])

@@ -98,7 +98,7 @@ def run(args) -> int:
         print(text)
     msg = (f"{rec_path.name}: {res.verdict}"
            + (f" at {res.chatter_hz:.1f} Hz; Harmonizer speed {res.recommended_rpm:.0f} rpm" if res.chatter_hz else "")
-           + f"; spindle {res.rpm:.1f} rpm" + ("" if res.spindle_found else " (nominal: harmonics not found)")
+           + f"; spindle {res.rpm:.1f} rpm"
            + (f", its speed wandered ±{100 * res.criterion['speed_wander']:.2g} % (tracked)"
               if res.criterion.get("speed_tracked") else ""))
     print(msg, file=sys.stderr if out is None else sys.stdout)
