@@ -815,3 +815,20 @@ def test_a_campaign_without_a_stop_makes_the_same_cuts_and_reports_calibration()
     assert b.coverage[0] == pytest.approx(np.mean((q[0] <= truth * 1.0000001) & (truth <= q[2] * 1.0000001)))
     for near, away, cov in zip(b.coverage_near[1:], b.coverage_away[1:], b.coverage[1:]):
         assert 0 <= near <= 1 and 0 <= away <= 1 and min(near, away) <= cov + 1e-12 <= max(near, away) + 2e-12
+
+
+def test_cli_update_says_when_a_cut_lies_off_the_lobes_or_its_chatter_off_the_modes(tmp_path, capsys):
+    """A cut at 40000 rpm on a prior drawn over 5000–25000 rpm, and a chatter frequency of 50 kHz (a kHz slip, or a
+    machine's line) on modes at 1243 and 1747 Hz: both counted, both said on one line each naming the table's line;
+    a chatter frequency on a tooth-passing alias of a mode (1747 + 1333 Hz at 20000 rpm, 4 teeth) is not."""
+    prior = tmp_path / "prior.toml"
+    prior.write_text(PRIOR_TOML)
+    p = tmp_path / "cuts.csv"
+    p.write_text("rpm,depth_mm,result,chatter_hz\n40000,0.5,stable,\n20000,0.9,chatter,50000\n"
+                 "20000,0.95,chatter,3080\n")
+    assert main(["update", "--prior", str(prior), "--cuts", str(p), "--out", str(tmp_path / "o"),
+                 "--samples", "300"]) == 0
+    err = [w for w in capsys.readouterr().err.splitlines() if "warning" in w]
+    assert len(err) == 2, err
+    assert "line 2" in err[0] and "outside the speeds of the lobes" in err[0]
+    assert "line 3" in err[1] and "50000 Hz lies far from every mode" in err[1]

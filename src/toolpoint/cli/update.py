@@ -139,9 +139,32 @@ def run(args) -> int:
     for c in cuts:  # a label that rests on a doubtful record: said where the user looks
         for w in c.warnings:
             print(f"{args.cuts}: line {c.line}: warning: {w}", file=sys.stderr)
-    for c, w in _depth_units(post):
+    for c, w in [*_depth_units(post), *_outside(post)]:
         print(f"{args.cuts}: line {c.line}: warning: {w}", file=sys.stderr)
     return 0
+
+
+def _outside(post, far: float = 0.5):
+    """(cut, warning) for a cut outside the speeds the lobes are drawn over (it counts, but the map, the recommended
+    point and the next cut stay within them), and for a chatter frequency farther than ``far`` (relative) from every
+    mode of the prior and its tooth-passing aliases f ± j f_t (|j| ≤ 2): a kHz value in a Hz column, or a machine's
+    line taken for chatter. Only said: the likelihood's chatter-frequency term gives such a line 5 % outlier weight."""
+    import numpy as np
+
+    lo, hi = float(np.min(post.rpm)), float(np.max(post.rpm))
+    f_modes = np.asarray(post.prior.freq_hz, float)
+    teeth = post.prior.cutting.teeth
+    for c in post.cuts:
+        if not lo * 0.995 <= c.rpm <= hi * 1.005:
+            yield c, (f"{c.rpm:g} rpm lies outside the speeds of the lobes ({lo:.0f}–{hi:.0f} rpm): the cut counts, "
+                      "but the map, the recommended point and the next cut stay within them")
+        if c.chatter_hz is not None:
+            f_t = teeth * c.rpm / 60.0
+            near = f_modes[:, None] + f_t * np.arange(-2, 3)[None, :]
+            if np.min(np.abs(c.chatter_hz / near - 1)) > far:
+                yield c, (f"chatter at {c.chatter_hz:g} Hz lies far from every mode of the prior "
+                          f"({', '.join(f'{f:.0f}' for f in f_modes)} Hz) and their tooth-passing aliases: is the "
+                          "chatter_hz column in Hz, and the line the cut's?")
 
 
 def _depth_units(post, factor: float = 30.0):
