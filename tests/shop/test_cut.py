@@ -816,3 +816,17 @@ def test_the_tone_test_holds_its_false_alarm_rate_on_noise():
         for alpha, lo, hi in ((0.1, 0.03, 0.16), (0.01, 0.0, 0.03)):
             rate_seen = float(np.mean(zmax > thr(n, int(keep.sum()), alpha)))
             assert lo <= rate_seen <= hi, (n, alpha, rate_seen, parts.shape[0])
+
+
+def test_a_real_microphone_record_that_is_no_cut_is_refused(tmp_path, capsys):
+    """The pyuff project's sample microphone time history (UFF58b, 79 292 samples; tests/data/pyuff, MIT), a file
+    nobody here made and no record of a cut: at 3000 and 6000 rpm and 4 teeth it read "chatter at 1814.7 Hz" (exit 0,
+    "harmonics not found"), at 9000–18000 rpm "stable". It does not hear a spindle at any of them: refused, naming
+    the file and rpm, nothing written."""
+    rec = Path(__file__).resolve().parents[1] / "data" / "pyuff" / "Sample_UFF58b_bin.uff"
+    for rpm in ("3000", "6000", "12000"):
+        out = tmp_path / f"c{rpm}.json"
+        assert main(["cut", str(rec), "--rpm", rpm, "--teeth", "4", "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "Sample_UFF58b_bin.uff" in err and "rpm" in err, err
+        assert "no spindle harmonics stand out" in err and not out.exists()
