@@ -587,6 +587,17 @@ def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
     p.write_text("rpm,depth_mm,result,record\n12000,0.8,stable,c1.wav\n")
     with pytest.raises(InputError, match="line 2: the table says stable, its record c1.wav says chatter"):
         read_test_cuts(p, teeth=4)
+    # a record `cut` will not judge (noise: no spindle heard): the table's own label stands and says why; without a
+    # label the line is refused, naming it and the record
+    sf.write(tmp_path / "n.wav", np.random.default_rng(0).normal(0.0, 0.01, int(4 * rate)), int(rate),
+             subtype="PCM_16")
+    p.write_text("rpm,depth_mm,result,record\n12000,0.8,stable,n.wav\n")
+    (c,) = read_test_cuts(p, teeth=4)
+    assert c.stable and len(c.warnings) == 1 and "its record n.wav was not judged (rpm: no spindle" in c.warnings[0]
+    p.write_text("rpm,depth_mm,result,record\n12000,0.8,,n.wav\n")
+    with pytest.raises(InputError, match="line 2: its record n.wav was not judged: rpm: no spindle") as exc:
+        read_test_cuts(p, teeth=4)
+    assert exc.value.field == "record"
 
 
 def _prior_updates(seed0, seeds, n_speeds, truths=150):
@@ -692,7 +703,10 @@ def test_a_doubtful_record_s_warning_reaches_update_s_report(tmp_path, capsys):
     assert main(["update", "--prior", str(tmp_path / "prior.toml"), "--cuts", str(cuts), "--out", str(out),
                  "--samples", "200"]) == 0
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith(f"{cuts}: line 2: warning: hum.wav: chatter at 50.0 Hz"), err
+    assert err[0].startswith(f"{cuts}: line 2: warning: hum.wav: chatter at 50.0 Hz"), err
+    # and, the update's own check, that 50 Hz lies far from the prior's modes (1243, 1747 Hz): the same line
+    assert len(err) == 2 and err[1].startswith(f"{cuts}: line 2: warning: chatter at 50.0 Hz"), err
+    assert "far from every mode" in err[1], err
     doc = json.loads((out / "update.json").read_text())
     assert [len(c["warnings"]) for c in doc["cuts"]] == [1, 0, 0]
     assert doc["cuts"][0]["warnings"][0].startswith("line 2: hum.wav: chatter at 50.0 Hz")
@@ -831,4 +845,4 @@ def test_cli_update_says_when_a_cut_lies_off_the_lobes_or_its_chatter_off_the_mo
     err = [w for w in capsys.readouterr().err.splitlines() if "warning" in w]
     assert len(err) == 2, err
     assert "line 2" in err[0] and "outside the speeds of the lobes" in err[0]
-    assert "line 3" in err[1] and "50000 Hz lies far from every mode" in err[1]
+    assert "line 3" in err[1] and "50000.0 Hz lies far from every mode" in err[1]

@@ -162,7 +162,7 @@ def _outside(post, far: float = 0.5):
             f_t = teeth * c.rpm / 60.0
             near = f_modes[:, None] + f_t * np.arange(-2, 3)[None, :]
             if np.min(np.abs(c.chatter_hz / near - 1)) > far:
-                yield c, (f"chatter at {c.chatter_hz:g} Hz lies far from every mode of the prior "
+                yield c, (f"chatter at {c.chatter_hz:.1f} Hz lies far from every mode of the prior "
                           f"({', '.join(f'{f:.0f}' for f in f_modes)} Hz) and their tooth-passing aliases: is the "
                           "chatter_hz column in Hz, and the line the cut's?")
 

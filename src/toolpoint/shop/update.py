@@ -182,8 +182,17 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
 
             rp = (p.parent / rec) if not Path(rec).is_absolute() else Path(rec)
             r = read_cut_record(rp)
-            a = analyse_cut(r.samples, r.rate_hz, rpm=rpm, teeth=teeth, full_scale=r.full_scale, source=str(rp),
-                            **(cut_options or {}))
+            try:
+                a = analyse_cut(r.samples, r.rate_hz, rpm=rpm, teeth=teeth, full_scale=r.full_scale, source=str(rp),
+                                **(cut_options or {}))
+            except InputError as e:  # a record `cut` will not judge (its spindle not heard, clipped, too short …)
+                why = (f"{e.field}: " if e.field else "") + e.message
+                if not res:
+                    raise InputError(f"line {line}: its record {rec} was not judged: {why}", file=p,
+                                     field="record") from None
+                a = None  # the table's own label stands, and the user hears why the record did not count
+                warns = (f"its record {rec} was not judged ({why}); the table's '{res}' stands",)
+        if rec and a is not None:
             if res and res != a.verdict:
                 raise InputError(f"line {line}: the table says {res}, its record {rec} says {a.verdict}"
                                  + (f" at {a.chatter_hz:.1f} Hz" if a.chatter_hz else ""), file=p, field="result")
