@@ -64,7 +64,7 @@ The detector (:func:`analyse_cut`):
      median of 32 correlated bins): a false alarm rate fixed by statistics, not tuned. On white noise it holds
      0.002–0.02 at α = 0.01 over parts of 3–40 frames. The χ²_ν with Welch's ν used before claimed α = 10⁻³ and held
      0.004–0.04 (it ignored F's error and the heavier tail); α = 0.01 with the calibrated level is as sensitive
-     as that was (t_α within +0.7 … −0.3 dB of it), and now says what it holds;
+     as that was (t_α +0.9 … −0.1 dB from it over 2–80 frames), and now says what it holds;
    * *new*: when the record holds an air cut, only lines standing ``rise_db`` (10 dB) above the air
      cut's spectrum are candidates (fans and pumps are there before the cut, chatter is not); of the
      significant new lines the strongest in power is the one judged (a chatter cluster raises its own
@@ -355,8 +355,7 @@ def check_record(samples, rate_hz: float, rpm: float, teeth: int, *, full_scale:
     Raises
     ------
     InputError
-        Naming ``source`` and the field (``rpm``, ``teeth``, ``samples``, ``rate_hz``); ``rpm`` also where the
-        record's spindle harmonics do not stand out within ``rpm_tolerance`` of ``rpm`` (module docstring, step 1).
+        Naming ``source`` and the field (``rpm``, ``teeth``, ``samples``, ``rate_hz``).
     """
     if isinstance(teeth, bool) or not isinstance(teeth, (int, np.integer)) or not 1 <= teeth <= 100:
         raise InputError(f"must be a whole number of teeth in 1..100, got {teeth!r}", file=source, field="teeth")
@@ -609,6 +608,13 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     -------
     CutAnalysis
 
+    Raises
+    ------
+    InputError
+        The checks of :func:`check_record`; field ``rpm`` also where the record does not hear the spindle within
+        ``rpm_tolerance`` of ``rpm`` and no chatter line stands ≥ 20 dB out, or the speed was given in rev/s
+        (module docstring, step 1).
+
     Examples
     --------
     A 4-tooth cut at 6000 rpm (tooth passing 400 Hz) with chatter at 1234 Hz and its aliases in noise:
@@ -689,14 +695,14 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         """Whether two of the tooth-passing harmonics k N f0 (k ≤ 4; each its main lobe, ±1.5 bins) stand out of the
         floor by the tone test (α 0.01 over those bins; :func:`_tone_threshold`) at one speed (their peaks / k within
         ``_TRACK_AGREE``): a cut's forced lines come as a family, a line of something else near one of them alone."""
-        lobes = [np.flatnonzero(inband & (np.abs(freq - k * teeth * f0) <= 1.5 * df)) for k in range(1, 5)]
-        lobes = [j for j in lobes if j.size and 0 < j[0] and j[-1] < freq.size - 1]
+        lobes = [(k, np.flatnonzero(inband & (np.abs(freq - k * teeth * f0) <= 1.5 * df))) for k in range(1, 5)]
+        lobes = [(k, j) for k, j in lobes if j.size and 0 < j[0] and j[-1] < freq.size - 1]
         if len(lobes) < 2:
             return False
         f_floor = np.exp(floor) / _chi2_median_ratio(stats[0](n))
-        t = stats[1](n, sum(j.size for j in lobes), 0.01)
+        t = stats[1](n, sum(j.size for _, j in lobes), 0.01)
         est = []
-        for k, j in zip(range(1, 5), lobes):
+        for k, j in lobes:
             i = int(j[np.argmax(mean_p[j])])
             if mean_p[i] > t * f_floor[i]:
                 lp = np.log(mean_p[i - 1:i + 2] + 1e-300)
@@ -718,10 +724,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             f_s = float(f0s[best])
             # the comb's mean log-excess: e^0.5, 2.2 dB over the floor. A best comb at the range's edge is the flank
             # of one outside it (the real recording, 6460 rpm, given 8000 and 6000 rpm: 7760 and 5820 rpm, the edges)
-            # heard: the comb over all the harmonics stands out, or a tooth-passing harmonic does by the tone test
-            # (a housing accelerometer without runout hears the tooth passing alone: simulated records at 5000 and
-            # 6538 rpm, 3 teeth, their tooth harmonics 15–22 dB out and the comb over 40 harmonics 1.0–1.8 dB; a
-            # cut under broadband noise 3 × its first tooth harmonic's amplitude: that harmonic ~15 dB, the comb less)
+            # heard: the comb over all the harmonics stands out, or two tooth-passing harmonics do by the tone test at
+            # one speed (a housing accelerometer without runout hears the tooth passing alone: simulated records at
+            # 5000 and 6538 rpm, 3 teeth, their tooth harmonics 15–22 dB out and the comb over 40 harmonics 1.0–1.8 dB)
             heard = score[best] > 0.5 or teeth_heard(mean_p, floor, frames.size, f_s)
             spindle_found = bool(heard) and 4 <= best < score.size - 4  # a main lobe: 4 steps
             comb = (float(score[best]) * 10 / math.log(10), f_s, bool(heard))  # dB, Hz, heard: the refusal's words
@@ -810,8 +815,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         # without the tooth-passing harmonics neither the speed nor "strong" (a line against the strongest harmonic) is
         # known: white noise alone was "chatter" in 7 of 12 records of 20 s (a significant noise peak in one of ~20
         # windows passed every other test). A speed given in rev/s is refused; otherwise the record is judged at the
-        # nominal speed and kept only if a chatter line stands ≥ _UNHEARD_LINE_DB out (heavy chatter on a housing
-        # accelerometer of a slot buries the spindle's few lines: a simulated record at 19118 rpm)
+        # nominal speed and kept only if a chatter line stands ≥ _UNHEARD_LINE_DB out (heavy chatter can bury the
+        # spindle's few lines: a simulated housing-accelerometer record at 19118 rpm was refused by the comb alone)
         tol_txt = f"±{100 * rpm_tolerance:g} % of {rpm:g} rpm" if rpm_tolerance > 0 else f"{rpm:g} rpm"
         if rev_s is not None:
             raise InputError(f"no spindle harmonics stand out within {tol_txt}, but near {60 * rev_s:.0f} rpm (60 × "
