@@ -700,6 +700,12 @@ def test_a_record_that_does_not_hear_the_spindle_is_refused_not_judged(tmp_path,
         assert exc.value.field == "rpm"
         with pytest.raises(InputError, match="no spindle harmonics stand out"):
             analyse_cut(x, rate, rpm=6500, teeth=2, rpm_tolerance=0.0)
+    # a long one: its ~1600 frames put the level near the mean, under the bracket the solver was given (a
+    # ValueError traceback before the review)
+    with pytest.raises(InputError, match="no spindle harmonics stand out"):
+        analyse_cut(np.random.default_rng(9).normal(0.0, 1e-3, int(150 * rate)), rate, rpm=6500, teeth=2)
+    with pytest.raises(InputError, match="alpha: must be a probability"):
+        analyse_cut(x, rate, rpm=6500, teeth=2, alpha=0.0)
     wav = tmp_path / "noise.wav"
     sf.write(wav, x, int(rate), subtype="FLOAT")
     out = tmp_path / "c.json"
@@ -793,7 +799,7 @@ def test_the_real_recording_through_a_phone_s_gain_control_keeps_its_air_cut(att
     assert any("gain control" in w for w in res.criterion["warnings"])
 
 
-def test_the_tone_test_holds_its_false_alarm_rate_on_noise():
+def test_the_tone_test_holds_its_false_alarm_rate_on_noise(monkeypatch):
     """The tone test's level t_α against what it claims: parts of n Hann frames of white noise, judged as `_judge`
     judges them (the block-median floor over the unmasked bins), exceed it in about α of the parts. The χ² level with
     Welch's ν used before held α = 0.1 for 0.29–0.38 of these parts (its floor's own error and the overlapping
@@ -816,6 +822,16 @@ def test_the_tone_test_holds_its_false_alarm_rate_on_noise():
         for alpha, lo, hi in ((0.1, 0.03, 0.16), (0.01, 0.0, 0.03)):
             rate_seen = float(np.mean(zmax > thr(n, int(keep.sum()), alpha)))
             assert lo <= rate_seen <= hi, (n, alpha, rate_seen, parts.shape[0])
+    # long parts (a whole record's frames): the level from the Toeplitz symbol's eigenvalues, grouped, against the
+    # level from the exact eigenvalues, at 100 and 250 frames
+    exact = [d._t_alpha(L, hop, n, 3600, 0.01) for n in (100, 250)]
+    monkeypatch.setattr(d, "_EIG_EXACT_MAX", 64)
+    d._t_alpha.cache_clear()
+    try:
+        symbol = [d._t_alpha(L, hop, n, 3600, 0.01) for n in (100, 250)]
+    finally:
+        d._t_alpha.cache_clear()
+    assert np.allclose(symbol, exact, rtol=5e-3), (symbol, exact)
 
 
 def test_a_real_microphone_record_that_is_no_cut_is_refused(tmp_path, capsys):

@@ -513,35 +513,66 @@ def _t_alpha(L, hop, n, m, alpha) -> float:
     rho = [float(np.dot(w[:L - k * hop], w[k * hop:]) / np.dot(w, w)) for k in range(1, L // hop + 1) if k * hop < L]
     gx, gw = np.polynomial.hermite_e.hermegauss(24)
     gw = gw / gw.sum()
-    C = np.eye(n)
-    for k, r in enumerate(rho, 1):
-        if k < n:
-            C += r * (np.eye(n, k=k) + np.eye(n, k=-k))
-    mu = np.linalg.eigvalsh(C) / n
-    mu = mu[mu > 1e-12]
-    nu = 2.0 / float(np.sum(mu**2))
+    mu, wt = _overlap_eigenvalues(rho, n)
+    nu = 2.0 / float(wt @ mu**2)
     med = chi2.ppf(0.5, nu) / nu
     s = math.sqrt(_BIN_CORR * (2 / 3) / (4 * _BLOCK * (chi2.pdf(med * nu, nu) * nu) ** 2)) / med
 
-    def sf(x):  # P(Σ μ_j E_j > x), x > 1 (the mean): saddlepoint ŝ of K'(ŝ) = x by bisection, vectorised
-        lo, hi = np.zeros_like(x), np.full_like(x, (1 - 1e-12) / mu.max())
-        for _ in range(80):
+    def sf(x):  # P(Σ μ_j E_j > x): saddlepoint ŝ of K'(ŝ) = x by bisection (either side of the mean 1), vectorised
+        x = np.where(np.abs(x - 1) < 1e-3, 1 + np.copysign(1e-3, x - 1), x)  # Lugannani–Rice is singular at the mean
+        lo, hi = np.full_like(x, -1e3 * n / max(float(x.min()), 1e-3)), np.full_like(x, (1 - 1e-12) / mu.max())
+        for _ in range(100):
             mid = 0.5 * (lo + hi)
-            big = (mu / (1 - mu * mid[:, None])).sum(axis=1) > x
+            big = (wt * mu / (1 - mu * mid[:, None])).sum(axis=1) > x
             hi, lo = np.where(big, mid, hi), np.where(big, lo, mid)
         sh = 0.5 * (lo + hi)
         q = mu / (1 - mu * sh[:, None])
-        K = -np.log1p(-mu * sh[:, None]).sum(axis=1)
-        r = np.sqrt(np.maximum(2 * (sh * x - K), 1e-300))
-        u = sh * np.sqrt((q**2).sum(axis=1))
-        return np.clip(ndtr(-r) + np.exp(-0.5 * r**2) / math.sqrt(2 * math.pi) * (1 / u - 1 / r), 0.0, 1.0)
+        K = -(wt * np.log1p(-mu * sh[:, None])).sum(axis=1)
+        r = np.sign(sh) * np.sqrt(np.maximum(2 * (sh * x - K), 0.0))
+        u = sh * np.sqrt((wt * q**2).sum(axis=1))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lr = ndtr(-r) + np.exp(-0.5 * r**2) / math.sqrt(2 * math.pi) * (1 / u - 1 / r)
+        return np.clip(np.where(np.isfinite(lr), lr, 0.5), 0.0, 1.0)
 
     def log_pf(t):
-        e = np.sum(gw * np.expm1(_BLOCK * np.log1p(-sf(np.maximum(t * np.exp(s * gx), 1.05)))))
-        return math.log(max(-math.expm1(m / _BLOCK * math.log1p(e)), 1e-300))
+        e = np.sum(gw * np.expm1(_BLOCK * np.log1p(-np.minimum(sf(t * np.exp(s * gx)), 1 - 1e-16))))
+        return math.log(max(-math.expm1(m / _BLOCK * math.log1p(max(e, -1 + 1e-300))), 1e-300))
 
-    return math.exp(brentq(lambda lt: log_pf(math.exp(lt)) - math.log(alpha), math.log(1.2), math.log(200.0),
-                           xtol=1e-4))
+    def f(lt):
+        return log_pf(math.exp(lt)) - math.log(alpha)
+
+    lo, hi = math.log(1 + 1e-6), math.log(200.0)  # the level lies above the mean: a long part's comes near 1
+    if f(lo) <= 0:
+        return math.exp(lo)
+    if f(hi) >= 0:
+        return math.exp(hi)
+    return math.exp(brentq(f, lo, hi, xtol=1e-4))
+
+
+_EIG_EXACT_MAX = 256
+"""Frames up to which :func:`_overlap_eigenvalues` takes the correlation matrix's eigenvalues exactly."""
+
+
+def _overlap_eigenvalues(rho, n):
+    """(μ, weights): the eigenvalues of the n × n correlation matrix of n overlapping frames (ρ_k off the diagonal),
+    over n, each with its multiplicity. Up to ``_EIG_EXACT_MAX`` frames exactly; beyond, the banded Toeplitz
+    matrix's eigenvalues are its symbol 1 + 2 Σ ρ_k cos(2π j k / n) at j = 0 … n − 1 (Szegő), sorted and averaged in
+    256 groups of equal count — a whole record's frames (thousands) cost no n³ and no n² of memory."""
+    if n <= _EIG_EXACT_MAX:
+        C = np.eye(n)
+        for k, r in enumerate(rho, 1):
+            if k < n:
+                C += r * (np.eye(n, k=k) + np.eye(n, k=-k))
+        lam = np.linalg.eigvalsh(C)
+        mu, wt = lam, np.ones_like(lam)
+    else:
+        theta = 2 * np.pi * np.arange(n) / n
+        lam = np.sort(1 + 2 * sum(r * np.cos(k * theta) for k, r in enumerate(rho, 1)))
+        groups = np.array_split(lam, _EIG_EXACT_MAX)
+        mu = np.array([g.mean() for g in groups])
+        wt = np.array([g.size for g in groups], float)
+    good = mu > 1e-12 * n
+    return mu[good] / n, wt[good]
 
 
 def _once_per_rev(x, rate, f_s):
@@ -632,6 +663,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     """
     x = np.asarray(samples, float)
     check_record(x, rate_hz, rpm, teeth, full_scale=full_scale, source=source)
+    if not (isinstance(alpha, (int, float, np.floating)) and 0 < alpha < 1):
+        raise InputError(f"must be a probability in (0, 1), got {alpha!r}", file=source, field="alpha")
     if not (math.isfinite(growth_db) and growth_db >= 0):
         raise InputError(f"must be ≥ 0 dB (0: no growth test), got {growth_db!r}", file=source, field="growth_db")
     k0, k1 = _live_part(x, float(rate_hz), source)
@@ -709,11 +742,14 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 est.append((freq[i] + _vertex(*lp) * df) / (k * teeth))
         return _agreeing(est).size >= 2
 
+    def spectrum(frames):
+        """(mean power, its log, the log of its block-median floor) of these frames."""
+        mean_p = P[frames].mean(axis=0)
+        return mean_p, np.log(mean_p + 1e-300), np.log(_block_floor(mean_p[None, :], inband)[0] + 1e-300)
+
     def spindle(frames):
         """(f_s Hz, spindle found, the speed in rev/s the comb finds at 60 × or None, a speed elsewhere or None)."""
-        mean_p = P[frames].mean(axis=0)
-        logp = np.log(mean_p + 1e-300)
-        floor = np.log(_block_floor(mean_p[None, :], inband)[0] + 1e-300)
+        mean_p, logp, floor = spectrum(frames)
         rev_s = None
         if rpm_tolerance > 0:
             ftop = min(hi, 40 * f_nom)
@@ -826,9 +862,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                    f"{60 * elsewhere[0]:.0f} rpm ({100 * (elsewhere[0] / f_nom - 1):+.1f} %): give the speed the "
                    "spindle ran at (an override?) or widen --rpm-tolerance")
         elif rpm_tolerance > 0 and comb[2]:  # the best within the range lay at its edge: where is it?
-            mean_p = P[cutting].mean(axis=0)
-            logp = np.log(mean_p + 1e-300)
-            floor = np.log(_block_floor(mean_p[None, :], inband)[0] + 1e-300)
+            _, logp, floor = spectrum(cutting)
             ftop = min(hi, 40 * f_nom)
             f0s = np.arange(f_nom * (1 - _ELSEWHERE_REL), f_nom * (1 + _ELSEWHERE_REL), df / (4 * ftop / f_nom))
             score = np.where(np.abs(f0s / f_nom - 1) > rpm_tolerance, _comb_score(freq, logp, floor, f0s, ftop),
