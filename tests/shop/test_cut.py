@@ -846,3 +846,48 @@ def test_a_real_microphone_record_that_is_no_cut_is_refused(tmp_path, capsys):
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1 and "Sample_UFF58b_bin.uff" in err and "rpm" in err, err
         assert "no spindle harmonics stand out" in err and not out.exists()
+
+
+def _teeth_warning(res):
+    return [w for w in res.criterion["warnings"] if "spindle harmonics that stand out in the" in w]
+
+
+def test_a_tooth_count_the_record_contradicts_is_warned():
+    """A wrong --teeth (a slip no range check catches) moves the tooth-passing aliases the chatter test looks for,
+    the split into air and cut and the Harmonizer speed. The spindle harmonics that stand out in the stable cut
+    keep the spacing of the cutter's tooth passing: where another spacing explains them better (Otsu's criterion,
+    ``_spacing``), it is warned. Synthetic shop records (runout lines 0.1 of the tooth harmonics), and the real
+    recording (2 teeth at 6460 rpm), given 3 teeth: it was chatter at 596 Hz in a dozen pieces of air and cut,
+    against 1067 Hz in one cut with 2, without a word."""
+    for teeth, wrong in ((2, 3), (3, 2), (3, 4), (4, 3), (4, 5), (4, 2), (2, 1)):
+        x, rate, *_ = shop_record(rpm=6000, teeth=teeth, seed=teeth + 10 * wrong)
+        assert not _teeth_warning(analyse_cut(x, rate, rpm=6000, teeth=teeth, full_scale=1.0)), (teeth, wrong)
+        w = _teeth_warning(analyse_cut(x, rate, rpm=6000, teeth=wrong, full_scale=1.0))
+        assert len(w) == 1 and f"multiples of {teeth} ({teeth * 100:.1f} Hz" in w[0] and "check --teeth" in w[0], w
+    rec = read_cut_record(REAL)
+    right = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=2, full_scale=rec.full_scale)
+    assert not _teeth_warning(right)
+    res = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=3, full_scale=rec.full_scale)
+    w = _teeth_warning(res)
+    assert len(w) == 1 and "multiples of 2 (215.3 Hz" in w[0] and "not of the 3 teeth given" in w[0], w
+
+
+def test_a_spindle_heard_by_its_own_lines_is_judged():
+    """A housing accelerometer on a slot with an even tooth count hears hardly any tooth passing: a simulated
+    record of EM28-80 at 4827 rpm stood 24, 18 and 24 dB out at 1×, 2× and 4× (its first tooth harmonic) and 0 dB
+    over 40 harmonics, and was refused as "no spindle harmonics stand out". Three of the eight lowest spindle
+    harmonics standing out at one speed are the spindle heard: such records (white noise, 4.5 s at 25.6 kHz, the
+    cut 0.7–3.8 s) are judged stable, each of which the rule before refused; one line alone is still refused."""
+    rate, rpm = 25600.0, 4827.0
+    f_s = rpm / 60
+    t = np.arange(int(4.5 * rate)) / rate
+    cut = ((t > 0.7) & (t < 3.8)).astype(float)
+    for seed, amp in enumerate((0.3, 0.5, 1.0)):
+        rng = np.random.default_rng(seed)
+        noise = rng.standard_normal(t.size) * (1 + cut)  # chips double the floor in the cut
+        lines = amp * np.sin(2 * np.pi * f_s * t + 1.0) + 0.5 * amp * np.sin(2 * np.pi * 2 * f_s * t + 2.0)
+        tooth = 2 * amp * cut * np.sin(2 * np.pi * 4 * f_s * t + 0.3)
+        res = analyse_cut(noise + lines + tooth, rate, rpm=rpm, teeth=4)
+        assert res.verdict == "stable" and abs(res.rpm / rpm - 1) < 1e-3, (amp, res.rpm)
+        with pytest.raises(InputError, match="no spindle harmonics stand out"):
+            analyse_cut(noise + 2 * amp * np.sin(2 * np.pi * f_s * t), rate, rpm=rpm, teeth=4)

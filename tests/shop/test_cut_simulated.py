@@ -109,3 +109,19 @@ def test_the_simulated_shop_labels_cuts_heard_by_a_housing_accelerometer():
     a = float(sdm_limit(pr)(theta, [14000.0])[0])
     assert shop(theta, 14000.0, 0.7 * a, np.random.default_rng(1)).stable
     assert not shop(theta, 14000.0, 1.4 * a, np.random.default_rng(2)).stable
+
+
+def test_a_wrong_tooth_count_s_chatter_on_the_tooth_passing_is_warned():
+    """The stable cut at 9000 rpm (4 teeth, 0.75 × its SDM limit) given 8, 5 or 3 teeth: the cutter's own tooth
+    harmonics, no multiples of the tooth passing given, pass for chatter on a spindle harmonic (600 or 1200 Hz). The
+    warning says whose multiples they are; with 4 teeth there is none."""
+    rpm, want, sim = next(iter(_cuts()))
+    assert (rpm, want) == (9000.0, "stable")
+    x, rate, *_ = microphone(sim, rpm=rpm, teeth=4, seed=4)
+    r = analyse_cut(x, rate, rpm=rpm, teeth=4, full_scale=1.0)
+    assert r.verdict == "stable" and not any("spindle harmonics that stand out" in w for w in r.criterion["warnings"])
+    for wrong in (8, 5, 3):
+        r = analyse_cut(x, rate, rpm=rpm, teeth=wrong, full_scale=1.0)
+        w = [w for w in r.criterion["warnings"] if "spindle harmonics that stand out in the" in w]
+        assert r.verdict == "chatter" and r.chatter_hz == pytest.approx(600.0 * round(r.chatter_hz / 600), rel=1e-3)
+        assert len(w) == 1 and "chatter on a spindle harmonic are the multiples of 4 (600.0 Hz" in w[0], (wrong, w)

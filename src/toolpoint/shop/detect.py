@@ -198,6 +198,8 @@ _MASKED_WARN = 0.95  # a stable verdict with this much of the band under the spi
 _ELSEWHERE_REL = 0.25  # nominal speeds up to this far off are checked for (the range measured)
 _ELSEWHERE_DB = 13.0  # … where the tooth-passing harmonics stand this far over the floor (mean of the four lowest)
 _ELSEWHERE_GAIN_DB = 10.0  # … and this much higher than within the tolerance: warned (see _speed_elsewhere)
+_SPACING_DB = 6.0  # the stable cut's harmonics at multiples of M f_s stand this far over the others on average …
+_SPACING_RATIO = 1.5  # … and split them this much better than the multiples of N f_s: --teeth is doubted (_spacing)
 _CUT_PROMINENCE_DB = 4.0  # dB over noise: a quiet stretch whose tooth-passing harmonics stand out this far, and half
 #   as far as in the loud part, is cutting (see _split)
 _AIR_EXCESS_DB = 3.0  # dB over noise: a loud part whose tooth-passing harmonics stand out no further has none …
@@ -724,13 +726,13 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     # 2. spindle frequency: comb search on the mean spectrum of the cutting frames
     stats = (_welch_dof(L, hop), _tone_threshold(L, hop))
 
-    def teeth_heard(mean_p, floor, n, f0):
-        """Whether two of the tooth-passing harmonics k N f0 (k ≤ 4; each its main lobe, ±1.5 bins) stand out of the
+    def lines_heard(mean_p, floor, n, f0, orders, need):
+        """Whether ``need`` of the harmonics k f0 (k in ``orders``; each its main lobe, ±1.5 bins) stand out of the
         floor by the tone test (α 0.01 over those bins; :func:`_tone_threshold`) at one speed (their peaks / k within
         ``_TRACK_AGREE``): a cut's forced lines come as a family, a line of something else near one of them alone."""
-        lobes = [(k, np.flatnonzero(inband & (np.abs(freq - k * teeth * f0) <= 1.5 * df))) for k in range(1, 5)]
+        lobes = [(k, np.flatnonzero(inband & (np.abs(freq - k * f0) <= 1.5 * df))) for k in orders]
         lobes = [(k, j) for k, j in lobes if j.size and 0 < j[0] and j[-1] < freq.size - 1]
-        if len(lobes) < 2:
+        if len(lobes) < need:
             return False
         f_floor = np.exp(floor) / _chi2_median_ratio(stats[0](n))
         t = stats[1](n, sum(j.size for _, j in lobes), 0.01)
@@ -739,8 +741,17 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             i = int(j[np.argmax(mean_p[j])])
             if mean_p[i] > t * f_floor[i]:
                 lp = np.log(mean_p[i - 1:i + 2] + 1e-300)
-                est.append((freq[i] + _vertex(*lp) * df) / (k * teeth))
-        return _agreeing(est).size >= 2
+                est.append((freq[i] + _vertex(*lp) * df) / k)
+        return _agreeing(est).size >= need
+
+    def teeth_heard(mean_p, floor, n, f0):
+        """Two of the four lowest tooth-passing harmonics k N f0, or three of the eight lowest spindle harmonics k f0,
+        heard at one speed (:func:`lines_heard`). The spindle's own lines: a housing accelerometer on a slot with an
+        even tooth count hears hardly any tooth passing, and its imbalance lines at 1× and 2× with one tooth harmonic
+        stood 18–25 dB out while the comb over 40 harmonics stood 0 dB (EM28-80 at 4827 rpm, refused before). Three,
+        not two: any two lines lie at a ratio of small whole numbers to within 0.1 % somewhere in the search range."""
+        return (lines_heard(mean_p, floor, n, f0, teeth * np.arange(1, 5), 2)
+                or lines_heard(mean_p, floor, n, f0, np.arange(1, 9), 3))
 
     def spectrum(frames):
         """(mean power, its log, the log of its block-median floor) of these frames."""
@@ -967,6 +978,25 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         warns.append(f"the cut's noise floor lies {-low:.1f} dB under the air cut's over 90 % of the band: the "
                      "recorder's gain fell when the cut began (automatic gain control or a limiter); the air cut was "
                      "lowered to match, but for test cuts switch the recorder's gain control off")
+    # the tooth count against the record (_spacing): read where no chatter family lies between the harmonics — the
+    # stable cut, or chatter that rests on a spindle harmonic, which a wrong count makes of the cut's own tooth passing
+    on_harm = [sg for sg in chat if abs(sg.chatter_hz / f_s - round(sg.chatter_hz / f_s)) * f_s
+               <= 2 * df + _MASK_REL * sg.chatter_hz]
+    for part, group in (("stable cut", [sg for sg in judged if sg.verdict == "stable"]),
+                        ("chatter on a spindle harmonic", on_harm)):
+        if not group:
+            continue
+        _, logp_s, floor_s = spectrum(np.unique(np.concatenate([frames_in(sg.start_s, sg.end_s) for sg in group])))
+        sp = _spacing(freq, logp_s, floor_s, inband, f_s, teeth, df)
+        if sp is not None:
+            m, d_m, d_n = sp
+            also = ("" if part == "stable cut" else " — or chatter locked on a spindle harmonic, whose own harmonics "
+                    "and period doubling make such a comb")
+            warns.append(f"the spindle harmonics that stand out in the {part} are the multiples of {m} "
+                         f"({m * f_s:.1f} Hz, {d_m:.0f} dB over the others), not of the {teeth} teeth given "
+                         f"({teeth * f_s:.1f} Hz, {d_n:.0f} dB): check --teeth (and --rpm){also}; the tooth passing "
+                         "sets the alias test, the split into air and cut and the Harmonizer speed")
+            break
     criterion = {"alpha": alpha, "rise_db": rise_db if ref is not None else None, "dominance": dominance,
                  "alias_dominance": alias_dominance, "growth_db": growth_db, "growth_t": _GROWTH_T,
                  "mask_hz": f"2*{df:.4g} + {_MASK_REL:g}*f", "frame_s": L / rate, "band_hz": [lo, hi],
@@ -1185,6 +1215,53 @@ def _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df):
     db = 10.0 / math.log(10.0)
     if t[j] * db >= _ELSEWHERE_DB and (t[j] - t_in) * db >= _ELSEWHERE_GAIN_DB:
         return float(f[j]), float(t[j] * db), t_in * db
+    return None
+
+
+def _spacing(freq, logp, floor, inband, f_s, teeth, df):
+    """The spacing M f_s that the spindle harmonics standing out in a stable cut keep, where it is not the tooth
+    passing N f_s given: (M, its contrast dB, N's contrast dB), else None.
+
+    Each harmonic k f_s (k ≤ 40, in the band) gets its excess e_k over the floor (the peak of its main lobe, ±1.5
+    bins, ln power). A spacing M splits the harmonics into its multiples (the tooth passing and its harmonics, were
+    M the tooth count) and the rest (runout): its score is the between-class variance of that split, w (1 − w) d |d|,
+    with w the share of multiples and d the difference of the two classes' mean excess (Otsu's criterion: a sparse
+    set of strong lines or a dense set of weak ones scores less than the tooth passing's family). M runs over
+    2 … max(8, N) with at least two multiples among the harmonics. Doubted where the best M is not N, its d is
+    ≥ ``_SPACING_DB`` and it scores ≥ ``_SPACING_RATIO`` × N's (N = 1 scores 0).
+
+    Why: a wrong tooth count (a 3-flute cutter entered as 4, or 2 as 3) is a plausible slip that no range check
+    catches. It moves the tooth-passing aliases the chatter test looks for, the split into air and cut, and the
+    Harmonizer speed: the real recording in ``examples/cuts`` (2 teeth) given 3 teeth was "chatter at 596 Hz" in
+    a dozen air and cut pieces, against chatter at 1067 Hz in one cut. Only stable cuts are read: chatter lays
+    its family f_c + j f_t over the harmonics (period doubling at f_t/2 with 4 teeth puts it on the multiples of
+    2 f_s exactly), and the simulated housing-accelerometer records that chatter made other spacings stand out
+    (7 of 119, ``docs/design/shop.md``).
+    """
+    k = np.arange(1, int(min(40, freq[inband][-1] / f_s)) + 1)
+    e = np.full(k.size, np.nan)
+    ex = logp - floor
+    for i, c in enumerate(k * f_s):
+        j = np.flatnonzero(inband & (np.abs(freq - c) <= 1.5 * df))
+        if j.size:
+            e[i] = ex[j].max()
+    ok = np.isfinite(e)
+    db = 10.0 / math.log(10.0)
+
+    def score(m):
+        a, b = ok & (k % m == 0), ok & (k % m != 0)
+        if a.sum() < 2 or b.sum() < 1:
+            return 0.0, 0.0
+        w = a.sum() / ok.sum()
+        d = float(e[a].mean() - e[b].mean()) * db
+        return w * (1 - w) * d * abs(d), d
+
+    scores = {m: score(m) for m in range(2, max(8, teeth) + 1)}
+    best = max(scores, key=lambda m: scores[m][0])
+    s_n, d_n = scores.get(teeth, (0.0, 0.0))
+    s_b, d_b = scores[best]
+    if best != teeth and d_b >= _SPACING_DB and s_b >= _SPACING_RATIO * max(s_n, 0.0) and s_b > 0:
+        return best, d_b, d_n
     return None
 
 
