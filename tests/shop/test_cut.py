@@ -579,6 +579,18 @@ def test_a_record_is_known_by_its_first_bytes(tmp_path, capsys):
     assert main(["cut", str(mat), "--rpm", "6000", "--teeth", "4"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "cut.mat" in err
+    # what phones record, which libsndfile does not read: it was "no data rows" (read as a text table) or "not a
+    # UTF-8 text file"; now the format and how to convert it, by the first bytes (an ISO-media box 'ftyp', an ADTS
+    # frame, AMR's magic) whatever the suffix
+    heads = {"memo.m4a": b"\x00\x00\x00\x1cftypM4A \x00\x00\x00\x00M4A isommp42",
+             "memo": b"\x00\x00\x00\x18ftyp3gp4\x00\x00\x00\x00isom", "memo.aac": b"\xff\xf1\x50\x80\x2f\xdf\xfc",
+             "memo.amr": b"#!AMR\n\x3c"}
+    for name, head in heads.items():
+        f = tmp_path / name
+        f.write_bytes(head + bytes(4000))
+        assert main(["cut", str(f), "--rpm", "6000", "--teeth", "4"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and name in err and f"ffmpeg -i {name} {f.stem}.wav" in err, err
 
 
 @pytest.mark.parametrize("start_s,end_s", [(0.0, 6.5), (20.0, 40.0)])

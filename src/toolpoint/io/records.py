@@ -1,7 +1,8 @@
 """Records of a cut: microphone audio, accelerometer or displacement time histories → one channel of samples.
 
 Formats (by extension, or by the first bytes: audio renamed or without its suffix is audio; MATLAB ``.mat``, HDF5
-and TDMS files are refused saying how to export the signal):
+and TDMS files are refused saying how to export the signal, and audio libsndfile does not read — a phone's M4A / AAC /
+3GP / AMR, WMA, WebM — saying how to convert it):
 
 * audio ``.wav .flac .ogg .mp3`` (and whatever else libsndfile reads: ``.aiff``, ``.au``) through the
   ``soundfile`` package (libsndfile ≥ 1.1 for MP3; the wheels of soundfile ≥ 0.12.1 bundle 1.2);
@@ -105,6 +106,11 @@ def read_cut_record(path: str | os.PathLike, *, rate_hz: float | None = None, ch
     check_regular_file(p, what="record")  # before the first bytes are read: a FIFO would block for ever
     suffix = p.suffix.lower()
     kind = _sniff(p)
+    if kind is None and suffix in _AUDIO_NOT_READ_SUFFIXES:
+        kind = _AUDIO_NOT_READ_SUFFIXES[suffix]
+    if kind in _AUDIO_NOT_READ:
+        raise InputError(f"{_AUDIO_NOT_READ[kind]}: toolpoint reads audio as WAV, FLAC, OGG or MP3; convert it (ffmpeg "
+                         f"-i {p.name} {p.stem}.wav) or set the recorder to WAV", file=p, field="data")
     if kind in _NOT_READ:
         raise InputError(f"{_NOT_READ[kind]}: toolpoint reads audio (WAV, FLAC, OGG, MP3), text columns and UFF58; "
                          "export the signal as one of those (MATLAB: audiowrite, or writematrix([t(:) x(:)], "
@@ -131,11 +137,20 @@ def read_cut_record(path: str | os.PathLike, *, rate_hz: float | None = None, ch
 
 _NOT_READ = {"mat": "a MATLAB .mat file", "hdf5": "an HDF5 file (MATLAB -v7.3, or a DAQ's)",
              "tdms": "a LabVIEW TDMS file"}
+# audio that libsndfile does not read, mostly what phones record: refused saying how to convert it, where it had been
+# read as a text table ("no data rows") or as "not a UTF-8 text file"
+_AUDIO_NOT_READ = {"mp4": "an MP4 / M4A / 3GP container (a phone's recorder: AAC or ALAC audio)",
+                   "aac": "raw AAC audio (ADTS)", "amr": "AMR speech audio (a phone's voice recorder)",
+                   "asf": "a Windows Media (WMA / ASF) file", "mkv": "a WebM / Matroska file (a browser's recorder)"}
+_AUDIO_NOT_READ_SUFFIXES = {".m4a": "mp4", ".m4b": "mp4", ".mp4": "mp4", ".mov": "mp4", ".3gp": "mp4",
+                            ".3g2": "mp4", ".aac": "aac", ".amr": "amr", ".wma": "asf", ".asf": "asf",
+                            ".webm": "mkv", ".mka": "mkv", ".mkv": "mkv"}
 
 
 def _sniff(p: Path) -> str | None:
     """What the file's first bytes say it is: ``audio`` (RIFF/WAVE, FLAC, Ogg, MP3, AIFF), or a
-    container toolpoint does not read (``mat``, ``hdf5``, ``tdms``); None: anything else (text, UFF)."""
+    container toolpoint does not read (``mat``, ``hdf5``, ``tdms``; audio ``mp4``, ``aac``, ``amr``, ``asf``,
+    ``mkv``); None: anything else (text, UFF)."""
     try:
         with open(p, "rb") as fh:
             head = fh.read(128)
@@ -152,6 +167,16 @@ def _sniff(p: Path) -> str | None:
         return "hdf5"
     if head.startswith(b"TDSm"):
         return "tdms"
+    if head[4:8] == b"ftyp":  # ISO base media: M4A, MP4, MOV, 3GP
+        return "mp4"
+    if len(head) > 1 and head[0] == 0xFF and head[1] & 0xF6 == 0xF0:  # an ADTS frame: sync, layer 00
+        return "aac"
+    if head.startswith(b"#!AMR"):
+        return "amr"
+    if head.startswith(bytes.fromhex("3026b2758e66cf11a6d900aa0062ce6c")):
+        return "asf"
+    if head.startswith(b"\x1a\x45\xdf\xa3"):
+        return "mkv"
     return None
 
 
