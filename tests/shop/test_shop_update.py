@@ -664,7 +664,10 @@ def test_a_lower_risk_after_the_first_chatter():
     stable = [TestCut(20000.0, 0.45e-3, True)]
     a = update(pr, stable, rng=np.random.default_rng(4), **kw).next_cut
     b = update(pr, stable, rng=np.random.default_rng(4), risk_after_chatter=0.1, **kw).next_cut
-    assert a == b and a["risk"] == 0.3
+    # the same cut; its floats to rounding (two runs of the same draws differed in the 16th digit of p_chatter on the
+    # minimum-version CI, 2026-11-28: a reduction's order, not another proposal)
+    assert a.keys() == b.keys() and a["risk"] == 0.3
+    assert all(a[k] == pytest.approx(b[k], rel=1e-9) if isinstance(a[k], float) else a[k] == b[k] for k in a), (a, b)
     cuts = stable + [TestCut(20000.0, 0.8e-3, False, 1290.0)]
     a = update(pr, cuts, rng=np.random.default_rng(4), **kw).next_cut
     b = update(pr, cuts, rng=np.random.default_rng(4), risk_after_chatter=0.1, **kw).next_cut

@@ -749,7 +749,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         heard at one speed (:func:`lines_heard`). The spindle's own lines: a housing accelerometer on a slot with an
         even tooth count hears hardly any tooth passing, and its imbalance lines at 1× and 2× with one tooth harmonic
         stood 18–25 dB out while the comb over 40 harmonics stood 0 dB (EM28-80 at 4827 rpm, refused before). Three,
-        not two: any two lines lie at a ratio of small whole numbers to within 0.1 % somewhere in the search range."""
+        not two: two lines of something else fit one of the 28 pairs of orders k ≤ 8 within 0.1 % by chance far more
+        often than three fit one speed."""
         return (lines_heard(mean_p, floor, n, f0, teeth * np.arange(1, 5), 2)
                 or lines_heard(mean_p, floor, n, f0, np.arange(1, 9), 3))
 
@@ -1219,8 +1220,8 @@ def _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df):
 
 
 def _spacing(freq, logp, floor, inband, f_s, teeth, df):
-    """The spacing M f_s that the spindle harmonics standing out in a stable cut keep, where it is not the tooth
-    passing N f_s given: (M, its contrast dB, N's contrast dB), else None.
+    """The spacing M f_s that the spindle harmonics standing out in a cut keep, where it is not the tooth passing
+    N f_s given: (M, its contrast dB, N's contrast dB), else None.
 
     Each harmonic k f_s (k ≤ 40, in the band) gets its excess e_k over the floor (the peak of its main lobe, ±1.5
     bins, ln power). A spacing M splits the harmonics into its multiples (the tooth passing and its harmonics, were
@@ -1233,10 +1234,13 @@ def _spacing(freq, logp, floor, inband, f_s, teeth, df):
     Why: a wrong tooth count (a 3-flute cutter entered as 4, or 2 as 3) is a plausible slip that no range check
     catches. It moves the tooth-passing aliases the chatter test looks for, the split into air and cut, and the
     Harmonizer speed: the real recording in ``examples/cuts`` (2 teeth) given 3 teeth was "chatter at 596 Hz" in
-    a dozen air and cut pieces, against chatter at 1067 Hz in one cut. Only stable cuts are read: chatter lays
-    its family f_c + j f_t over the harmonics (period doubling at f_t/2 with 4 teeth puts it on the multiples of
-    2 f_s exactly), and the simulated housing-accelerometer records that chatter made other spacings stand out
-    (7 of 119, ``docs/design/shop.md``).
+    fourteen segments, against chatter at 1067 Hz in one cut. :func:`analyse_cut` reads it on the stable cut and on
+    chatter that rests on a spindle harmonic (what a wrong count makes of the cutter's own tooth harmonics), not on
+    other chatter: its family f_c + j f_t and its own harmonics lie over the spindle's (read over all the cutting
+    frames, 7 of the 119 chattering simulated housing-accelerometer records of truths 10–11 had another spacing
+    stand out; ``docs/design/shop.md``, *A tooth count the record contradicts*). Chatter locked on a harmonic can
+    make such a comb too (period doubling of a 4-tooth cutter makes the lines of a 2-tooth one): warned there with
+    both readings.
     """
     k = np.arange(1, int(min(40, freq[inband][-1] / f_s)) + 1)
     e = np.full(k.size, np.nan)
