@@ -1,7 +1,8 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|inside|update|sampler|forward|ceiling|sdm-bands] [--shops zoa,noisy,sim] [--cases cornelius,example]
+        [--only cut|teeth|inside|update|sampler|forward|ceiling|sdm-bands] [--shops zoa,noisy,sim]
+        [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
         [--sensor microphone|accelerometer]
@@ -17,6 +18,8 @@ CPU time (time.process_time), not wall time: the machine is shared.
    speeds, heard by the tests' shop microphone or (``--sensor accelerometer``) by an accelerometer on the spindle
    housing (tests/milling_sim.py: force through a housing mode, bearing and imbalance lines, mains hum, offset and
    drift, 25.6 kS/s).
+   ``teeth``: the same simulated records judged with a wrong tooth count (N ± 1, 2 N, N / 2): the verdicts it
+   changes and whether ``cut`` warns of the count, and the records warned at the right count.
    ``inside``: records taken inside a chattering cut, without air cut (windows of the real recording's chattering
    stretch; synthetic cuts whose chatter waxes and wanes).
 2. ``update``: virtual campaigns (truth drawn from the prior, the next cut from the ``info`` rule) on the
@@ -224,6 +227,64 @@ class _Score:
               f"per s of audio")
 
 
+class _TeethScore(_Score):
+    """What a wrong tooth count does to ``cut`` on the same records, and whether it is warned.
+
+    Each record is judged with its tooth count N and with N − 1, N + 1, 2 N and N / 2 (even N); per kind of slip: the
+    records whose verdict it changed (and to chatter), those of them warned ("the spindle harmonics that stand out
+    in the …"), and all warned; for N itself, the records warned (false warnings)."""
+
+    KINDS = ("right", "N-1", "N+1", "2N", "N/2")
+
+    def __init__(self, record=None):
+        super().__init__(record)
+        self.count = {k: dict.fromkeys(("n", "refused", "changed", "to_chatter", "changed_warned", "warned"), 0)
+                      for k in self.KINDS}
+
+    def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
+        from toolpoint.errors import InputError
+        from toolpoint.simulation import simulate_milling
+
+        res = simulate_milling(mm, mm, c, rpm=rpm, depth_m=depth, revolutions=250, seed=seed, seed_level=seed_level)
+        n_t = c.teeth
+        for p in range(rpm.size):
+            if abs(depth[p] / lim[p] - 1) < 0.05:
+                self.skipped += 1
+                continue
+            x, rate = self.record(res, float(rpm[p]), n_t, rng, point=p)
+            self.n += 1
+            ref = analyse_cut(x, rate, rpm=float(rpm[p]), teeth=n_t, full_scale=self.full_scale)
+            slips = {"right": n_t, "N-1": n_t - 1, "N+1": n_t + 1, "2N": 2 * n_t,
+                     "N/2": n_t // 2 if n_t % 2 == 0 else 0}
+            for kind, z in slips.items():
+                if z < 1:
+                    continue
+                cnt = self.count[kind]
+                cnt["n"] += 1
+                try:
+                    r = ref if kind == "right" else analyse_cut(x, rate, rpm=float(rpm[p]), teeth=z,
+                                                                full_scale=self.full_scale)
+                except InputError:  # 2 N's fourth tooth harmonic above Nyquist
+                    cnt["refused"] += 1
+                    continue
+                warned = any("spindle harmonics that stand out in the" in w for w in r.criterion["warnings"])
+                changed = r.verdict != ref.verdict
+                cnt["changed"] += changed
+                cnt["to_chatter"] += changed and r.verdict == "chatter"
+                cnt["changed_warned"] += changed and warned
+                cnt["warned"] += warned
+
+    def report(self, what):
+        print(f"{what}; {self.skipped} within ±5 % of the SDM limit left out), each judged with a wrong tooth count:")
+        for kind, cnt in self.count.items():
+            if kind == "right":
+                print(f"   N (right): {cnt['n']} records, {cnt['warned']} warned of their tooth count")
+                continue
+            print(f"   {kind}: {cnt['n']} records ({cnt['refused']} refused): verdict changed {cnt['changed']} "
+                  f"({cnt['to_chatter']} to chatter), of them warned {cnt['changed_warned']}; warned in all "
+                  f"{cnt['warned']}")
+
+
 def _truth(pr, rng, random_cut=True):
     """A truth θ* drawn from the prior: (ModalModel, CuttingConditions), with a random immersion and direction
     unless ``random_cut`` is false (the prior's own)."""
@@ -236,7 +297,7 @@ def _truth(pr, rng, random_cut=True):
                                    milling=str(rng.choice(["down", "up"])))
 
 
-def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="microphone"):
+def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="microphone", score=None):
     """Verdicts of ``cut`` on records (``sensor``) of cuts simulated by ``toolpoint.simulation``; truth: the SDM.
 
     Each simulated cut starts on the steady cut with a kick of ``seed_level`` × the forced response (a shop cut's
@@ -251,7 +312,7 @@ def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="micro
     """
     from toolpoint.stability import sdm_lobes, sdm_spectral_radius
 
-    sc = _Score(SENSORS[sensor])
+    sc = score or _Score(SENSORS[sensor])  # or another scorer of the same records (_TeethScore)
     for case in ("cornelius", "example"):
         for seed in range(seed_start, seed_start + (2 if quick else truths)):
             rng = np.random.default_rng(seed)
@@ -269,7 +330,7 @@ def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="micro
               f"priors, random immersion and up/down, 7 speeds x 7 depths")
 
 
-def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01, sensor="microphone"):
+def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01, sensor="microphone", score=None):
     """``cut`` at the speeds a chatter-avoiding choice lands on: a tooth-passing harmonic j f_t on a mode.
 
     For each truth (drawn from each prior, its immersion and direction, seeds
@@ -281,7 +342,7 @@ def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01, s
     from toolpoint.shop.model import sdm_limits
     from toolpoint.stability import sdm_spectral_radius
 
-    sc = _Score(SENSORS[sensor])
+    sc = score or _Score(SENSORS[sensor])  # or another scorer of the same records (_TeethScore)
     for name, pr in priors.items():
         lo, hi = pr.rpm_range if pr.rpm_range is not None else (5000.0, 25000.0)
         for seed in range(seed_start, seed_start + (1 if quick else truths)):
@@ -512,7 +573,8 @@ def main():
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=("cut", "inside", "update", "sampler", "forward", "ceiling", "sdm-bands"))
+    ap.add_argument("--only", choices=("cut", "teeth", "inside", "update", "sampler", "forward", "ceiling",
+                                       "sdm-bands"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -544,6 +606,18 @@ def main():
             pockets[tool] = prior_from_library(out, tool)
         bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level,
                           sensor=a.sensor)
+    if a.only in (None, "teeth"):
+        sensor = SENSORS[a.sensor]
+        bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level, sensor=a.sensor,
+                      score=_TeethScore(sensor))
+        pockets = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
+        if a.library_prior:
+            from toolpoint.shop.prior import prior_from_library
+
+            out, tool = a.library_prior.rsplit(":", 1)
+            pockets[tool] = prior_from_library(out, tool)
+        bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level,
+                          sensor=a.sensor, score=_TeethScore(sensor))
     if a.only in (None, "inside"):
         bench_cut_inside(a.quick)
     if a.only in (None, "forward"):

@@ -991,12 +991,16 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         sp = _spacing(freq, logp_s, floor_s, inband, f_s, teeth, df)
         if sp is not None:
             m, d_m, d_n = sp
-            also = ("" if part == "stable cut" else " — or chatter locked on a spindle harmonic, whose own harmonics "
-                    "and period doubling make such a comb")
+            # on chatter both readings: a wrong count, or chatter locked on the rotation (period doubling of 4 teeth
+            # makes the lines of 2; a line on harmonic k has its own harmonics at 2k, 3k): 4 and 11 of 573 simulated
+            # chattering records at the right count (microphone, accelerometer) were warned this way, none stable
+            why = ("check --teeth (and --rpm)" if part == "stable cut" else
+                   f"chatter locked on the spindle's rotation (period doubling, or a line and its own harmonics) "
+                   f"makes such a comb — or the cutter has {m} teeth: check --teeth (and --rpm)")
             warns.append(f"the spindle harmonics that stand out in the {part} are the multiples of {m} "
                          f"({m * f_s:.1f} Hz, {d_m:.0f} dB over the others), not of the {teeth} teeth given "
-                         f"({teeth * f_s:.1f} Hz, {d_n:.0f} dB): check --teeth (and --rpm){also}; the tooth passing "
-                         "sets the alias test, the split into air and cut and the Harmonizer speed")
+                         f"({teeth * f_s:.1f} Hz, {d_n:.0f} dB): {why}; the tooth passing sets the alias test, the "
+                         "split into air and cut and the Harmonizer speed")
             break
     criterion = {"alpha": alpha, "rise_db": rise_db if ref is not None else None, "dominance": dominance,
                  "alias_dominance": alias_dominance, "growth_db": growth_db, "growth_t": _GROWTH_T,
