@@ -869,8 +869,8 @@ def test_a_tooth_count_the_record_contradicts_is_warned():
     the split into air and cut and the Harmonizer speed. The spindle harmonics that stand out in the stable cut
     keep the spacing of the cutter's tooth passing: where another spacing explains them better (Otsu's criterion,
     ``_spacing``), it is warned. Synthetic shop records (runout lines 0.1 of the tooth harmonics), and the real
-    recording (2 teeth at 6460 rpm), given 3 teeth: it was chatter at 596 Hz in a dozen pieces of air and cut,
-    against 1067 Hz in one cut with 2, without a word."""
+    recording (2 teeth at 6460 rpm), given 3 teeth: it was chatter at 596 Hz in fourteen segments of air, entry,
+    cut and exit, against 1067 Hz in one cut with 2, without a word."""
     for teeth, wrong in ((2, 3), (3, 2), (3, 4), (4, 3), (4, 5), (4, 2), (2, 1)):
         x, rate, *_ = shop_record(rpm=6000, teeth=teeth, seed=teeth + 10 * wrong)
         assert not _teeth_warning(analyse_cut(x, rate, rpm=6000, teeth=teeth, full_scale=1.0)), (teeth, wrong)
