@@ -19,13 +19,16 @@ The detector (:func:`analyse_cut`):
    few harmonics — an accelerometer on the housing of a slot cut — leaves the comb a main lobe off). A nominal
    speed several % off (an override) is warned where the four lowest tooth-passing harmonics stand out at a
    speed within ±25 % of it, outside the tolerance, much more than within it (``speed_elsewhere_rpm``).
-   *A record that does not hear the spindle*: its comb stands ≤ 2.2 dB over the floor (mean excess) and fewer than
-   two of the four lowest tooth-passing harmonics stand out of it by the tone test (α 0.01 over their main lobes,
-   step 4) at one speed (0.1 %), or its best comb lies within a main lobe (4 steps) of the range's edge (the flank
-   of one outside it). Without the harmonics neither the speed
-   nor "strong" (step 4) is known — white noise alone was "chatter" in 7 of 12 records of 20 s — so it is judged
+   *A record that does not hear the spindle*: its comb stands ≤ 2.2 dB over the floor (mean excess), and fewer than
+   two of the four lowest tooth-passing harmonics, and fewer than three of the eight lowest spindle harmonics, stand
+   out of it by the tone test (α 0.01 over their main lobes, step 4) at one speed (0.1 %); or its best comb lies
+   within a main lobe (4 steps) of the range's edge (the flank of one outside it). Without the harmonics neither the
+   speed nor "strong" (step 4) is known — white noise alone was "chatter" in 7 of 12 records of 20 s — so it is judged
    at the nominal speed and kept only where a chatter line stands ≥ 20 dB out (``line_db``), with a warning that
-   says where the harmonics do stand out; else refused (``InputError``, field ``rpm``), as is a speed in rev/s;
+   says where the harmonics do stand out; else refused (``InputError``, field ``rpm``), as is a speed in rev/s.
+   *A tooth count the record contradicts* is warned where the spindle harmonics that stand out in the stable cut
+   (or under chatter resting on a spindle harmonic) keep another spacing than the tooth passing given
+   (:func:`_spacing`);
 2. **segments** — frame energy in the band, split at a two-level (Otsu) threshold into air cut and
    cutting when the levels differ by ≥ ``activity_db`` (see *Automatic gain control* below for the loud
    stretches without tooth passing that are air all the same; when no level splits, as under a loud coolant
@@ -730,8 +733,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         """Whether ``need`` of the harmonics k f0 (k in ``orders``; each its main lobe, ±1.5 bins) stand out of the
         floor by the tone test (α 0.01 over those bins; :func:`_tone_threshold`) at one speed (their peaks / k within
         ``_TRACK_AGREE``): a cut's forced lines come as a family, a line of something else near one of them alone."""
-        lobes = [(k, np.flatnonzero(inband & (np.abs(freq - k * f0) <= 1.5 * df))) for k in orders]
-        lobes = [(k, j) for k, j in lobes if j.size and 0 < j[0] and j[-1] < freq.size - 1]
+        lobes = [(k, j) for k, j in _harmonic_lobes(freq, inband, f0, orders, df) if 0 < j[0] and j[-1] < freq.size - 1]
         if len(lobes) < need:
             return False
         f_floor = np.exp(floor) / _chi2_median_ratio(stats[0](n))
@@ -744,7 +746,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 est.append((freq[i] + _vertex(*lp) * df) / k)
         return _agreeing(est).size >= need
 
-    def teeth_heard(mean_p, floor, n, f0):
+    def harmonics_heard(mean_p, floor, n, f0):
         """Two of the four lowest tooth-passing harmonics k N f0, or three of the eight lowest spindle harmonics k f0,
         heard at one speed (:func:`lines_heard`). The spindle's own lines: a housing accelerometer on a slot with an
         even tooth count hears hardly any tooth passing, and its imbalance lines at 1× and 2× with one tooth harmonic
@@ -775,7 +777,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             # heard: the comb over all the harmonics stands out, or two tooth-passing harmonics do by the tone test at
             # one speed (a housing accelerometer without runout hears the tooth passing alone: simulated records at
             # 5000 and 6538 rpm, 3 teeth, their tooth harmonics 15–22 dB out and the comb over 40 harmonics 1.0–1.8 dB)
-            heard = score[best] > 0.5 or teeth_heard(mean_p, floor, frames.size, f_s)
+            heard = score[best] > 0.5 or harmonics_heard(mean_p, floor, frames.size, f_s)
             spindle_found = bool(heard) and 4 <= best < score.size - 4  # a main lobe: 4 steps
             comb = (float(score[best]) * 10 / math.log(10), f_s, bool(heard))  # dB, Hz, heard: the refusal's words
             if not spindle_found:
@@ -796,7 +798,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         else:  # the speed as given: its comb is read there alone
             f_s, elsewhere = f_nom, None
             sc = float(_comb_score(freq, logp, floor, np.array([f_nom]), min(hi, 40 * f_nom))[0])
-            spindle_found = sc > 0.5 or teeth_heard(mean_p, floor, frames.size, f_nom)
+            spindle_found = sc > 0.5 or harmonics_heard(mean_p, floor, frames.size, f_nom)
             comb = (sc * 10 / math.log(10), f_nom, spindle_found)
         return f_s, spindle_found, rev_s, elsewhere, comb
 
@@ -886,9 +888,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                         f"{score[b] * 10 / math.log(10):.1f} dB over the floor")
             why += "): give the speed the spindle ran at or widen --rpm-tolerance"
         else:
-            why = (f" (their comb {comb[0]:.1f} dB over the floor, a cut's stands ≥ 2.2 dB, and none of the lowest "
-                   "four tooth-passing harmonics stands out of it): check the speed, the channel and that the sensor "
-                   "heard the cut")
+            why = (f" (their comb {comb[0]:.1f} dB over the floor, a cut's stands ≥ 2.2 dB, and neither two of the "
+                   "four lowest tooth-passing harmonics nor three of the eight lowest spindle harmonics stand out "
+                   "at one speed): check the speed, the channel and that the sensor heard the cut")
         unheard = f"no spindle harmonics stand out within {tol_txt}" + why
 
     # 3. harmonic mask: all multiples of the spindle frequency
@@ -1249,10 +1251,8 @@ def _spacing(freq, logp, floor, inband, f_s, teeth, df):
     k = np.arange(1, int(min(40, freq[inband][-1] / f_s)) + 1)
     e = np.full(k.size, np.nan)
     ex = logp - floor
-    for i, c in enumerate(k * f_s):
-        j = np.flatnonzero(inband & (np.abs(freq - c) <= 1.5 * df))
-        if j.size:
-            e[i] = ex[j].max()
+    for kk, j in _harmonic_lobes(freq, inband, f_s, k, df):
+        e[kk - 1] = ex[j].max()
     ok = np.isfinite(e)
     db = 10.0 / math.log(10.0)
 
@@ -1273,13 +1273,22 @@ def _spacing(freq, logp, floor, inband, f_s, teeth, df):
     return None
 
 
+def _harmonic_lobes(freq, inband, f0, orders, df) -> list:
+    """[(k, bins)]: the in-band bins of the main lobe (±1.5 bins) of each harmonic k f0 (k in ``orders``) that has any
+    — where the comb, the speed's reading, the tests whether the spindle is heard and the tooth-count check look."""
+    out = []
+    for k in orders:
+        j = np.flatnonzero(inband & (np.abs(freq - k * f0) <= 1.5 * df))
+        if j.size:
+            out.append((int(k), j))
+    return out
+
+
 def _harmonic_peaks(freq, logp, floor, inband, f0, orders, df) -> list:
     """Spindle frequencies (Hz) read from the harmonics k f0 (k in ``orders``) that peak within the comb's main lobe
     there (±1.5 bins) ≥ 10 dB over the floor: each peak (a parabola through the log power of three bins) / k."""
     est = []
-    for k in orders:
-        c = k * f0
-        sel = np.flatnonzero(inband & (np.abs(freq - c) <= 1.5 * df))  # the comb's main lobe there
+    for k, sel in _harmonic_lobes(freq, inband, f0, orders, df):
         if sel.size < 3 or sel[0] == 0 or sel[-1] >= freq.size - 1:
             continue
         j = int(sel[np.argmax(logp[sel])])
