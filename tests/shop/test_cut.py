@@ -170,6 +170,31 @@ def test_cli_cut_writes_json_and_plot(tmp_path, capsys):
     assert doc["verdict"] == "chatter" and max(sg["n_alias"] for sg in doc["segments"] if sg["kind"] == "cut") >= 1
 
 
+def test_the_plot_shows_the_spectra_the_verdict_rests_on():
+    """The real recording's plot: its segment labels do not print over each other (an entry, two stable windows and
+    the chatter within 10 s of a 63 s record did before), and its second panel holds the chattering cut's and the air
+    cut's mean spectra with the chatter frequency marked where `cut` found it."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from toolpoint.shop import plot_cut
+
+    rec = read_cut_record(REAL)
+    res = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=2, full_scale=rec.full_scale)
+    fig = plot_cut(res, name=REAL.name)
+    FigureCanvasAgg(fig).draw()
+    ax, ax2 = fig.axes[:2]
+    assert fig._suptitle.get_text().startswith(f"{REAL.name}: chatter at {res.chatter_hz:.1f} Hz; Harmonizer speed")
+    labels = [tx for tx in ax.texts if tx.get_text() in ("air", "entry", "exit", "stable", "chatter")]
+    assert len(labels) == len(res.segments) >= 6
+    boxes = [tx.get_window_extent() for tx in labels]
+    assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
+    lines = {ln.get_label(): ln for ln in ax2.get_lines()}
+    assert {"air cut", "chattering cut", f"chatter {res.chatter_hz:.1f} Hz"} <= set(lines)
+    f, db = lines["chattering cut"].get_data()
+    f_air, db_air = lines["air cut"].get_data()
+    near = np.abs(f - res.chatter_hz) <= 3.0
+    assert db[near].max() - db_air[near].max() > 20  # the chatter line stands where the air holds none
+
+
 def test_a_weak_line_is_chatter_with_its_tooth_passing_aliases_not_alone():
     """A line at 1 % of the strongest harmonic's power that appears with the cut: with its aliases f ± f_t it is
     regenerative chatter; alone (a feed drive, a pump switched on with the cut) it is not."""

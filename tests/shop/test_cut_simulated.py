@@ -125,3 +125,25 @@ def test_a_wrong_tooth_count_s_chatter_on_the_tooth_passing_is_warned():
         w = [w for w in r.criterion["warnings"] if "spindle harmonics that stand out in the" in w]
         assert r.verdict == "chatter" and r.chatter_hz == pytest.approx(600.0 * round(r.chatter_hz / 600), rel=1e-3)
         assert len(w) == 1 and "chatter on a spindle harmonic are the multiples of 4 (600.0 Hz" in w[0], (wrong, w)
+
+
+def test_a_table_the_record_contradicts_through_a_wrong_tooth_count_says_why(tmp_path):
+    """`update` refuses a table whose label its record contradicts. When the contradiction comes from the prior's
+    tooth count (the same stable cut at 9000 rpm, 4 teeth, read with a prior of 3: "chatter" at a tooth harmonic),
+    the one-line refusal carries `cut`'s doubt of the count, so the shop need not run `cut` to find it."""
+    import soundfile as sf
+    from toolpoint.errors import InputError
+    from toolpoint.shop.update import read_test_cuts
+
+    rpm, want, sim = next(iter(_cuts()))
+    x, rate, *_ = microphone(sim, rpm=rpm, teeth=4, seed=4)
+    sf.write(tmp_path / "c1.wav", 0.5 * x / np.abs(x).max(), int(rate), subtype="PCM_16")
+    table = tmp_path / "cuts.csv"
+    table.write_text("rpm,depth_mm,result,record\n9000,1.0,stable,c1.wav\n")
+    assert read_test_cuts(table, teeth=4)[0].stable
+    with pytest.raises(InputError) as e:
+        read_test_cuts(table, teeth=3)
+    msg = str(e.value)
+    assert "line 2: the table says stable, its record c1.wav says chatter at" in msg and "\n" not in msg
+    assert "c1.wav: the spindle harmonics that stand out in the chatter on a spindle harmonic are the multiples of 4" \
+        in msg, msg

@@ -45,7 +45,8 @@ def register(sub) -> None:
                    help="a new line whose power rises steadily by this much over a judged part is chatter, however "
                         "weak (default 6 dB, with t >= 4; 0: no growth test)")
     p.add_argument("--out", help="result JSON (default: print it)")
-    p.add_argument("--plot", help="spectrogram with the harmonics marked (.png/.pdf/.svg)")
+    p.add_argument("--plot", help="spectrogram with the harmonics and segments marked, and the chattering cut's "
+                   "mean spectrum against the air cut's (.png/.pdf/.svg)")
     p.set_defaults(func=run)
 
 
@@ -87,7 +88,7 @@ def run(args) -> int:
     if plot is not None:
         use_agg()
         from ..shop.detect import plot_cut
-        fig = plot_cut(res, title=f"{rec_path.name}: {res.verdict}")
+        fig = plot_cut(res, name=rec_path.name)
     text = json.dumps(doc, indent=2)
     if out is not None:
         with atomic_open(out) as fh:

@@ -1701,10 +1701,30 @@ def _runs(b):
     return [(int(s), int(e), bool(b[s])) for s, e in zip(starts, ends)]
 
 
-def plot_cut(res: CutAnalysis, *, fmax_hz: float | None = None, title: str = ""):
-    """Spectrogram of the record (dB) with the spindle harmonics (thin), tooth-passing harmonics (dashed),
-    segment bounds and the chatter frequency found per segment marked; returns the matplotlib Figure."""
+def plot_cut(res: CutAnalysis, *, fmax_hz: float | None = None, title: str = "", name: str = ""):
+    """The record's spectrogram and the spectra the verdict rests on; returns the matplotlib Figure.
+
+    Top: spectrogram (dB) with the spindle harmonics (dotted), the tooth-passing harmonics (dashed), the segments'
+    bounds and, in a strip above it, their verdicts (narrow neighbours' labels on rows of their own, so they stay
+    legible), the chatter frequency of each chattering segment in red. Bottom: the mean spectrum (dB) of the
+    chattering part (else of the cut) against the air cut's, with the same harmonics and the chatter frequency
+    marked — what the test compares: a line between the harmonics that the air does not hold.
+
+    Parameters
+    ----------
+    res : CutAnalysis
+        Of :func:`analyse_cut`.
+    fmax_hz : float, optional
+        Highest frequency shown, Hz (default: 10 tooth-passing harmonics, 2.5 × the chatter frequency, at least
+        2 kHz, at most the record's band).
+    title : str, optional
+        The figure's title (default: the verdict, the chatter frequency, the Harmonizer speed and the spindle
+        speed, after ``name``).
+    name : str, optional
+        The record's name, put first in the default title.
+    """
     from matplotlib.figure import Figure
+    from matplotlib.transforms import blended_transform_factory
 
     f_s = res.rpm / 60.0
     f_t = res.teeth * f_s
@@ -1714,27 +1734,71 @@ def plot_cut(res: CutAnalysis, *, fmax_hz: float | None = None, title: str = "")
     t, f, p = res.time_s, res.freq_hz[m], res.power[:, m]
     step = max(1, t.size // 800)  # a figure needs no more than ~800 columns
     db = 10 * np.log10(p[::step].T + 1e-30)
-    fig = Figure(figsize=(10, 5.5))
-    ax = fig.add_subplot()
+    fig = Figure(figsize=(10, 8.5))
+    ax, ax2 = fig.subplots(2, 1, height_ratios=(3, 2))
+    fig.subplots_adjust(top=0.86, hspace=0.35)
     top = np.percentile(db, 99.9)
     mesh = ax.pcolormesh(t[::step], f, db, shading="nearest", vmin=top - 70, vmax=top, cmap="magma",
                          rasterized=True)
-    fig.colorbar(mesh, ax=ax, label="power, dB")
-    for k in range(1, int(fmax / f_s) + 1):
-        tooth = k % res.teeth == 0
-        ax.axhline(k * f_s, color="cyan" if tooth else "white", lw=0.6 if tooth else 0.3, ls="--" if tooth else ":",
-                   alpha=0.7)
-    colours = {"air": "grey", "entry": "yellow", "exit": "yellow", "cut": "lime"}
+    # the colour bar beside the spectrogram, not taken from its width: both panels share one frequency scale width
+    fig.colorbar(mesh, cax=ax.inset_axes([1.01, 0.0, 0.015, 1.0]), label="power, dB")
+
+    def harmonics(a, horizontal):
+        line = a.axhline if horizontal else a.axvline
+        for k in range(1, int(fmax / f_s) + 1):
+            tooth = k % res.teeth == 0
+            line(k * f_s, color=("cyan" if horizontal else "tab:blue") if tooth else ("white" if horizontal else
+                                                                                       "grey"),
+                 lw=0.6 if tooth else 0.3, ls="--" if tooth else ":", alpha=0.7)
+
+    harmonics(ax, True)
+    colours = {"air": "grey", "entry": "yellow", "exit": "yellow", "transient": "yellow", "stable": "green",
+               "chatter": "red"}
+    strip = blended_transform_factory(ax.transData, ax.transAxes)
+    span = max(t[-1] - t[0], 1e-9) if t.size > 1 else 1.0
+    row, last_end = 0, -np.inf
     for s in res.segments:
         ax.axvline(s.start_s, color=colours.get(s.kind, "white"), lw=0.8)
         label = s.kind if s.kind != "cut" else s.verdict
-        ax.text(0.5 * (s.start_s + s.end_s), fmax * 0.97, label, ha="center", va="top", fontsize=7, color="white")
+        # a label wider than its segment's room goes one row up (3 rows), so neighbours do not print over each other
+        mid = 0.5 * (s.start_s + s.end_s)
+        row = row + 1 if mid - 0.045 * span < last_end else 0
+        last_end = mid + 0.045 * span
+        ax.text(mid, 1.02 + 0.055 * (row % 3), label, transform=strip, ha="center", va="bottom", fontsize=7,
+                color=colours.get(label, "black"), clip_on=False)
         if s.chatter_hz:
             ax.plot([s.start_s, s.end_s], [s.chatter_hz] * 2, color="red", lw=2.0)
     ax.set_xlabel("time, s")
     ax.set_ylabel("frequency, Hz")
     ax.set_ylim(0, fmax)
-    ax.set_title(title or f"{res.verdict}"
-                 + (f" at {res.chatter_hz:.1f} Hz; try {res.recommended_rpm:.0f} rpm" if res.chatter_hz else "")
-                 + f" — spindle {res.rpm:.0f} rpm (dotted: its multiples; dashed: tooth passing)", fontsize=9)
+    ax.set_xlim(0, max([t[-1]] + [s.end_s for s in res.segments]))
+
+    def mean_db(kinds, verdicts):
+        sel = np.zeros(t.size, bool)
+        for s in res.segments:
+            if s.kind in kinds and s.verdict in verdicts:
+                sel |= (t >= s.start_s) & (t <= s.end_s)
+        return 10 * np.log10(p[sel].mean(axis=0) + 1e-30) if sel.any() else None
+
+    cut_db = mean_db(("cut",), ("chatter",)) if chat else None
+    what = "chattering cut"
+    if cut_db is None:
+        cut_db, what = mean_db(("cut",), ("stable", "chatter")), "cut"
+    air_db = mean_db(("air",), ("air",))
+    if air_db is not None:
+        ax2.plot(f, air_db, color="grey", lw=0.7, label="air cut")
+    if cut_db is not None:
+        ax2.plot(f, cut_db, color="black", lw=0.8, label=what)
+    harmonics(ax2, False)
+    if res.chatter_hz:
+        ax2.axvline(res.chatter_hz, color="red", lw=1.2, label=f"chatter {res.chatter_hz:.1f} Hz")
+    ax2.plot([], [], color="tab:blue", ls="--", lw=0.6, label=f"tooth passing ({f_t:.1f} Hz × k)")
+    ax2.set_xlim(0, fmax)
+    ax2.set_xlabel("frequency, Hz")
+    ax2.set_ylabel("mean power, dB")
+    ax2.legend(loc="upper right", fontsize=7)
+    head = (f"{res.verdict}" + (f" at {res.chatter_hz:.1f} Hz" if res.chatter_hz else "")
+            + (f"; Harmonizer speed {res.recommended_rpm:.0f} rpm" if res.recommended_rpm else "")
+            + f" — spindle {res.rpm:.0f} rpm, {res.teeth} teeth (dotted: its multiples; dashed: tooth passing)")
+    fig.suptitle(title or (f"{name}: {head}" if name else head), fontsize=9)
     return fig

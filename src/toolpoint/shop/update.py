@@ -194,8 +194,12 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                 warns = (f"its record {rec} was not judged ({why}); the table's '{res}' stands",)
         if rec and a is not None:
             if res and res != a.verdict:
+                # what `cut` doubted of the record may be the contradiction's cause (a wrong tooth count makes the
+                # cutter's own tooth harmonics "chatter"): the refusal says it, so `cut` need not be run to find it
+                doubts = a.criterion.get("warnings", ())
                 raise InputError(f"line {line}: the table says {res}, its record {rec} says {a.verdict}"
-                                 + (f" at {a.chatter_hz:.1f} Hz" if a.chatter_hz else ""), file=p, field="result")
+                                 + (f" at {a.chatter_hz:.1f} Hz" if a.chatter_hz else "")
+                                 + ("".join(f"; {rec}: {w}" for w in doubts)), file=p, field="result")
             res = a.verdict
             if fc is None and a.chatter_hz is not None:
                 fc = a.chatter_hz
