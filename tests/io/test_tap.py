@@ -133,6 +133,15 @@ def test_text_record_errors(tmp_path):
     p.write_text("0 0 0\n1e-4 1\n")
     with pytest.raises(InputError, match=r"r\.txt: columns: line 2: expected 3"):
         read_record(p)
+    # a LabVIEW export's Comment column, empty on every row, is no column; empty on some rows only it is a
+    # missing value
+    p.write_text("X_Value,Force (N),Accel (m/s^2),Comment\n"
+                 + "".join(f"{1e-4 * k:g},{k},{2 * k},\n" for k in range(10)))
+    r = read_record(p)
+    assert np.allclose(r.force_n, np.arange(10)) and np.allclose(r.response, 2 * np.arange(10))
+    p.write_text("0,0,0,\n1e-4,1,2,x\n")
+    with pytest.raises(InputError, match=r"r\.txt: columns: line 1: expected 3"):
+        read_record(p)
 
 
 def uff_record(path, t, f, a, rsp_type=12, force_inc=None):

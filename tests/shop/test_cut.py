@@ -660,6 +660,37 @@ def test_a_daq_s_time_column_printed_to_its_digits_and_in_ms(tmp_path):
         read_cut_record(coarse)
 
 
+def test_a_daq_s_export_with_a_comment_column_and_a_units_row(tmp_path):
+    """Two exports a shop's DAQ writes as they are: a LabVIEW measurement file (a header block, then
+    ``X_Value,Accel_X (g),Accel_Y (g),Comment`` with the Comment column empty on every row) and a Dewesoft-like
+    CSV (``Time;AI 1;AI 2`` over a units row ``ms;g;g``, decimal commas). The empty column is no channel (it was
+    "column 3: '' is not a number"), the time unit is read from the units row (ms: the rate was 1000 × off), and
+    the channels are named by the header, in the refusal that asks for one and in the record."""
+    rate = 25600.0
+    t = np.arange(int(0.5 * rate)) / rate
+    x = np.sin(2 * np.pi * 400 * t)
+    lvm = tmp_path / "run.csv"
+    lvm.write_text("LabVIEW Measurement\nWriter_Version,2\nSeparator,Comma\n***End_of_Header***\n"
+                   "X_Value,Accel_X (g),Accel_Y (g),Comment\n"
+                   + "".join(f"{a:.8f},{b:.6e},{0.5 * b:.6e},\n" for a, b in zip(t, x)))
+    with pytest.raises(InputError, match=r"run.csv: channel: 2 signal columns: choose one with --channel "
+                                         r"\(0: Accel_X \(g\), 1: Accel_Y \(g\)\)"):
+        read_cut_record(lvm)
+    r = read_cut_record(lvm, channel=1)
+    assert r.rate_hz == pytest.approx(rate, rel=1e-6) and r.channel == "1 (Accel_Y (g))"
+    assert np.allclose(r.samples, 0.5 * x, atol=1e-6)
+    dw = tmp_path / "dewe.csv"
+    dw.write_text("Time;AI 1;AI 2\nms;g;g\n" + "".join(f"{1e3 * a:.5f};{b:.6e};{-b:.6e}\n".replace(".", ",")
+                                                        for a, b in zip(t, x)))
+    r = read_cut_record(dw, channel=0)
+    assert r.rate_hz == pytest.approx(rate, rel=1e-6) and r.channel == "0 (AI 1 (g))"
+    assert np.allclose(r.samples, x, atol=1e-6)
+    blank = tmp_path / "blank.csv"  # a cell empty in some rows only is a missing sample, still refused
+    blank.write_text("t,a,b\n0,1,2\n0.001,,2\n0.002,1,\n")
+    with pytest.raises(InputError, match=r"blank.csv: column 1: line 3: '' is not a number"):
+        read_cut_record(blank)
+
+
 def test_a_slow_spindle_s_stable_verdict_says_its_masks_cover_the_band():
     """Below ~800 rpm the spindle harmonics lie closer than their masks are wide (±2 bins of a 0.4 s frame): chatter
     there goes unheard (0 of 8 synthetic chattering cuts at 600 rpm), so a 'stable' verdict is warned of; at 3000 rpm

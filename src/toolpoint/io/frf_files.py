@@ -805,6 +805,25 @@ _READERS = {".csv": read_csv_frf, ".uff": read_uff58, ".unv": read_uff58, ".uf":
 _WRITERS = {".csv": write_csv_frf, ".uff": write_uff58, ".unv": write_uff58, ".uf": write_uff58, ".frf": write_cutpro}
 
 
+def drop_empty_columns(rows: list) -> tuple[list, list]:
+    """(``rows`` [(line number, cells)] without the columns that are empty on every row, the kept columns' indices):
+    a LabVIEW export's Comment column, a separator closing each line, are no data. A cell empty on some rows only
+    stays (a missing value, refused by the reader that checks the numbers). Rows of unequal width are returned as
+    they are, for the reader to refuse.
+
+    Examples
+    --------
+    >>> drop_empty_columns([(2, ["0", "1.5", ""]), (3, ["0.1", "-2", ""])])
+    ([(2, ['0', '1.5']), (3, ['0.1', '-2'])], [0, 1])
+    """
+    if not rows or len({len(c) for _, c in rows}) != 1:
+        return rows, list(range(max((len(c) for _, c in rows), default=0)))
+    keep = [j for j in range(len(rows[0][1])) if any(c[j] for _, c in rows)]
+    if len(keep) == len(rows[0][1]):
+        return rows, keep
+    return [(n, [c[j] for j in keep]) for n, c in rows], keep
+
+
 def numeric_lines(text: list[str]):
     """(line number, cells) of a text table's data lines: comments (``#``, ``%``) and blank lines skipped, cells split
     at semicolons (a spreadsheet's export where the comma is the decimal mark: ``0,5;1,25`` is 0.5 and 1.25) or, where

@@ -359,11 +359,11 @@ def read_record(path, *, response: str = "acceleration") -> Record:
     """
     if Path(path).suffix.lower() in (".uff", ".unv", ".uf"):
         return _read_uff_record(path)
-    from .frf_files import _check_not_cut, _is_number, _read_text, numeric_lines
+    from .frf_files import _check_not_cut, _is_number, _read_text, drop_empty_columns, numeric_lines
 
     rows = []
     text, open_end = _read_text(path)
-    for n, cells in numeric_lines(text):
+    for n, cells in drop_empty_columns(list(numeric_lines(text)))[0]:
         if len(cells) != 3:
             raise InputError(f"line {n}: expected 3 columns (time s, force N, response), found {len(cells)}",
                              file=path, field="columns")

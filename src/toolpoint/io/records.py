@@ -180,12 +180,17 @@ def _sniff(p: Path) -> str | None:
     return None
 
 
-def _pick(data: np.ndarray, channel: int | None, p: Path, what: str) -> tuple[np.ndarray, str]:
-    """One channel of ``data`` (T, C): the given one, or the mean of all (audio) / the only one."""
+def _pick(data: np.ndarray, channel: int | None, p: Path, what: str, names=None) -> tuple[np.ndarray, str]:
+    """One channel of ``data`` (T, C): the given one, or the mean of all (audio) / the only one; ``names`` (C, the
+    table's header) name it in the result and list the choice in the refusal."""
     n = data.shape[1]
+
+    def label(k):
+        return f"{k} ({names[k]})" if names and names[k] else str(k)
+
     if channel is None:
         if n == 1:
-            return data[:, 0], "0"
+            return data[:, 0], label(0)
         if what == "audio":
             mean = data.mean(axis=1)
             # channels in opposite polarity (a swapped lead, an interface's inverted input) cancel in the mean: the
@@ -197,10 +202,12 @@ def _pick(data: np.ndarray, channel: int | None, p: Path, what: str) -> tuple[np
                                  f"{100 * np.var(mean) / each:.2g} % of their power: one is inverted?); choose one "
                                  f"with --channel (0..{n - 1})", file=p, field="channel")
             return mean, f"mean of {n}"
-        raise InputError(f"{n} signal columns: choose one with --channel (0..{n - 1})", file=p, field="channel")
+        raise InputError(f"{n} signal columns: choose one with --channel "
+                         + (f"({', '.join(f'{k}: {names[k]}' for k in range(n))})" if names else f"(0..{n - 1})"),
+                         file=p, field="channel")
     if not (0 <= channel < n):
         raise InputError(f"channel {channel} does not exist ({what} has {n}: 0..{n - 1})", file=p, field="channel")
-    return data[:, channel], str(channel)
+    return data[:, channel], label(channel)
 
 
 def _read_audio(p: Path, channel: int | None) -> CutRecord:
@@ -248,25 +255,31 @@ def _read_uff(p: Path, channel: int | None) -> CutRecord:
 
 
 def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecord:
-    from .frf_files import _is_number, _read_text, numeric_lines
+    from .frf_files import _is_number, _read_text, drop_empty_columns, numeric_lines
 
     text, _ = _read_text(p)
     rows, lines = [], []
     width = None
-    for n, cells in numeric_lines(text):
+    numbered = list(numeric_lines(text))
+    for n, cells in numbered:
         if width is None:
             width = len(cells)
         if len(cells) != width:
             raise InputError(f"line {n}: expected {width} columns, found {len(cells)}", file=p, field="columns")
-        for j, c in enumerate(cells):
-            if not _is_number(c):
-                raise InputError(f"line {n}: {c!r} is not a number", file=p, field=f"column {j}")
-        rows.append(cells)
-        lines.append(n)
-    if not rows:
+    if not numbered:
         raise InputError("no data rows (no line of numbers; cells split at ';', ',' or white space)", file=p,
                          field="data")
+    # a column empty in every row is no channel (a LabVIEW export's Comment column): dropped, and its name with it
+    names = _column_names(text, numbered[0][0], width)
+    kept, keep = drop_empty_columns(numbered)
+    for n, cells in kept:
+        for j, c in enumerate(cells):
+            if not _is_number(c):
+                raise InputError(f"line {n}: {c!r} is not a number", file=p, field=f"column {keep[j]}")
+        rows.append(cells)
+        lines.append(n)
     a = np.array(rows, dtype=float)
+    names = [names[j] for j in keep] if names else None
     if a.shape[1] == 1:
         if rate_hz is None:
             raise InputError("one column of samples: give the sampling rate (--rate HZ)", file=p, field="rate_hz")
@@ -275,8 +288,37 @@ def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecor
     unit, scale = _time_unit(text, lines[0])
     t = a[:, 0] * scale
     _check_time(t, lines, p, unit)
-    x, ch = _pick(a[:, 1:], channel, p, "the table")
+    x, ch = _pick(a[:, 1:], channel, p, "the table", names=names[1:] if names else None)
     return CutRecord(x, float((t.size - 1) / (t[-1] - t[0])), os.fspath(p), ch)
+
+
+def _header_cells(text: list[str], first: int) -> list[list[str]]:
+    """The header lines just above the first data line (line ``first``, 1-based), nearest first, split as
+    :func:`numeric_lines` splits the data; comments and blank lines skipped."""
+    out = []
+    for line in reversed(text[:first - 1]):
+        s = line.strip()
+        if not s or s[0] in "#%":
+            continue
+        sep = ";" if ";" in s else "\t" if "\t" in s else "," if "," in s else None
+        out.append([c.strip().strip('"') for c in (s.split(sep) if sep else s.split())])
+    return out
+
+
+def _is_unit_row(cells: list[str]) -> bool:
+    """A DAQ's units row under the names (``s;g;g``, ``[s] [m/s^2]``): short cells without a space."""
+    return all(0 < len(c) <= 8 and " " not in c for c in cells)
+
+
+def _column_names(text: list[str], first: int, width: int) -> list[str] | None:
+    """The columns' names from the header above the data: the names line, with a units row under it (a DAQ's
+    export: ``Time;AI 1`` over ``s;g``) as "AI 1 (g)"; None where the header holds another number of cells."""
+    head = [c for c in _header_cells(text, first)[:2] if len(c) == width]
+    if not head:
+        return None
+    if len(head) == 2 and _is_unit_row(head[0]):
+        return [f"{n} ({u.strip('[]()')})" if u else n for n, u in zip(head[1], head[0])]
+    return head[0]
 
 
 _TIME_UNITS = {"ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "s": 1.0}
@@ -284,18 +326,18 @@ _UNIT_IN_NAME = re.compile(r"(?:[\[(]\s*|_)(ms|us|µs|μs|s)\s*[\])]?\s*$", re.I
 
 
 def _time_unit(text: list[str], first: int) -> tuple[str, float]:
-    """The time column's unit from the header line above the data (``Time (ms)``, ``t [us]``, ``time_ms``;
-    default s) and its factor to s; ``first`` is the first data line's number (1-based)."""
-    for line in reversed(text[:first - 1]):
-        s = line.strip()
-        if not s or s[0] in "#%":
-            continue
-        name = (s.split(";") if ";" in s else s.split(",") if "," in s else s.split())[0]
-        m = _UNIT_IN_NAME.search(name.strip().strip('"'))
+    """The time column's unit from the header line above the data (``Time (ms)``, ``t [us]``, ``time_ms``, or a
+    DAQ's units row ``ms;g``; default s) and its factor to s; ``first`` is the first data line's number (1-based)."""
+    head = _header_cells(text, first)[:1]
+    if head and head[0]:
+        name = head[0][0]
+        whole = name.strip("[]() ").lower()
+        if whole in _TIME_UNITS:
+            return whole, _TIME_UNITS[whole]
+        m = _UNIT_IN_NAME.search(name)
         if m:
             u = m.group(1).lower()
             return u, _TIME_UNITS.get(u, 1.0)
-        break
     return "s", 1.0
 
 
