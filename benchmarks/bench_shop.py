@@ -1,7 +1,7 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|teeth|inside|update|sampler|forward|ceiling|sdm-bands] [--shops zoa,noisy,sim]
+        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands] [--shops zoa,noisy,sim]
         [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
@@ -20,6 +20,8 @@ CPU time (time.process_time), not wall time: the machine is shared.
    drift, 25.6 kS/s).
    ``teeth``: the same simulated records judged with a wrong tooth count (N ± 1, 2 N, N / 2): the verdicts it
    changes and whether ``cut`` warns of the count, and the records warned at the right count.
+   ``twocut``: two of those records one after the other, at one speed (two depths: neither refused nor judged
+   worse) or at two speeds ×1.31 apart (refused: one ``--rpm`` judges one speed).
    ``inside``: records taken inside a chattering cut, without air cut (windows of the real recording's chattering
    stretch; synthetic cuts whose chatter waxes and wanes).
 2. ``update``: virtual campaigns (truth drawn from the prior, the next cut from the ``info`` rule) on the
@@ -283,6 +285,63 @@ class _TeethScore(_Score):
             print(f"   {kind}: {cnt['n']} records ({cnt['refused']} refused): verdict changed {cnt['changed']} "
                   f"({cnt['to_chatter']} to chatter), of them warned {cnt['changed_warned']}; warned in all "
                   f"{cnt['warned']}")
+
+
+class _TwoCutScore(_Score):
+    """Records that hold two cuts, each with its air cut (two simulated records one after the other).
+
+    At one speed (consecutive depths of the grid): neither refused nor judged worse than its cuts — the verdict is
+    right when it is chatter if either cut is past the SDM limit. At two speeds (consecutive speeds of the grid,
+    ×1.31, one depth; judged at the first cut's speed): refused ("ran at another spindle speed"), not judged as one
+    speed. Points within ±5 % of the SDM limit left out, as in the other scores."""
+
+    def __init__(self, record=None):
+        super().__init__(record)
+        self.same = dict.fromkeys(("n", "refused", "right"), 0)
+        self.two = dict.fromkeys(("n", "refused", "right"), 0)
+        self.refusals = []
+
+    def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
+        from toolpoint.errors import InputError
+        from toolpoint.simulation import simulate_milling
+
+        res = simulate_milling(mm, mm, c, rpm=rpm, depth_m=depth, revolutions=250, seed=seed, seed_level=seed_level)
+        speeds = np.unique(rpm)
+        recs = {}
+        for p in range(rpm.size):
+            if abs(depth[p] / lim[p] - 1) < 0.05:
+                self.skipped += 1
+                continue
+            recs[p] = self.record(res, float(rpm[p]), c.teeth, rng, point=p) + (bool(rho[p] > 1),)
+        n_s = speeds.size
+        pairs = []
+        for p in recs:  # the grid is depths × speeds, raveled: p = i_depth * n_s + i_speed
+            for q, kind in ((p + n_s, "same"), (p + 1, "two")):
+                if q in recs and (kind == "same" or (p % n_s) + 1 < n_s):
+                    pairs.append((p, q, kind))
+        for p, q, kind in pairs:
+            (x1, rate, c1), (x2, _, c2) = recs[p], recs[q]
+            cnt = self.same if kind == "same" else self.two
+            cnt["n"] += 1
+            try:
+                r = analyse_cut(np.concatenate([x1, x2]), rate, rpm=float(rpm[p]), teeth=c.teeth,
+                                full_scale=self.full_scale)
+            except InputError as e:
+                cnt["refused"] += 1
+                if kind == "same":
+                    self.refusals.append(f"{rpm[p]:.0f} rpm, {1e3 * depth[p]:.3g} + {1e3 * depth[q]:.3g} mm: {e}")
+                continue
+            cnt["right"] += (r.verdict == "chatter") == (c1 or c2)
+
+    def report(self, what):
+        print(f"{what}; {self.skipped} within ±5 % of the SDM limit left out), two cuts in one record:")
+        s, t = self.same, self.two
+        print(f"   one speed, two depths: {s['n']} records, {s['refused']} refused, verdict right {s['right']} "
+              f"(chatter if either cut is past the limit)")
+        for line in self.refusals:
+            print(f"      refused: {line}")
+        print(f"   two speeds (x1.31), one depth: {t['n']} records, {t['refused']} refused; of the rest "
+              f"{t['right']} judged right")
 
 
 def _truth(pr, rng, random_cut=True):
@@ -573,7 +632,7 @@ def main():
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=("cut", "teeth", "inside", "update", "sampler", "forward", "ceiling",
+    ap.add_argument("--only", choices=("cut", "teeth", "twocut", "inside", "update", "sampler", "forward", "ceiling",
                                        "sdm-bands"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
@@ -618,6 +677,9 @@ def main():
             pockets[tool] = prior_from_library(out, tool)
         bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level,
                           sensor=a.sensor, score=_TeethScore(sensor))
+    if a.only in (None, "twocut"):
+        bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level, sensor=a.sensor,
+                      score=_TwoCutScore(SENSORS[a.sensor]))
     if a.only in (None, "inside"):
         bench_cut_inside(a.quick)
     if a.only in (None, "forward"):

@@ -691,6 +691,53 @@ def test_a_daq_s_export_with_a_comment_column_and_a_units_row(tmp_path):
         read_cut_record(blank)
 
 
+def test_a_record_of_cuts_at_two_speeds_is_refused_and_judged_in_parts(tmp_path, capsys):
+    """One --rpm judges one speed. Two test cuts recorded in one file at 6000 and 8000 rpm: given 6000 rpm the
+    8000 rpm cut's tooth passing was "chatter at 533.4 Hz", given 8000 rpm the 6000 rpm cut's spindle line
+    "chatter at 100.0 Hz". Now refused naming the cut and its speed, and each part judged alone (``span_s``,
+    ``--start``/``--end``). The same on the real recording followed by itself played 1.25 × faster (a second cut
+    at 8075 rpm): refused both ways, each part judged as the recording is. Two cuts at one speed are judged."""
+    import soundfile as sf
+    from scipy.signal import resample_poly
+
+    a, rate, *_ = shop_record(rpm=6000, teeth=4, seed=1)
+    b, _, *_ = shop_record(rpm=8000, teeth=4, seed=3, chatter_hz=1234.0, chatter_amp=0.5)
+    c, _, *_ = shop_record(rpm=6000, teeth=4, seed=2, chatter_hz=1234.0, chatter_amp=0.5)
+    x = np.concatenate([a, b])
+    with pytest.raises(InputError, match=r"rpm: the cut at 5\.0–7\.0 s ran at another spindle speed, ≈ 8000 rpm"):
+        analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0)
+    with pytest.raises(InputError, match=r"rpm: the cut at 1\.0–3\.0 s ran at another spindle speed, ≈ 600[01] rpm"):
+        analyse_cut(x, rate, rpm=8000, teeth=4, full_scale=1.0)
+    assert analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0, span_s=(0, 4)).verdict == "stable"
+    r = analyse_cut(x, rate, rpm=8000, teeth=4, full_scale=1.0, span_s=(4, np.inf))
+    assert r.verdict == "chatter" and abs(r.chatter_hz / 1234 - 1) < 0.01 and r.criterion["span_s"] == [4, 8]
+    assert min(g.start_s for g in r.segments) == pytest.approx(4.0) and r.time_s[0] > 4
+    same = analyse_cut(np.concatenate([a, c]), rate, rpm=6000, teeth=4, full_scale=1.0)
+    assert [g.verdict for g in same.segments if g.kind == "cut"] == ["stable", "chatter"]
+    rec = read_cut_record(REAL)
+    part = rec.samples[:int(25 * rec.rate_hz)]  # air, the cut, air
+    both = np.concatenate([part, resample_poly(part, 4, 5)])
+    for rpm, where in ((6500, r"30\.\d–3\d\.\d s ran at another spindle speed, ≈ [78]\d\d\d rpm"),
+                       (8075, r"6\.\d–16\.\d s ran at another spindle speed, ≈ 64\d\d rpm")):
+        with pytest.raises(InputError, match=r"the cut at " + where):
+            analyse_cut(both, rec.rate_hz, rpm=rpm, teeth=2, full_scale=1.0)
+    r1 = analyse_cut(both, rec.rate_hz, rpm=6500, teeth=2, full_scale=1.0, span_s=(0, 25))
+    r2 = analyse_cut(both, rec.rate_hz, rpm=8075, teeth=2, full_scale=1.0, span_s=(25, 50))
+    assert r1.chatter_hz == pytest.approx(1067.3, abs=0.2) and r2.chatter_hz == pytest.approx(1.25 * 1067.3, rel=2e-3)
+    twice = analyse_cut(np.concatenate([part, part]), rec.rate_hz, rpm=6500, teeth=2, full_scale=1.0)
+    assert twice.verdict == "chatter" and twice.chatter_hz == pytest.approx(1067.3, abs=0.2)
+    # the command line: --start/--end, and a start past the record's end refused naming --start
+    wav = tmp_path / "two.wav"
+    sf.write(wav, 0.5 * x / np.abs(x).max(), int(rate), subtype="PCM_16")
+    assert main(["cut", str(wav), "--rpm", "6000", "--teeth", "4"]) == 2
+    assert "ran at another spindle speed" in capsys.readouterr().err
+    out = tmp_path / "b.json"
+    assert main(["cut", str(wav), "--rpm", "8000", "--teeth", "4", "--start", "4", "--out", str(out)]) == 0
+    assert json.loads(out.read_text())["verdict"] == "chatter"
+    assert main(["cut", str(wav), "--rpm", "8000", "--teeth", "4", "--start", "9"]) == 2
+    assert "two.wav: --start: 9 s is after the record's end (8 s)" in capsys.readouterr().err
+
+
 def test_a_slow_spindle_s_stable_verdict_says_its_masks_cover_the_band():
     """Below ~800 rpm the spindle harmonics lie closer than their masks are wide (±2 bins of a 0.4 s frame): chatter
     there goes unheard (0 of 8 synthetic chattering cuts at 600 rpm), so a 'stable' verdict is warned of; at 3000 rpm

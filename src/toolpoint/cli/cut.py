@@ -1,4 +1,5 @@
-"""``toolpoint cut RECORD --rpm N --teeth Z [--rate HZ] [--channel K] [--out cut.json] [--plot cut.png]``.
+"""``toolpoint cut RECORD --rpm N --teeth Z [--rate HZ] [--channel K] [--start S] [--end S] [--out cut.json]
+[--plot cut.png]``.
 
 Chatter detection from a record of a cut: microphone audio (WAV, FLAC, OGG, MP3), accelerometer or
 displacement time histories (CSV/text columns, time first; one column with ``--rate``; UFF58). Spindle
@@ -15,6 +16,7 @@ A one-line summary goes to stdout. Bad input: one line naming file and field, ex
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -44,6 +46,9 @@ def register(sub) -> None:
     p.add_argument("--growth-db", default="6",
                    help="a new line whose power rises steadily by this much over a judged part is chatter, however "
                         "weak (default 6 dB, with t >= 4; 0: no growth test)")
+    p.add_argument("--start", help="judge the record from this time on, s (one cut of a record that holds cuts at "
+                   "several speeds; times stay the record's)")
+    p.add_argument("--end", help="judge the record up to this time, s")
     p.add_argument("--out", help="result JSON (default: print it)")
     p.add_argument("--plot", help="spectrogram with the harmonics and segments marked, and the chattering cut's "
                    "mean spectrum against the air cut's (.png/.pdf/.svg)")
@@ -71,6 +76,10 @@ def run(args) -> int:
     if tol >= 0.5:
         raise InputError(f"must be < 0.5, got {args.rpm_tolerance}", file="command line", field="--rpm-tolerance")
     window = check_number(args.window, "--window", above=0, unit="s")
+    start = check_number(args.start, "--start", minimum=0, unit="s") if args.start is not None else None
+    end = check_number(args.end, "--end", above=0, unit="s") if args.end is not None else None
+    if start is not None and end is not None and end <= start:
+        raise InputError(f"must be after --start ({start:g} s), got {end:g} s", file="command line", field="--end")
     dominance = check_number(args.dominance, "--dominance", above=0)
     alias_dominance = check_number(args.alias_dominance, "--alias-dominance", minimum=0)
     growth_db = check_number(args.growth_db, "--growth-db", minimum=0, unit="dB")
@@ -79,10 +88,13 @@ def run(args) -> int:
     from ..shop import analyse_cut
 
     rec = read_cut_record(rec_path, rate_hz=rate, channel=channel)
+    if start is not None and start >= rec.duration_s:
+        raise InputError(f"{start:g} s is after the record's end ({rec.duration_s:.4g} s)", file=rec_path,
+                         field="--start")
     res = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=teeth, rpm_tolerance=tol, window_s=window,
                       dominance=dominance, alias_dominance=alias_dominance, growth_db=growth_db,
-                      full_scale=rec.full_scale,
-                      source=str(rec_path))
+                      full_scale=rec.full_scale, source=str(rec_path),
+                      span_s=None if start is None and end is None else (start or 0.0, end or math.inf))
     doc = {"record": str(rec_path), "channel": rec.channel, "rate_hz": rec.rate_hz, **res.to_dict()}
     fig = None
     if plot is not None:

@@ -28,7 +28,8 @@ The detector (:func:`analyse_cut`):
    says where the harmonics do stand out; else refused (``InputError``, field ``rpm``), as is a speed in rev/s.
    *A tooth count the record contradicts* is warned where the spindle harmonics that stand out in the stable cut
    (or under chatter resting on a spindle harmonic) keep another spacing than the tooth passing given
-   (:func:`_spacing`);
+   (:func:`_spacing`). *Cuts at two speeds in one record* (a shop's two test cuts in one file) are refused,
+   naming the cut and its speed (:func:`_one_speed`): one ``rpm`` judges one speed; ``span_s`` judges a part;
 2. **segments** — frame energy in the band, split at a two-level (Otsu) threshold into air cut and
    cutting when the levels differ by ≥ ``activity_db`` (see *Automatic gain control* below for the loud
    stretches without tooth passing that are air all the same; when no level splits, as under a loud coolant
@@ -201,6 +202,10 @@ _MASKED_WARN = 0.95  # a stable verdict with this much of the band under the spi
 _ELSEWHERE_REL = 0.25  # nominal speeds up to this far off are checked for (the range measured)
 _ELSEWHERE_DB = 13.0  # … where the tooth-passing harmonics stand this far over the floor (mean of the four lowest)
 _ELSEWHERE_GAIN_DB = 10.0  # … and this much higher than within the tolerance: warned (see _speed_elsewhere)
+_RUN_SPEED_REL = 2e-3  # a cutting run's speed against the record's: its frames' wander (see _one_speed)
+_RUN_UNIQUE_DB = 6.0  # … and another speed's own lines this much further out than the speed read's …
+_RUN_OWN_DB = 6.0  # … whose own lines stand no further out than this: refused (both chosen on truths 10–11)
+_RUN_GROUP_REL = 0.02  # runs whose other speeds agree this well are judged together
 _SPACING_DB = 6.0  # the stable cut's harmonics at multiples of M f_s stand this far over the others on average …
 _SPACING_RATIO = 1.5  # … and split them this much better than the multiples of N f_s: --teeth is doubted (_spacing)
 _CUT_PROMINENCE_DB = 4.0  # dB over noise: a quiet stretch whose tooth-passing harmonics stand out this far, and half
@@ -601,7 +606,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 band_hz: tuple | None = None, window_s: float = 1.0, activity_db: float = 4.0,
                 rise_db: float = 10.0, dominance: float = 0.05, alias_dominance: float = 0.002,
                 growth_db: float = 6.0, alpha: float = _ALPHA, full_scale: float | None = None,
-                source: str | None = None) -> CutAnalysis:
+                source: str | None = None, span_s: tuple | None = None) -> CutAnalysis:
     """Judge a record of a milling cut: stable or chatter, per segment, with the chatter frequency.
 
     Parameters
@@ -639,6 +644,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         noise, 0.002–0.02 at 0.01).
     full_scale, source
         For the input checks (:func:`check_record`).
+    span_s : (float, float), optional
+        The part of the record judged, (start, end) s: one cut of a record that holds cuts at several speeds (refused
+        as a whole, field ``rpm``). Times in the result stay the record's.
 
     Returns
     -------
@@ -667,6 +675,25 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     ('chatter', 1234)
     """
     x = np.asarray(samples, float)
+    kw = dict(rpm=rpm, teeth=teeth, rpm_tolerance=rpm_tolerance, band_hz=band_hz, window_s=window_s,
+              activity_db=activity_db, rise_db=rise_db, dominance=dominance, alias_dominance=alias_dominance,
+              growth_db=growth_db, alpha=alpha, full_scale=full_scale, source=source)
+    if span_s is not None:
+        a, b = (float(v) for v in span_s)
+        if not (math.isfinite(rate_hz) and rate_hz > 0):
+            raise InputError(f"must be > 0 Hz, got {rate_hz!r}", file=source, field="rate_hz")
+        dur = x.size / float(rate_hz)
+        if not (0 <= a < b):  # an end of inf: to the record's end
+            raise InputError(f"must be 0 ≤ start < end, got {a:g}–{b:g} s", file=source, field="span_s")
+        if a >= dur:
+            raise InputError(f"starts at {a:g} s, after the record's end ({dur:.4g} s)", file=source, field="span_s")
+        k0 = int(round(a * rate_hz))
+        res = analyse_cut(x[k0:int(round(min(b, dur) * rate_hz))], rate_hz, **kw)
+        segs = tuple(replace(g, start_s=g.start_s + a, end_s=g.end_s + a) for g in res.segments)
+        crit = dict(res.criterion, span_s=[a, min(b, dur)])
+        if "digital_silence_s" in crit:
+            crit["digital_silence_s"] = [[u + a, v + a] for u, v in crit["digital_silence_s"]]
+        return replace(res, segments=segs, criterion=crit, time_s=res.time_s + a)
     check_record(x, rate_hz, rpm, teeth, full_scale=full_scale, source=source)
     if not (isinstance(alpha, (int, float, np.floating)) and 0 < alpha < 1):
         raise InputError(f"must be a probability in (0, 1), got {alpha!r}", file=source, field="alpha")
@@ -676,9 +703,6 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     if k0 > 0 or k1 < x.size:
         # digital silence before or after the signal (a recorder started before its input was live): judged without
         # it — as the low level of the record it made the air cut look like cutting — and the times kept the record's
-        kw = dict(rpm=rpm, teeth=teeth, rpm_tolerance=rpm_tolerance, band_hz=band_hz, window_s=window_s,
-                  activity_db=activity_db, rise_db=rise_db, dominance=dominance, alias_dominance=alias_dominance,
-                  growth_db=growth_db, alpha=alpha, full_scale=full_scale, source=source)
         res = analyse_cut(x[k0:k1], rate_hz, **kw)
         t0 = k0 / float(rate_hz)
         segs = tuple(replace(g, start_s=g.start_s + t0, end_s=g.end_s + t0) for g in res.segments)
@@ -860,6 +884,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 runs, air, ref, cutting = again
                 track, wander, f_s = tracked(cutting)
 
+    if spindle_found and rpm_tolerance > 0:
+        _one_speed(runs, f_s, f_nom, rpm, rpm_tolerance, teeth, frames_in, spectrum, freq, df, source)
     unheard = None
     if not spindle_found:
         # without the tooth-passing harmonics neither the speed nor "strong" (a line against the strongest harmonic) is
@@ -1196,11 +1222,94 @@ def _harmonic_mask(freq, inband, f_lo, f_hi, df):
     return inband & ~near, inband & near
 
 
-def _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df):
+def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, df, source) -> None:
+    """Refuse a record whose cutting runs ran at different spindle speeds.
+
+    A run (a cut between air cuts) is at another speed where (1) its four lowest tooth-passing harmonics stand
+    ≥ 13 dB out at a speed a third to three times the nominal, no multiple, half or third of the speed read
+    ``f_s`` (:func:`_speed_elsewhere`; runs whose speeds agree within ``_RUN_GROUP_REL`` judged together); (2) that
+    speed's own lines — its harmonics that are no harmonics of ``f_s``, :func:`_own_lines_db` — stand
+    ≥ ``_RUN_UNIQUE_DB`` further out than ``f_s``'s own lines, which stand ≤ ``_RUN_OWN_DB`` out (the speed, its
+    half or its third: whichever's own lines stand out most); and (3) its own lines stand ≤ ``_RUN_OWN_DB`` out in
+    the other runs, which hear ``f_s``'s own lines > ``_RUN_OWN_DB`` (else the speed read is off for the whole
+    record: the real recording given 5850 rpm, split in two pieces, is the warning of :func:`_speed_elsewhere`).
+    Refused where some runs are and some are not.
+
+    Why: a shop records two test cuts in one file, at 6000 and 8000 rpm; given 6000 rpm the 8000 rpm cut's tooth
+    passing (533.3 Hz) was "chatter at 533.4 Hz", given 8000 rpm the 6000 rpm cut's spindle line "chatter at 100.0
+    Hz", without a word. One ``--rpm`` judges one speed. Each speed is judged by its own lines because two speeds
+    share harmonics (6000 and 8000 rpm share every fourth and third: 400 Hz is 4 × 100 and 3 × 133.3); (3) because
+    a housing accelerometer's bearing tones, in every run, make a comb at no speed of the spindle's. Heavy chatter
+    still can (one simulated accelerometer record of two chattering cuts at one speed, ρ 1.05–1.26, of 320): the
+    refusal says so, and each part judged alone keeps its verdict. Measured in ``docs/design/shop.md``, *Cuts at
+    two speeds in one record*.
+    """
+    cut_runs = [(ta, tb) for ta, tb, v in runs if v]
+    if len(cut_runs) < 2:
+        return
+    span = (1 / 3, 3.0)
+    cand = []  # (speed Hz, run index) of the runs whose tooth passing stands out elsewhere
+    for r, (ta, tb) in enumerate(cut_runs):
+        _, logp, floor = spectrum(frames_in(ta, tb))
+        e = _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df, span=span, f_s=f_s, gain_db=0.0)
+        if e is not None:
+            cand.append((e[0], r))
+    # runs at one other speed are judged together: a speed the record was not split at leaves its cut in pieces (the
+    # real recording's cut, played 1.25 × faster after it, given its own speed: six pieces of 0.05–0.6 s)
+    while cand:
+        f_e = cand[0][0]
+        group = [r for f, r in cand if abs(f / f_e - 1) <= _RUN_GROUP_REL]
+        cand = [(f, r) for f, r in cand if r not in group]
+        _, logp, floor = spectrum(np.unique(np.concatenate([frames_in(*cut_runs[r]) for r in group])))
+        e = _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df, span=span, f_s=f_s, gain_db=0.0)
+        if e is None:
+            continue
+        # the speed whose own lines stand out most among it, its half and its third (a 2-tooth cutter's tooth
+        # passing is a comb at twice its speed: the real recording's fast copy read as 12900 rpm, its own lines
+        # 5.2 dB over 8075 rpm's, against 7.3 dB at 6450 rpm)
+        best = max(((_own_lines_db(freq, logp, floor, e[0] / m, f_s, df),
+                     _own_lines_db(freq, logp, floor, f_s, e[0] / m, df), e[0] / m) for m in (1, 2, 3)
+                    if e[0] / m >= span[0] * f_nom), key=lambda u: u[0] - u[1])
+        u_e, u_s, f_run = best
+        if u_e - u_s < _RUN_UNIQUE_DB or u_s > _RUN_OWN_DB or len(group) == len(cut_runs):
+            continue
+        # … and that speed's own lines are not in the other runs: lines every run holds are the machine's (a
+        # bearing's tones on a housing accelerometer make a comb at no speed of the spindle's)
+        rest = [r for r in range(len(cut_runs)) if r not in group]
+        _, logp_r, floor_r = spectrum(np.unique(np.concatenate([frames_in(*cut_runs[r]) for r in rest])))
+        if (_own_lines_db(freq, logp_r, floor_r, f_run, f_s, df) > _RUN_OWN_DB
+                or _own_lines_db(freq, logp_r, floor_r, f_s, f_run, df) <= _RUN_OWN_DB):
+            continue  # … while they hear the speed read: else it is the whole record's speed that is off
+        ref = cut_runs[rest[0]]
+        ta, tb = cut_runs[min(group)][0], cut_runs[max(group)][1]
+        raise InputError(f"the cut at {ta:.1f}–{tb:.1f} s ran at another spindle speed, ≈ {60 * f_run:.0f} rpm: the "
+                         f"harmonics of that speed that are none of {60 * f_s:.0f} rpm's stand {u_e:.0f} dB over "
+                         f"the floor there, those of {60 * f_s:.0f} rpm (the speed of the cut at {ref[0]:.1f}–"
+                         f"{ref[1]:.1f} s) {u_s:.0f} dB; one --rpm judges one speed: judge each part with its own "
+                         "--rpm and --start/--end, or cut the record in two (heavy chatter can make such lines: "
+                         "judged alone, that cut's verdict stands)", file=source, field="rpm")
+
+
+def _own_lines_db(freq, logp, floor, f_a, f_b, df) -> float:
+    """Mean excess over the floor, dB, of the harmonics k f_a (k ≤ 40, in the spectrum) that are no harmonics of f_b
+    (farther than 2 Δf + ``_MASK_REL`` f from every k' f_b): each the peak of its main lobe, ±1.5 bins."""
+    k = np.arange(1, int(min(40, freq[-1] / f_a)) + 1)
+    fk = k * f_a
+    own = np.abs(fk - np.round(fk / f_b) * f_b) > 2 * df + _MASK_REL * fk
+    if not own.any():
+        return -np.inf
+    i = np.rint(fk[own] / df).astype(int)[:, None] + np.arange(-1, 2)[None, :]
+    i = np.clip(i, 0, freq.size - 1)
+    return float(((logp - floor)[i]).max(axis=1).mean() * 10 / math.log(10))
+
+
+def _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df, span=None, f_s=None, gain_db=_ELSEWHERE_GAIN_DB):
     """A spindle frequency within ±``_ELSEWHERE_REL`` of the nominal ``f_nom`` but outside ±``tol``, where the four
     lowest tooth-passing harmonics k N f (k ≤ 4) stand ≥ ``_ELSEWHERE_DB`` over the floor on average and
     ≥ ``_ELSEWHERE_GAIN_DB`` higher than at the best speed within ``tol``: (f Hz, its dB, the best within tol's dB),
-    else None.
+    else None. ``span`` (lo, hi): the range searched, × ``f_nom`` (default ±``_ELSEWHERE_REL``); ``f_s``: the speed
+    read, whose multiples, half and third are left out (and ``t_in`` read at it, ±``_RUN_SPEED_REL``); ``gain_db``:
+    the least gain over it.
 
     Why: a nominal speed several % off (a spindle override, another program's speed) leaves the tooth-passing
     harmonics outside their masks, and they are judged as chatter: on simulated records of stable cuts, a nominal
@@ -1211,16 +1320,28 @@ def _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df):
     on the saved simulated records (``docs/design/shop.md``, *A nominal speed several % off*).
     """
     step = df / (16.0 * teeth)  # a quarter bin at the 4th tooth-passing harmonic
-    f = np.arange(f_nom * (1 - _ELSEWHERE_REL), f_nom * (1 + _ELSEWHERE_REL), step)
+    lo, hi = span if span is not None else (1 - _ELSEWHERE_REL, 1 + _ELSEWHERE_REL)
+    f = np.arange(f_nom * lo, f_nom * hi, step)
     fk = f[:, None] * teeth * np.arange(1, 5)[None, :]
     t = np.interp(fk, freq, logp - floor, right=0.0).mean(axis=1)  # mean ln-power excess over the floor
     inside = np.abs(f / f_nom - 1) <= tol
     if not inside.any() or inside.all():
         return None
+    out = inside.copy()
+    if f_s is not None:
+        # against the speed read (the other runs' speed, to the wander a run's frames show), where a range of ±tol
+        # finds lines of another speed's cut by chance; and not at its multiples, whose tooth passing is its own
+        inside = np.abs(f / f_s - 1) <= _RUN_SPEED_REL
+        for m in (1 / 3, 1 / 2):
+            out |= np.abs(f / (m * f_s) - 1) <= tol
+        m = np.maximum(1.0, np.round(f / f_s))
+        out |= np.abs(f / (m * f_s) - 1) <= tol
+    if not inside.any():
+        return None
     t_in = float(t[inside].max())
-    j = int(np.argmax(np.where(inside, -np.inf, t)))
+    j = int(np.argmax(np.where(out, -np.inf, t)))
     db = 10.0 / math.log(10.0)
-    if t[j] * db >= _ELSEWHERE_DB and (t[j] - t_in) * db >= _ELSEWHERE_GAIN_DB:
+    if t[j] * db >= _ELSEWHERE_DB and (t[j] - t_in) * db >= gain_db:
         return float(f[j]), float(t[j] * db), t_in * db
     return None
 
