@@ -738,6 +738,24 @@ def test_a_record_of_cuts_at_two_speeds_is_refused_and_judged_in_parts(tmp_path,
     assert "two.wav: --start: 9 s is after the record's end (8 s)" in capsys.readouterr().err
 
 
+def test_a_daq_s_high_rate_is_decimated_to_the_band_judged():
+    """A DAQ's 96–192 kHz holds nothing the test looks at above its band (≤ 10 kHz): the record is decimated first
+    (2 min at 192 kHz peaked at 2.7 GB before, 0.6 GB after; docs/design/shop.md). The verdict and chatter frequency
+    are those of the record at 24 kHz; a band given up to 20 kHz keeps 48 kHz; below 50 kHz nothing is decimated."""
+    from scipy.signal import resample_poly
+
+    x, rate, *_ = shop_record(rpm=6000, teeth=4, seed=5, rate=24000.0, chatter_hz=1234.0, chatter_amp=0.5)
+    ref = analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=None)
+    for q in (4, 8):
+        r = analyse_cut(resample_poly(x, q, 1), q * rate, rpm=6000, teeth=4, full_scale=None)
+        assert r.criterion["analysed_rate_hz"] == 24000.0
+        assert r.verdict == ref.verdict == "chatter" and r.chatter_hz == pytest.approx(ref.chatter_hz, abs=0.05)
+        assert [g.kind for g in r.segments] == [g.kind for g in ref.segments]
+    wide = analyse_cut(resample_poly(x, 4, 1), 96000.0, rpm=6000, teeth=4, full_scale=None, band_hz=(50.0, 20000.0))
+    assert wide.criterion["analysed_rate_hz"] == 48000.0 and wide.verdict == "chatter"
+    assert analyse_cut(resample_poly(x, 2, 1), 48000.0, rpm=6000, teeth=4).criterion["analysed_rate_hz"] == 48000.0
+
+
 def test_a_slow_spindle_s_stable_verdict_says_its_masks_cover_the_band():
     """Below ~800 rpm the spindle harmonics lie closer than their masks are wide (±2 bins of a 0.4 s frame): chatter
     there goes unheard (0 of 8 synthetic chattering cuts at 600 rpm), so a 'stable' verdict is warned of; at 3000 rpm

@@ -206,6 +206,8 @@ _RUN_SPEED_REL = 2e-3  # a cutting run's speed against the record's: its frames'
 _RUN_UNIQUE_DB = 6.0  # … and another speed's own lines this much further out than the speed read's …
 _RUN_OWN_DB = 6.0  # … whose own lines stand no further out than this: refused (both chosen on truths 10–11)
 _RUN_GROUP_REL = 0.02  # runs whose other speeds agree this well are judged together
+_DECIMATE_ABOVE_HZ = 50_000.0  # records sampled faster than this are decimated …
+_DECIMATE_TO_HZ = 24_000.0  # … by q = rate // this (51.2 kHz by 2, 96 kHz by 4, 192 kHz by 8), band permitting
 _SPACING_DB = 6.0  # the stable cut's harmonics at multiples of M f_s stand this far over the others on average …
 _SPACING_RATIO = 1.5  # … and split them this much better than the multiples of N f_s: --teeth is doubted (_spacing)
 _CUT_PROMINENCE_DB = 4.0  # dB over noise: a quiet stretch whose tooth-passing harmonics stand out this far, and half
@@ -306,7 +308,9 @@ class CutAnalysis:
         (None where that test cannot run: fewer than 3 teeth, or no air cut); ``speed_wander`` the largest
         relative departure of the tracked spindle speed from its median over the cutting frames (0 where it
         could not be tracked), ``speed_tracked`` whether it exceeded the mask's 0.05 % and each judged part
-        masked the speeds it ran at (module docstring, step 3); ``warnings`` what the verdict cannot rule out
+        masked the speeds it ran at (module docstring, step 3); ``analysed_rate_hz`` the rate the spectra were
+        taken at (a record sampled above 50 kHz is decimated to 22–48 kHz first); ``warnings`` what the verdict
+        cannot rule out
         (chatter on a mains harmonic, 50 or 60 Hz × k within 2 Δf + 0.2 %, in a record without an air cut: hum
         from a ground loop is a steady tone there, and without the air cut only its strength is judged).
     time_s, freq_hz, power : ndarray
@@ -710,6 +714,16 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                                                                                 round(x.size / rate_hz, 4)]])
         return replace(res, segments=segs, criterion=crit, time_s=res.time_s + t0)
     rate = float(rate_hz)
+    # a DAQ's 51.2–192 kHz holds nothing the test looks at above its band (≤ 10 kHz): decimated by q to ≥ 22.2 kHz
+    # first (an FIR anti-alias filter), else the spectra grow with the rate — 2 min at 192 kHz peaked at 2.7 GB
+    top = band_hz[1] if band_hz is not None else 10_000.0
+    q = int(rate // _DECIMATE_TO_HZ) if rate > _DECIMATE_ABOVE_HZ else 1
+    q = max(1, min(q, int(0.45 * rate / top)))
+    if q > 1:
+        from scipy.signal import resample_poly
+
+        x = resample_poly(x - x.mean(), 1, q)
+        rate /= q
     x = x - x.mean()
     dur = x.size / rate
     f_nom = rpm / 60.0
@@ -1036,7 +1050,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                  "spindle_multiples_removed": True,
                  "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None,
                  "speed_wander": round(wander, 6), "speed_tracked": track is not None,
-                 "speed_elsewhere_rpm": None if elsewhere is None else round(60 * elsewhere[0], 1), "warnings": warns}
+                 "speed_elsewhere_rpm": None if elsewhere is None else round(60 * elsewhere[0], 1),
+                 "analysed_rate_hz": rate, "warnings": warns}
     return CutAnalysis(verdict, chatter_hz, tuple(segments), float(rpm), 60 * f_s, int(teeth), rec,
                        alts, criterion, frame_t, freq, P)
 
