@@ -898,8 +898,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 runs, air, ref, cutting = again
                 track, wander, f_s = tracked(cutting)
 
-    if spindle_found and rpm_tolerance > 0:
-        _one_speed(runs, f_s, f_nom, rpm, rpm_tolerance, teeth, frames_in, spectrum, freq, df, source)
+    if spindle_found:  # with --rpm-tolerance 0 too: a speed given exactly is still one speed
+        _one_speed(runs, f_s, f_nom, rpm, max(rpm_tolerance, 0.03), teeth, frames_in, spectrum, freq, hi, df,
+                   source)
     unheard = None
     if not spindle_found:
         # without the tooth-passing harmonics neither the speed nor "strong" (a line against the strongest harmonic) is
@@ -1237,7 +1238,7 @@ def _harmonic_mask(freq, inband, f_lo, f_hi, df):
     return inband & ~near, inband & near
 
 
-def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, df, source) -> None:
+def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, hi, df, source) -> None:
     """Refuse a record whose cutting runs ran at different spindle speeds.
 
     A run (a cut between air cuts) is at another speed where (1) its four lowest tooth-passing harmonics stand
@@ -1282,8 +1283,8 @@ def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, df,
         # the speed whose own lines stand out most among it, its half and its third (a 2-tooth cutter's tooth
         # passing is a comb at twice its speed: the real recording's fast copy read as 12900 rpm, its own lines
         # 5.2 dB over 8075 rpm's, against 7.3 dB at 6450 rpm)
-        best = max(((_own_lines_db(freq, logp, floor, e[0] / m, f_s, df),
-                     _own_lines_db(freq, logp, floor, f_s, e[0] / m, df), e[0] / m) for m in (1, 2, 3)
+        best = max(((_own_lines_db(freq, logp, floor, e[0] / m, f_s, hi, df),
+                     _own_lines_db(freq, logp, floor, f_s, e[0] / m, hi, df), e[0] / m) for m in (1, 2, 3)
                     if e[0] / m >= span[0] * f_nom), key=lambda u: u[0] - u[1])
         u_e, u_s, f_run = best
         if u_e - u_s < _RUN_UNIQUE_DB or u_s > _RUN_OWN_DB or len(group) == len(cut_runs):
@@ -1292,8 +1293,8 @@ def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, df,
         # bearing's tones on a housing accelerometer make a comb at no speed of the spindle's)
         rest = [r for r in range(len(cut_runs)) if r not in group]
         _, logp_r, floor_r = spectrum(np.unique(np.concatenate([frames_in(*cut_runs[r]) for r in rest])))
-        if (_own_lines_db(freq, logp_r, floor_r, f_run, f_s, df) > _RUN_OWN_DB
-                or _own_lines_db(freq, logp_r, floor_r, f_s, f_run, df) <= _RUN_OWN_DB):
+        if (_own_lines_db(freq, logp_r, floor_r, f_run, f_s, hi, df) > _RUN_OWN_DB
+                or _own_lines_db(freq, logp_r, floor_r, f_s, f_run, hi, df) <= _RUN_OWN_DB):
             continue  # … while they hear the speed read: else it is the whole record's speed that is off
         ref = cut_runs[rest[0]]
         ta, tb = cut_runs[min(group)][0], cut_runs[max(group)][1]
@@ -1305,10 +1306,10 @@ def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, df,
                          "judged alone, that cut's verdict stands)", file=source, field="rpm")
 
 
-def _own_lines_db(freq, logp, floor, f_a, f_b, df) -> float:
-    """Mean excess over the floor, dB, of the harmonics k f_a (k ≤ 40, in the spectrum) that are no harmonics of f_b
+def _own_lines_db(freq, logp, floor, f_a, f_b, fmax, df) -> float:
+    """Mean excess over the floor, dB, of the harmonics k f_a (k ≤ 40, ≤ ``fmax`` Hz) that are no harmonics of f_b
     (farther than 2 Δf + ``_MASK_REL`` f from every k' f_b): each the peak of its main lobe, ±1.5 bins."""
-    k = np.arange(1, int(min(40, freq[-1] / f_a)) + 1)
+    k = np.arange(1, int(min(40, fmax / f_a)) + 1)
     fk = k * f_a
     own = np.abs(fk - np.round(fk / f_b) * f_b) > 2 * df + _MASK_REL * fk
     if not own.any():
