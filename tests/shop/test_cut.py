@@ -143,7 +143,8 @@ def test_real_shop_recording_air_entry_cut_chatter_exit():
     from toolpoint.shop.update import _cutting_s
 
     entry, exit_ = res.segments[1], res.segments[-2]
-    assert _cutting_s(res.segments) == pytest.approx(exit_.end_s - entry.start_s)
+    assert _cutting_s(res) == pytest.approx(exit_.end_s - entry.start_s)
+    assert res.cuts == ((entry.start_s, exit_.end_s, "chatter", fc),)  # one cut
     assert res.segments[0].end_s <= entry.start_s and exit_.end_s <= res.segments[-1].start_s
 
 
@@ -714,6 +715,8 @@ def test_a_record_of_cuts_at_two_speeds_is_refused_and_judged_in_parts(tmp_path,
     assert min(g.start_s for g in r.segments) == pytest.approx(4.0) and r.time_s[0] > 4
     same = analyse_cut(np.concatenate([a, c]), rate, rpm=6000, teeth=4, full_scale=1.0)
     assert [g.verdict for g in same.segments if g.kind == "cut"] == ["stable", "chatter"]
+    assert [(round(t0), round(t1), v) for t0, t1, v, _ in same.cuts] == [(1, 3, "stable"), (5, 7, "chatter")]
+    assert same.cuts[1][3] == pytest.approx(1234.0, rel=0.01) and len(same.to_dict()["cuts"]) == 2
     rec = read_cut_record(REAL)
     part = rec.samples[:int(25 * rec.rate_hz)]  # air, the cut, air
     both = np.concatenate([part, resample_poly(part, 4, 5)])
@@ -731,6 +734,20 @@ def test_a_record_of_cuts_at_two_speeds_is_refused_and_judged_in_parts(tmp_path,
     sf.write(wav, 0.5 * x / np.abs(x).max(), int(rate), subtype="PCM_16")
     assert main(["cut", str(wav), "--rpm", "6000", "--teeth", "4"]) == 2
     assert "ran at another spindle speed" in capsys.readouterr().err
+    sess = tmp_path / "session.wav"  # two cuts at one speed: each cut's verdict on a line of its own
+    y = np.concatenate([a, c])
+    sf.write(sess, 0.5 * y / np.abs(y).max(), int(rate), subtype="PCM_16")
+    assert main(["cut", str(sess), "--rpm", "6000", "--teeth", "4", "--out", str(tmp_path / "s.json")]) == 0
+    said = capsys.readouterr().out.splitlines()
+    assert said[0].startswith("session.wav: chatter at 123") and said[1].startswith("session.wav: 2 cuts: 1.0–3.0 s "
+                                                                                       "stable; 5.0–7.0 s chatter at")
+    # … and a test-cut table's row, which is one cut, is warned that its record holds two that disagree
+    from toolpoint.shop.update import read_test_cuts
+
+    (tmp_path / "cuts.csv").write_text("rpm,depth_mm,result,record\n6000,0.5,,session.wav\n")
+    row = read_test_cuts(tmp_path / "cuts.csv", teeth=4)[0]
+    assert not row.stable and any("session.wav: the record holds 2 cuts (1.0–3.0 s stable; 5.0–7.0 s chatter)" in w
+                                  for w in row.warnings), row.warnings
     out = tmp_path / "b.json"
     assert main(["cut", str(wav), "--rpm", "8000", "--teeth", "4", "--start", "4", "--out", str(out)]) == 0
     assert json.loads(out.read_text())["verdict"] == "chatter"

@@ -7,10 +7,11 @@ and tooth-passing harmonics (all multiples of the spindle frequency: runout incl
 strongest remaining peak is tested (:func:`toolpoint.shop.analyse_cut` documents the criterion), per
 segment (air cut, entry, cut windows, exit).
 
-``cut.json``: ``verdict`` (stable|chatter), ``chatter_hz`` (null when stable), ``segments`` (kind,
-start_s, end_s, verdict, chatter_hz, …), ``rpm_measured`` (from the spindle harmonics),
-``recommended_rpm`` (a tooth-passing harmonic on the chatter frequency) and the criterion used.
-A one-line summary goes to stdout. Bad input: one line naming file and field, exit 2.
+``cut.json``: ``verdict`` (stable|chatter), ``chatter_hz`` (null when stable), ``cuts`` (start_s, end_s, verdict,
+chatter_hz of each cut between air cuts), ``segments`` (kind, start_s, end_s, verdict, chatter_hz, …),
+``rpm_measured`` (from the spindle harmonics), ``recommended_rpm`` (a tooth-passing harmonic on the chatter
+frequency) and the criterion used. A one-line summary goes to stdout (and a line of each cut's verdict where the
+record holds several). Bad input: one line naming file and field, exit 2.
 """
 
 from __future__ import annotations
@@ -115,6 +116,10 @@ def run(args) -> int:
            + (f", its speed wandered ±{100 * res.criterion['speed_wander']:.2g} % (tracked)"
               if res.criterion.get("speed_tracked") else ""))
     print(msg, file=sys.stderr if out is None else sys.stdout)
+    if len(res.cuts) > 1:  # a session's record: each cut's verdict
+        print(f"{rec_path.name}: {len(res.cuts)} cuts: " + "; ".join(
+            f"{a:.1f}–{b:.1f} s {v}" + (f" at {hz:.1f} Hz" if hz else "") for a, b, v, hz in res.cuts),
+            file=sys.stderr if out is None else sys.stdout)
     for w in res.criterion.get("warnings", ()):
         print(f"{rec_path.name}: warning: {w}", file=sys.stderr)
     return 0

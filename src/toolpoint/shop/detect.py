@@ -293,7 +293,7 @@ class CutAnalysis:
     chatter_hz : float or None
         Chatter frequency, Hz (of the longest chattering segment), None when stable.
     segments : tuple of CutSegment
-        In time order.
+        In time order; :attr:`cuts` groups them into the record's cuts.
     rpm_nominal, rpm : float
         The speed given and the one measured from the spindle harmonics, rpm.
     teeth : int
@@ -330,10 +330,29 @@ class CutAnalysis:
     freq_hz: np.ndarray = field(repr=False)
     power: np.ndarray = field(repr=False)
 
+    @property
+    def cuts(self) -> tuple:
+        """The record's cuts: each run of segments between air cuts (entry, judged windows, exit) as (start s, end s,
+        verdict, chatter Hz or None) — chatter where one of its windows chatters, at its longest chattering window's
+        frequency. A record of one test cut holds one; a session's record, one per cut."""
+        out, run = [], []
+        for g in (*self.segments, None):
+            if g is not None and g.kind != "air":
+                run.append(g)
+                continue
+            chat = [w for w in run if w.kind == "cut" and w.verdict == "chatter"]
+            if any(w.kind == "cut" for w in run):
+                hz = max(chat, key=lambda w: w.end_s - w.start_s).chatter_hz if chat else None
+                out.append((run[0].start_s, run[-1].end_s, "chatter" if chat else "stable", hz))
+            run = []
+        return tuple(out)
+
     def to_dict(self) -> dict:
         """The JSON document of ``toolpoint cut`` (no spectrogram)."""
         return {"verdict": self.verdict,
                 "chatter_hz": None if self.chatter_hz is None else round(float(self.chatter_hz), 2),
+                "cuts": [{"start_s": round(float(a), 4), "end_s": round(float(b), 4), "verdict": v,
+                          "chatter_hz": None if hz is None else round(float(hz), 2)} for a, b, v, hz in self.cuts],
                 "segments": [s.to_dict() for s in self.segments],
                 "rpm_nominal": float(self.rpm_nominal), "rpm_measured": round(float(self.rpm), 2),
                 "teeth": int(self.teeth),

@@ -204,8 +204,13 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             if fc is None and a.chatter_hz is not None:
                 fc = a.chatter_hz
             if dur is None:
-                dur = _cutting_s(a.segments)
+                dur = _cutting_s(a)
             warns = tuple(f"{rec}: {w}" for w in a.criterion.get("warnings", ()))
+            if len({v for *_, v, _ in a.cuts}) > 1:  # a row is one cut; its record holds cuts that disagree
+                warns += (f"{rec}: the record holds {len(a.cuts)} cuts ("
+                          + "; ".join(f"{t0:.1f}–{t1:.1f} s {v}" for t0, t1, v, _ in a.cuts)
+                          + f"): the row takes the record's verdict, {a.verdict}; give each cut its own row and "
+                          "record",)
         if not res:
             raise InputError(f"line {line}: empty (and no record)", file=p, field="result")
         if res == "stable" and fc is not None:
@@ -217,13 +222,9 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
     return cuts
 
 
-def _cutting_s(segments) -> float | None:
-    """The longest run of non-air segments of a record (entry, cut, exit: chatter grows within one run), s."""
-    best = run = 0.0
-    for g in segments:
-        run = 0.0 if g.kind == "air" else run + (g.end_s - g.start_s)
-        best = max(best, run)
-    return best if best > 0 else None
+def _cutting_s(analysis) -> float | None:
+    """The longest of a record's cuts (entry, cut, exit: chatter grows within one cut), s."""
+    return max((b - a for a, b, *_ in analysis.cuts), default=None) or None
 
 
 def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, source: str | None = None) -> None:
