@@ -575,6 +575,30 @@ def test_running_out_of_memory_is_one_line_and_writes_nothing(tmp_path, capsys, 
     assert not out.exists()
 
 
+def test_audio_in_the_containers_recorders_write_is_read(tmp_path):
+    """What libsndfile reads is read, by suffix or by first bytes: Apple's CAF (a Mac's or an iPhone app's recorder),
+    RF64 and Wave64 (a field recorder's or a DAQ's WAV past 4 GB), AU, Ogg Opus. CAF and Wave64 were refused as
+    "not a UTF-8 text file"."""
+    import shutil
+
+    import soundfile as sf
+
+    x, rate, *_ = shop_record(rpm=6000, teeth=4, seed=2, rate=48000.0)
+    y = (0.5 * x / np.abs(x).max()).astype(np.float32)
+    for name, fmt, sub in (("a.caf", "CAF", "PCM_16"), ("a.rf64", "RF64", "PCM_24"), ("a.w64", "W64", "FLOAT"),
+                           ("a.au", "AU", "PCM_16"), ("a.opus", "OGG", "OPUS")):
+        try:
+            sf.write(tmp_path / name, y, int(rate), format=fmt, subtype=sub)
+        except (sf.LibsndfileError, ValueError, TypeError):  # an older libsndfile without Opus
+            continue
+        shutil.copy(tmp_path / name, tmp_path / f"copy_{fmt}")  # and without its suffix
+        for path in (tmp_path / name, tmp_path / f"copy_{fmt}"):
+            r = read_cut_record(path)
+            assert r.rate_hz == rate and r.samples.size == y.size, name
+            if sub != "OPUS":  # lossless: the samples themselves
+                assert np.allclose(r.samples, y, atol=1e-4), name
+
+
 def test_a_record_is_known_by_its_first_bytes(tmp_path, capsys):
     """A WAV renamed .csv or without a suffix is read as audio; a MATLAB .mat file (or HDF5, TDMS) is refused with one
     line that says how to export the signal, not as 'not a UTF-8 text file'."""

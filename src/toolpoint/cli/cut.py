@@ -30,7 +30,8 @@ def register(sub) -> None:
     p = sub.add_parser("cut", help="chatter detection from a record of a cut (audio, accelerometer, UFF58)",
                        description="Judge a test cut from its record: stable or chatter per segment, chatter "
                        "frequency, measured spindle speed and a Harmonizer-style speed.")
-    p.add_argument("record", metavar="RECORD", help="audio (.wav/.flac/.ogg/.mp3), text/CSV columns or UFF58")
+    p.add_argument("record", metavar="RECORD",
+                   help="audio (.wav/.flac/.ogg/.mp3/.aiff/.caf, RF64, Wave64), text/CSV columns or UFF58")
     p.add_argument("--rpm", required=True, help="nominal spindle speed, rpm (refined from the record)")
     p.add_argument("--teeth", required=True, help="number of teeth")
     p.add_argument("--rate", help="sampling rate, Hz (needed for a one-column table)")

@@ -31,7 +31,8 @@ from ..errors import InputError
 
 __all__ = ["CutRecord", "read_cut_record", "AUDIO_SUFFIXES"]
 
-AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".oga", ".mp3", ".aif", ".aiff", ".au")
+AUDIO_SUFFIXES = (".wav", ".flac", ".ogg", ".oga", ".opus", ".mp3", ".aif", ".aiff", ".aifc", ".au", ".snd", ".caf",
+                  ".w64", ".rf64")
 _UFF_SUFFIXES = (".uff", ".unv", ".uf")
 
 
@@ -109,12 +110,13 @@ def read_cut_record(path: str | os.PathLike, *, rate_hz: float | None = None, ch
     if kind is None and suffix in _AUDIO_NOT_READ_SUFFIXES:
         kind = _AUDIO_NOT_READ_SUFFIXES[suffix]
     if kind in _AUDIO_NOT_READ:
-        raise InputError(f"{_AUDIO_NOT_READ[kind]}: toolpoint reads audio as WAV, FLAC, OGG or MP3; convert it (ffmpeg "
-                         f"-i {p.name} {p.stem}.wav) or set the recorder to WAV", file=p, field="data")
+        raise InputError(f"{_AUDIO_NOT_READ[kind]}: toolpoint reads audio as WAV, FLAC, OGG, MP3, AIFF or CAF; "
+                         f"convert it (ffmpeg -i {p.name} {p.stem}.wav) or set the recorder to WAV", file=p,
+                         field="data")
     if kind in _NOT_READ:
-        raise InputError(f"{_NOT_READ[kind]}: toolpoint reads audio (WAV, FLAC, OGG, MP3), text columns and UFF58; "
-                         "export the signal as one of those (MATLAB: audiowrite, or writematrix([t(:) x(:)], "
-                         "'cut.csv'))", file=p, field="data")
+        raise InputError(f"{_NOT_READ[kind]}: toolpoint reads audio (WAV, FLAC, OGG, MP3, AIFF, CAF), text columns "
+                         "and UFF58; export the signal as one of those (MATLAB: audiowrite, or "
+                         "writematrix([t(:) x(:)], 'cut.csv'))", file=p, field="data")
     if suffix in AUDIO_SUFFIXES or kind == "audio":  # a recorder's file renamed or without its suffix
         rec = _read_audio(p, channel)
     elif suffix in _UFF_SUFFIXES:
@@ -148,7 +150,8 @@ _AUDIO_NOT_READ_SUFFIXES = {".m4a": "mp4", ".m4b": "mp4", ".mp4": "mp4", ".mov":
 
 
 def _sniff(p: Path) -> str | None:
-    """What the file's first bytes say it is: ``audio`` (RIFF/WAVE, FLAC, Ogg, MP3, AIFF), or a
+    """What the file's first bytes say it is: ``audio`` (RIFF/WAVE and its large forms RF64 and Wave64, FLAC, Ogg,
+    MP3, AIFF, Apple's CAF, AU), or a
     container toolpoint does not read (``mat``, ``hdf5``, ``tdms``; audio ``mp4``, ``aac``, ``amr``, ``asf``,
     ``mkv``); None: anything else (text, UFF)."""
     try:
@@ -156,7 +159,9 @@ def _sniff(p: Path) -> str | None:
             head = fh.read(128)
     except OSError:
         return None  # the reader that opens it names the reason
-    if head[:4] == b"RIFF" and head[8:12] == b"WAVE" or head[:4] in (b"fLaC", b"OggS", b"ID3\x03", b"ID3\x04") \
+    if head[:4] in (b"RIFF", b"RF64", b"BW64") and head[8:12] == b"WAVE" \
+            or head[:4] in (b"fLaC", b"OggS", b"ID3\x03", b"ID3\x04", b"caff", b".snd") \
+            or head[:16] == bytes.fromhex("72696666 2e91cf11 a5d628db 04c10000") \
             or head[:4] == b"FORM" and head[8:12] in (b"AIFF", b"AIFC") \
             or len(head) > 1 and head[0] == 0xFF and head[1] & 0xE6 == 0xE2:  # an MPEG layer III frame (no ID3
         # tag); not FF FE, the byte-order mark of a UTF-16 text file (a spreadsheet's "Unicode text" export)
