@@ -144,6 +144,38 @@ def test_text_record_errors(tmp_path):
         read_record(p)
 
 
+def test_the_header_s_units_are_read(synth, tmp_path):
+    """A DAQ exports the response in g and names it ("Accel (g)", or a units row under the names): read as m/s² it
+    was an FRF 9.8 × too small — a tool 9.8 × too stiff, lobes far too high. The header's units are now read (time
+    ms/µs, force kN/lbf, acceleration g, mm/s² …) and the record is the same as in SI; a voltage, a response of
+    another kind than --response, a force in g are refused naming the column."""
+    t, f, a = synth
+    ref = read_record(_write(tmp_path / "si.csv", "time_s,force_n,acceleration_ms2", t, f, a))
+    cases = (("g.csv", "Time (s),Force (N),Accel (g)", t, f, a / 9.80665),
+             ("units.csv", "Time;Force;Accel\nms;kN;g", 1e3 * t, 1e-3 * f, a / 9.80665),
+             ("lbf.csv", "t [us],F [lbf],a [mm/s^2]", 1e6 * t, f / 4.4482216, 1e3 * a))
+    for name, head, *cols in cases:
+        r = read_record(_write(tmp_path / name, head, *cols))
+        assert np.allclose(r.time_s, ref.time_s, rtol=1e-9, atol=1e-12), name
+        assert np.allclose(r.force_n, ref.force_n, rtol=1e-6) and np.allclose(r.response, ref.response, rtol=1e-6)
+    bad = (("t (s),F (N),v (mm/s)", "response",
+            r"column 'v \(mm/s\)' holds a velocity and the record is read as acceleration: give --response velocity"),
+           ("t (s),F (V),a (g)", "force_n", r"column 'F \(V\)' is a voltage: divide it by the sensor's"),
+           ("t (s),F (g),a (g)", "force_n", r"column 'F \(g\)' holds an acceleration, where a force"))
+    for head, field, msg in bad:
+        with pytest.raises(InputError, match=f"{field}: {msg}"):
+            read_record(_write(tmp_path / "bad.csv", head, t, f, a))
+    assert np.allclose(read_record(_write(tmp_path / "v.csv", "t (s),F (N),v (mm/s)", t, f, a),
+                                   response="velocity").response, 1e-3 * a)
+
+
+def _write(path, head, t, f, a):
+    sep = ";" if ";" in head else ","
+    rows = "".join(f"{x:.12g}{sep}{y:.10g}{sep}{z:.10g}\n" for x, y, z in zip(t, f, a))
+    path.write_text(head + "\n" + (rows.replace(".", ",") if sep == ";" else rows))
+    return path
+
+
 def uff_record(path, t, f, a, rsp_type=12, force_inc=None):
     sets = []
     for data, odt in ((f, 13), (a, rsp_type)):

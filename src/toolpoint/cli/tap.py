@@ -36,7 +36,8 @@ def register(sub) -> None:
     p = sub.add_parser("tap", help="impact-test records (time, force, response) → FRF with coherence",
                        description="FRF of an impact (hammer) test: hits found at a force threshold, force and "
                        "optional exponential windows, H1/H2 averaged over hits, coherence, double-hit and "
-                       "overload checks. Units: s, N, m/s² (or m/s, m); output m/N.")
+                       "overload checks. Units: s, N, m/s² (or m/s, m), or as a text header names them "
+                       "(Accel (g), Time (ms), a units row); output m/N.")
     p.add_argument("records", nargs="+", metavar="RECORD", help="text (time s, force N, response) or UFF file")
     p.add_argument("--out", required=True, help="output FRF: .csv, .uff/.unv/.uf or .frf")
     p.add_argument("--response", choices=("acceleration", "velocity", "displacement"), default="acceleration",

@@ -54,6 +54,7 @@ failure never leaves a half-written file.
 from __future__ import annotations
 
 import os
+import re
 import warnings
 from pathlib import Path
 
@@ -803,6 +804,68 @@ def _write_table(path, frf, header: str | None, sep: str, as_measured: bool = Fa
 _READERS = {".csv": read_csv_frf, ".uff": read_uff58, ".unv": read_uff58, ".uf": read_uff58, ".frf": read_cutpro,
             ".txt": read_cutpro, ".tsv": read_cutpro, ".dat": read_cutpro}
 _WRITERS = {".csv": write_csv_frf, ".uff": write_uff58, ".unv": write_uff58, ".uf": write_uff58, ".frf": write_cutpro}
+
+
+def header_cells(text: list[str], first: int) -> list[list[str]]:
+    """The header lines just above the first data line (line ``first``, 1-based), nearest first, split as
+    ``numeric_lines`` splits the data; comments and blank lines skipped."""
+    out = []
+    for line in reversed(text[:first - 1]):
+        s = line.strip()
+        if not s or s[0] in "#%":
+            continue
+        sep = ";" if ";" in s else "\t" if "\t" in s else "," if "," in s else None
+        out.append([c.strip().strip('"') for c in (s.split(sep) if sep else s.split())])
+    return out
+
+
+def _is_unit_row(cells: list[str]) -> bool:
+    """A DAQ's units row under the names (``s;g;g``, ``[s] [m/s^2]``): short cells without a space."""
+    return all(0 < len(c) <= 8 and " " not in c for c in cells)
+
+
+def column_names(text: list[str], first: int, width: int) -> list[str] | None:
+    """The columns' names from the header above the data: the names line, with a units row under it (a DAQ's
+    export: ``Time;AI 1`` over ``s;g``) as "AI 1 (g)"; None where the header holds another number of cells."""
+    head = [c for c in header_cells(text, first)[:2] if len(c) == width]
+    if not head:
+        return None
+    if len(head) == 2 and _is_unit_row(head[0]):
+        return [f"{n} ({u.strip('[]()')})" if u else n for n, u in zip(head[1], head[0])]
+    return head[0]
+
+
+_G0 = 9.80665  # standard gravity, m/s² per g
+# the units a column's header may carry (lower case, spaces removed): (quantity, factor to SI); a voltage is no
+# physical quantity until divided by the sensor's sensitivity (factor None)
+UNITS = {**{u: ("time", f) for u, f in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("µs", 1e-6), ("μs", 1e-6))},
+         **{u: ("force", f) for u, f in (("n", 1.0), ("kn", 1e3), ("lbf", 4.4482216), ("lb", 4.4482216))},
+         **{u: ("acceleration", 1.0) for u in ("m/s^2", "m/s²", "m/s2", "ms2", "ms^-2", "m/s/s", "ms-2")},
+         **{u: ("acceleration", f) for u, f in (("g", _G0), ("mm/s^2", 1e-3), ("mm/s²", 1e-3), ("mm/s2", 1e-3),
+                                                 ("in/s^2", 0.0254), ("in/s²", 0.0254), ("in/s2", 0.0254))},
+         **{u: ("velocity", f) for u, f in (("m/s", 1.0), ("mm/s", 1e-3), ("in/s", 0.0254), ("ips", 0.0254))},
+         **{u: ("displacement", f) for u, f in (("m", 1.0), ("mm", 1e-3), ("um", 1e-6), ("µm", 1e-6), ("μm", 1e-6),
+                                                 ("in", 0.0254), ("mil", 2.54e-5))},
+         "v": ("voltage", None), "mv": ("voltage", None)}
+_UNIT_IN_BRACKETS = re.compile(r"[\[(]\s*([^\[\]()]+?)\s*[\])]\s*$")
+_UNIT_AFTER_UNDERSCORE = re.compile(r"_([^_\s]+)$")
+
+
+def column_unit(name: str) -> tuple | None:
+    """(unit, quantity, factor to SI or None) that a column's header names: in brackets at its end (``Accel (g)``,
+    ``t [ms]``), after its last underscore (``time_s``, ``acceleration_ms2``) or as the whole cell (a units row's
+    ``g``); None where it names no unit of :data:`UNITS`.
+
+    Examples
+    --------
+    >>> column_unit("Accel (g)"), column_unit("time_ms"), column_unit("Accel_X"), column_unit("mV")
+    (('g', 'acceleration', 9.80665), ('ms', 'time', 0.001), None, ('mv', 'voltage', None))
+    """
+    for m in (_UNIT_IN_BRACKETS.search(name), _UNIT_AFTER_UNDERSCORE.search(name)):
+        if m and (u := m.group(1).replace(" ", "").lower()) in UNITS:
+            return (u, *UNITS[u])
+    u = name.strip().strip("[]()").replace(" ", "").lower()
+    return (u, *UNITS[u]) if u in UNITS else None
 
 
 def drop_empty_columns(rows: list) -> tuple[list, list]:

@@ -335,7 +335,10 @@ def read_record(path, *, response: str = "acceleration") -> Record:
 
     Text (any extension but ``.uff``/``.unv``/``.uf``): three columns separated
     by commas, tabs or spaces; an optional header line; lines starting with
-    ``#`` or ``%`` are comments. UFF: the file's datasets 58 of function type 1
+    ``#`` or ``%`` are comments. Where the header names units (``Accel (g)``,
+    ``Time (ms)``, ``force_kn``, a DAQ's units row under the names) they are
+    converted to s, N and SI; a voltage, or a response of another kind than
+    ``response``, is refused. UFF: the file's datasets 58 of function type 1
     (time response); the force is the one with ordinate data type 13 (force),
     the response the one with 8/11/12 (displacement/velocity/acceleration, which
     overrides ``response``; an ordinate unit ``g`` is converted to m/s²).
@@ -359,11 +362,14 @@ def read_record(path, *, response: str = "acceleration") -> Record:
     """
     if Path(path).suffix.lower() in (".uff", ".unv", ".uf"):
         return _read_uff_record(path)
-    from .frf_files import _check_not_cut, _is_number, _read_text, drop_empty_columns, numeric_lines
+    from .frf_files import _check_not_cut, _is_number, _read_text, column_names, drop_empty_columns, numeric_lines
 
     rows = []
     text, open_end = _read_text(path)
-    for n, cells in drop_empty_columns(list(numeric_lines(text)))[0]:
+    numbered = list(numeric_lines(text))
+    kept, keep = drop_empty_columns(numbered)
+    names = column_names(text, numbered[0][0], len(numbered[0][1])) if numbered else None
+    for n, cells in kept:
         if len(cells) != 3:
             raise InputError(f"line {n}: expected 3 columns (time s, force N, response), found {len(cells)}",
                              file=path, field="columns")
@@ -381,6 +387,8 @@ def read_record(path, *, response: str = "acceleration") -> Record:
                     raise InputError(f"line {n}: {c!r} is not a number", file=path, field=name) from None
         raise
     _check_not_cut(path, rows, ("time_s", "force_n", "response"), open_end)
+    if names:  # the header's units, where it names them: a response in g read as m/s² was an FRF 9.8 × too small
+        a, response = _to_si(a, [names[j] for j in keep], response, path)
     bad = np.argwhere(~np.isfinite(a))
     if bad.size:
         i, j = bad[0]
@@ -392,6 +400,36 @@ def read_record(path, *, response: str = "acceleration") -> Record:
         raise InputError(f"line {rows[k][0]}: time must increase ({a[k, 0]:.10g} s follows {a[k - 1, 0]:.10g} s)",
                          file=path, field="time_s")
     return Record(a[:, 0], a[:, 1], a[:, 2], response, os.fspath(path))
+
+
+def _to_si(a: np.ndarray, names: list, response: str, path) -> tuple:
+    """(the columns time, force, response in s, N and SI, the response's kind) from the units their header names
+    (``Time (ms)``, ``Force (kN)``, ``Accel (g)``, ``force_n``, a DAQ's units row; :func:`~toolpoint.io.frf_files.
+    column_unit`); a column without a unit keeps it (s, N, SI). Refused: a unit of another quantity than the column's
+    (a force in g), a voltage (not yet divided by the sensor's sensitivity), a response of another kind than
+    ``response`` (a velocity in mm/s read as acceleration)."""
+    from .frf_files import column_unit
+
+    a = a.copy()
+    for j, (name, want) in enumerate((("time_s", ("time",)), ("force_n", ("force",)),
+                                       ("response", ("acceleration", "velocity", "displacement")))):
+        u = column_unit(names[j])
+        if u is None:
+            continue
+        _, qty, factor = u
+        if qty == "voltage":
+            raise InputError(f"column '{names[j]}' is a voltage: divide it by the sensor's sensitivity (V per "
+                             f"{'N' if name == 'force_n' else 'm/s²'}) first", file=path, field=name)
+        if qty not in want:
+            raise InputError(f"column '{names[j]}' holds {'an' if qty[0] in 'aeiou' else 'a'} {qty}, where "
+                             f"{'a ' if name != 'response' else 'an '}{' or '.join(want)} is expected "
+                             "(columns: time, force, response)", file=path, field=name)
+        if name == "response" and qty != response:
+            raise InputError(f"column '{names[j]}' holds {'an' if qty[0] in 'aeiou' else 'a'} {qty} and the "
+                             f"record is read as {response}: "
+                             f"give --response {qty}", file=path, field="response")
+        a[:, j] *= factor
+    return a, response
 
 
 _UFF_RESPONSE = {8: "displacement", 11: "velocity", 12: "acceleration"}

@@ -21,7 +21,6 @@ table must have one signal column.
 from __future__ import annotations
 
 import os
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -261,7 +260,7 @@ def _read_uff(p: Path, channel: int | None) -> CutRecord:
 
 
 def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecord:
-    from .frf_files import _is_number, _read_text, drop_empty_columns, numeric_lines
+    from .frf_files import _is_number, _read_text, column_names, drop_empty_columns, numeric_lines
 
     text, _ = _read_text(p)
     rows, lines = [], []
@@ -276,7 +275,7 @@ def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecor
         raise InputError("no data rows (no line of numbers; cells split at ';', ',' or white space)", file=p,
                          field="data")
     # a column empty in every row is no channel (a LabVIEW export's Comment column): dropped, and its name with it
-    names = _column_names(text, numbered[0][0], width)
+    names = column_names(text, numbered[0][0], width)
     kept, keep = drop_empty_columns(numbered)
     for n, cells in kept:
         for j, c in enumerate(cells):
@@ -293,61 +292,22 @@ def _read_table(p: Path, channel: int | None, rate_hz: float | None) -> CutRecor
         return CutRecord(x, float(rate_hz), os.fspath(p), ch)
     unit, scale = _time_unit(text, lines[0])
     t = a[:, 0] * scale
-    _check_time(t, lines, p, unit)
+    _check_time(t, lines, p, unit, scale)
     x, ch = _pick(a[:, 1:], channel, p, "the table", names=names[1:] if names else None)
     return CutRecord(x, float((t.size - 1) / (t[-1] - t[0])), os.fspath(p), ch)
-
-
-def _header_cells(text: list[str], first: int) -> list[list[str]]:
-    """The header lines just above the first data line (line ``first``, 1-based), nearest first, split as
-    :func:`numeric_lines` splits the data; comments and blank lines skipped."""
-    out = []
-    for line in reversed(text[:first - 1]):
-        s = line.strip()
-        if not s or s[0] in "#%":
-            continue
-        sep = ";" if ";" in s else "\t" if "\t" in s else "," if "," in s else None
-        out.append([c.strip().strip('"') for c in (s.split(sep) if sep else s.split())])
-    return out
-
-
-def _is_unit_row(cells: list[str]) -> bool:
-    """A DAQ's units row under the names (``s;g;g``, ``[s] [m/s^2]``): short cells without a space."""
-    return all(0 < len(c) <= 8 and " " not in c for c in cells)
-
-
-def _column_names(text: list[str], first: int, width: int) -> list[str] | None:
-    """The columns' names from the header above the data: the names line, with a units row under it (a DAQ's
-    export: ``Time;AI 1`` over ``s;g``) as "AI 1 (g)"; None where the header holds another number of cells."""
-    head = [c for c in _header_cells(text, first)[:2] if len(c) == width]
-    if not head:
-        return None
-    if len(head) == 2 and _is_unit_row(head[0]):
-        return [f"{n} ({u.strip('[]()')})" if u else n for n, u in zip(head[1], head[0])]
-    return head[0]
-
-
-_TIME_UNITS = {"ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "s": 1.0}
-_UNIT_IN_NAME = re.compile(r"(?:[\[(]\s*|_)(ms|us|µs|μs|s)\s*[\])]?\s*$", re.IGNORECASE)
 
 
 def _time_unit(text: list[str], first: int) -> tuple[str, float]:
     """The time column's unit from the header line above the data (``Time (ms)``, ``t [us]``, ``time_ms``, or a
     DAQ's units row ``ms;g``; default s) and its factor to s; ``first`` is the first data line's number (1-based)."""
-    head = _header_cells(text, first)[:1]
-    if head and head[0]:
-        name = head[0][0]
-        whole = name.strip("[]() ").lower()
-        if whole in _TIME_UNITS:
-            return whole, _TIME_UNITS[whole]
-        m = _UNIT_IN_NAME.search(name)
-        if m:
-            u = m.group(1).lower()
-            return u, _TIME_UNITS.get(u, 1.0)
-    return "s", 1.0
+    from .frf_files import column_unit, header_cells
+
+    head = header_cells(text, first)[:1]
+    u = column_unit(head[0][0]) if head and head[0] else None
+    return (u[0], u[2]) if u is not None and u[1] == "time" else ("s", 1.0)
 
 
-def _check_time(t: np.ndarray, lines: list[int], p: Path, unit: str) -> None:
+def _check_time(t: np.ndarray, lines: list[int], p: Path, unit: str, scale: float) -> None:
     """The time column must increase in equal steps, to the digits it was printed with: a DAQ's export at 25.6 kHz
     with the time to 1 µs has steps of 39 and 40 µs. Refused: a step ≤ 0 (too few digits, or not a time), and a step
     more than half a step off the median step (samples missing or doubled)."""
@@ -359,7 +319,7 @@ def _check_time(t: np.ndarray, lines: list[int], p: Path, unit: str) -> None:
     bad = np.flatnonzero(~(d > 0))
     if bad.size:
         k = int(bad[0]) + 1
-        raise InputError(f"line {lines[k]}: the time ({t[k] / _TIME_UNITS[unit]:.9g} {unit}) does not increase: "
+        raise InputError(f"line {lines[k]}: the time ({t[k] / scale:.9g} {unit}) does not increase: "
                          "printed with too few digits for the sampling rate, or not a time column" + hint, file=p,
                          field="time_s")
     dt = float(np.median(d))
