@@ -410,6 +410,9 @@ def _to_si(a: np.ndarray, names: list, response: str, path) -> tuple:
     ``response`` (a velocity in mm/s read as acceleration)."""
     from .frf_files import column_unit
 
+    def an(word):
+        return f"{'an' if word[0] in 'aeiou' else 'a'} {word}"
+
     a = a.copy()
     for j, (name, want) in enumerate((("time_s", ("time",)), ("force_n", ("force",)),
                                        ("response", ("acceleration", "velocity", "displacement")))):
@@ -421,13 +424,11 @@ def _to_si(a: np.ndarray, names: list, response: str, path) -> tuple:
             raise InputError(f"column '{names[j]}' is a voltage: divide it by the sensor's sensitivity (V per "
                              f"{'N' if name == 'force_n' else 'm/s²'}) first", file=path, field=name)
         if qty not in want:
-            raise InputError(f"column '{names[j]}' holds {'an' if qty[0] in 'aeiou' else 'a'} {qty}, where "
-                             f"{'a ' if name != 'response' else 'an '}{' or '.join(want)} is expected "
+            raise InputError(f"column '{names[j]}' holds {an(qty)}, where {an(' or '.join(want))} is expected "
                              "(columns: time, force, response)", file=path, field=name)
         if name == "response" and qty != response:
-            raise InputError(f"column '{names[j]}' holds {'an' if qty[0] in 'aeiou' else 'a'} {qty} and the "
-                             f"record is read as {response}: "
-                             f"give --response {qty}", file=path, field="response")
+            raise InputError(f"column '{names[j]}' holds {an(qty)} and the record is read as {response}: give "
+                             f"--response {qty}", file=path, field="response")
         a[:, j] *= factor
     return a, response
 
