@@ -186,16 +186,24 @@ class _Score:
         self.n = self.skipped = self.sim_agree = 0
         self.ferr, self.cpu_cut, self.audio_s = [], 0.0, 0.0
 
-    def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
-        """Simulate the points (rpm, depth) (their SDM limit ``lim`` and ρ), hear and judge them."""
+    def heard(self, mm, c, rpm, depth, lim, seed, seed_level, rng):
+        """(the simulation of the points (rpm, depth), {point: (samples, rate)}): each point not within ±5 % of its
+        SDM limit ``lim`` heard by ``self.record`` (the others counted in ``skipped``), in the points' order."""
         from toolpoint.simulation import simulate_milling
 
         res = simulate_milling(mm, mm, c, rpm=rpm, depth_m=depth, revolutions=250, seed=seed, seed_level=seed_level)
+        recs = {}
         for p in range(rpm.size):
             if abs(depth[p] / lim[p] - 1) < 0.05:
                 self.skipped += 1
                 continue
-            x, rate = self.record(res, float(rpm[p]), c.teeth, rng, point=p)
+            recs[p] = self.record(res, float(rpm[p]), c.teeth, rng, point=p)
+        return res, recs
+
+    def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
+        """Simulate the points (rpm, depth) (their SDM limit ``lim`` and ρ), hear and judge them."""
+        res, recs = self.heard(mm, c, rpm, depth, lim, seed, seed_level, rng)
+        for p, (x, rate) in recs.items():
             chatter = bool(rho[p] > 1)
             self.n += 1
             self.sim_agree += chatter == (not res.stable[p])
@@ -245,15 +253,10 @@ class _TeethScore(_Score):
 
     def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
         from toolpoint.errors import InputError
-        from toolpoint.simulation import simulate_milling
 
-        res = simulate_milling(mm, mm, c, rpm=rpm, depth_m=depth, revolutions=250, seed=seed, seed_level=seed_level)
+        _, recs = self.heard(mm, c, rpm, depth, lim, seed, seed_level, rng)
         n_t = c.teeth
-        for p in range(rpm.size):
-            if abs(depth[p] / lim[p] - 1) < 0.05:
-                self.skipped += 1
-                continue
-            x, rate = self.record(res, float(rpm[p]), n_t, rng, point=p)
+        for p, (x, rate) in recs.items():
             self.n += 1
             ref = analyse_cut(x, rate, rpm=float(rpm[p]), teeth=n_t, full_scale=self.full_scale)
             slips = {"right": n_t, "N-1": n_t - 1, "N+1": n_t + 1, "2N": 2 * n_t,
@@ -303,17 +306,10 @@ class _TwoCutScore(_Score):
 
     def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
         from toolpoint.errors import InputError
-        from toolpoint.simulation import simulate_milling
 
-        res = simulate_milling(mm, mm, c, rpm=rpm, depth_m=depth, revolutions=250, seed=seed, seed_level=seed_level)
-        speeds = np.unique(rpm)
-        recs = {}
-        for p in range(rpm.size):
-            if abs(depth[p] / lim[p] - 1) < 0.05:
-                self.skipped += 1
-                continue
-            recs[p] = self.record(res, float(rpm[p]), c.teeth, rng, point=p) + (bool(rho[p] > 1),)
-        n_s = speeds.size
+        _, heard = self.heard(mm, c, rpm, depth, lim, seed, seed_level, rng)
+        recs = {p: xr + (bool(rho[p] > 1),) for p, xr in heard.items()}
+        n_s = np.unique(rpm).size
         pairs = []
         for p in recs:  # the grid is depths × speeds, raveled: p = i_depth * n_s + i_speed
             for q, kind in ((p + n_s, "same"), (p + 1, "two")):

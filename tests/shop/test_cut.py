@@ -589,8 +589,10 @@ def test_audio_in_the_containers_recorders_write_is_read(tmp_path):
                            ("a.au", "AU", "PCM_16"), ("a.opus", "OGG", "OPUS")):
         try:
             sf.write(tmp_path / name, y, int(rate), format=fmt, subtype=sub)
-        except (sf.LibsndfileError, ValueError, TypeError):  # an older libsndfile without Opus
-            continue
+        except (sf.LibsndfileError, ValueError, TypeError):
+            if sub == "OPUS":  # an older libsndfile without Opus; every other container must be written and read
+                continue
+            raise
         shutil.copy(tmp_path / name, tmp_path / f"copy_{fmt}")  # and without its suffix
         for path in (tmp_path / name, tmp_path / f"copy_{fmt}"):
             r = read_cut_record(path)

@@ -835,13 +835,12 @@ def column_names(text: list[str], first: int, width: int) -> list[str] | None:
     return head[0]
 
 
-_G0 = 9.80665  # standard gravity, m/s² per g
 # the units a column's header may carry (lower case, spaces removed): (quantity, factor to SI); a voltage is no
 # physical quantity until divided by the sensor's sensitivity (factor None)
 UNITS = {**{u: ("time", f) for u, f in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("µs", 1e-6), ("μs", 1e-6))},
          **{u: ("force", f) for u, f in (("n", 1.0), ("kn", 1e3), ("lbf", 4.4482216), ("lb", 4.4482216))},
          **{u: ("acceleration", 1.0) for u in ("m/s^2", "m/s²", "m/s2", "ms2", "ms^-2", "m/s/s", "ms-2")},
-         **{u: ("acceleration", f) for u, f in (("g", _G0), ("mm/s^2", 1e-3), ("mm/s²", 1e-3), ("mm/s2", 1e-3),
+         **{u: ("acceleration", f) for u, f in (("g", G0), ("mm/s^2", 1e-3), ("mm/s²", 1e-3), ("mm/s2", 1e-3),
                                                  ("in/s^2", 0.0254), ("in/s²", 0.0254), ("in/s2", 0.0254))},
          **{u: ("velocity", f) for u, f in (("m/s", 1.0), ("mm/s", 1e-3), ("in/s", 0.0254), ("ips", 0.0254))},
          **{u: ("displacement", f) for u, f in (("m", 1.0), ("mm", 1e-3), ("um", 1e-6), ("µm", 1e-6), ("μm", 1e-6),

@@ -712,11 +712,10 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             raise InputError(f"starts at {a:g} s, after the record's end ({dur:.4g} s)", file=source, field="span_s")
         k0 = int(round(a * rate_hz))
         res = analyse_cut(x[k0:int(round(min(b, dur) * rate_hz))], rate_hz, **kw)
-        segs = tuple(replace(g, start_s=g.start_s + a, end_s=g.end_s + a) for g in res.segments)
         crit = dict(res.criterion, span_s=[a, min(b, dur)])
         if "digital_silence_s" in crit:
             crit["digital_silence_s"] = [[u + a, v + a] for u, v in crit["digital_silence_s"]]
-        return replace(res, segments=segs, criterion=crit, time_s=res.time_s + a)
+        return _shifted(res, a, crit)
     check_record(x, rate_hz, rpm, teeth, full_scale=full_scale, source=source)
     if not (isinstance(alpha, (int, float, np.floating)) and 0 < alpha < 1):
         raise InputError(f"must be a probability in (0, 1), got {alpha!r}", file=source, field="alpha")
@@ -728,16 +727,15 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         # it — as the low level of the record it made the air cut look like cutting — and the times kept the record's
         res = analyse_cut(x[k0:k1], rate_hz, **kw)
         t0 = k0 / float(rate_hz)
-        segs = tuple(replace(g, start_s=g.start_s + t0, end_s=g.end_s + t0) for g in res.segments)
-        crit = dict(res.criterion, digital_silence_s=[[0.0, round(t0, 4)], [round(k1 / rate_hz, 4),
-                                                                                round(x.size / rate_hz, 4)]])
-        return replace(res, segments=segs, criterion=crit, time_s=res.time_s + t0)
+        return _shifted(res, t0, dict(res.criterion, digital_silence_s=[[0.0, round(t0, 4)], [
+            round(k1 / rate_hz, 4), round(x.size / rate_hz, 4)]]))
     rate = float(rate_hz)
     # a DAQ's 51.2–192 kHz holds nothing the test looks at above its band (≤ 10 kHz): decimated by q to ≥ 22.2 kHz
     # first (an FIR anti-alias filter), else the spectra grow with the rate — 2 min at 192 kHz peaked at 2.7 GB
     top = band_hz[1] if band_hz is not None else 10_000.0
     q = int(rate // _DECIMATE_TO_HZ) if rate > _DECIMATE_ABOVE_HZ else 1
-    q = max(1, min(q, int(0.45 * rate / top)))
+    # a band given that ends at ≤ 0 Hz or NaN is refused below (its lines), not divided by here
+    q = max(1, min(q, int(0.45 * rate / top))) if math.isfinite(top) and top > 0 else 1
     if q > 1:
         from scipy.signal import resample_poly
 
@@ -918,7 +916,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 track, wander, f_s = tracked(cutting)
 
     if spindle_found:  # with --rpm-tolerance 0 too: a speed given exactly is still one speed
-        _one_speed(runs, f_s, f_nom, rpm, max(rpm_tolerance, 0.03), teeth, frames_in, spectrum, freq, hi, df,
+        _one_speed(runs, f_s, f_nom, rpm, max(rpm_tolerance, 0.03), teeth, frames_in, spectrum, freq, inband, df,
                    source)
     unheard = None
     if not spindle_found:
@@ -1257,7 +1255,13 @@ def _harmonic_mask(freq, inband, f_lo, f_hi, df):
     return inband & ~near, inband & near
 
 
-def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, hi, df, source) -> None:
+def _shifted(res: CutAnalysis, t0: float, criterion: dict) -> CutAnalysis:
+    """``res`` of a part of a record that starts at ``t0`` s, its times the record's again (segments, frames)."""
+    segs = tuple(replace(g, start_s=g.start_s + t0, end_s=g.end_s + t0) for g in res.segments)
+    return replace(res, segments=segs, criterion=criterion, time_s=res.time_s + t0)
+
+
+def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, inband, df, source) -> None:
     """Refuse a record whose cutting runs ran at different spindle speeds.
 
     A run (a cut between air cuts) is at another speed where (1) its four lowest tooth-passing harmonics stand
@@ -1302,8 +1306,8 @@ def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, hi,
         # the speed whose own lines stand out most among it, its half and its third (a 2-tooth cutter's tooth
         # passing is a comb at twice its speed: the real recording's fast copy read as 12900 rpm, its own lines
         # 5.2 dB over 8075 rpm's, against 7.3 dB at 6450 rpm)
-        best = max(((_own_lines_db(freq, logp, floor, e[0] / m, f_s, hi, df),
-                     _own_lines_db(freq, logp, floor, f_s, e[0] / m, hi, df), e[0] / m) for m in (1, 2, 3)
+        best = max(((_own_lines_db(freq, logp, floor, inband, e[0] / m, f_s, df),
+                     _own_lines_db(freq, logp, floor, inband, f_s, e[0] / m, df), e[0] / m) for m in (1, 2, 3)
                     if e[0] / m >= span[0] * f_nom), key=lambda u: u[0] - u[1])
         u_e, u_s, f_run = best
         if u_e - u_s < _RUN_UNIQUE_DB or u_s > _RUN_OWN_DB or len(group) == len(cut_runs):
@@ -1312,8 +1316,8 @@ def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, hi,
         # bearing's tones on a housing accelerometer make a comb at no speed of the spindle's)
         rest = [r for r in range(len(cut_runs)) if r not in group]
         _, logp_r, floor_r = spectrum(np.unique(np.concatenate([frames_in(*cut_runs[r]) for r in rest])))
-        if (_own_lines_db(freq, logp_r, floor_r, f_run, f_s, hi, df) > _RUN_OWN_DB
-                or _own_lines_db(freq, logp_r, floor_r, f_s, f_run, hi, df) <= _RUN_OWN_DB):
+        if (_own_lines_db(freq, logp_r, floor_r, inband, f_run, f_s, df) > _RUN_OWN_DB
+                or _own_lines_db(freq, logp_r, floor_r, inband, f_s, f_run, df) <= _RUN_OWN_DB):
             continue  # … while they hear the speed read: else it is the whole record's speed that is off
         ref = cut_runs[rest[0]]
         ta, tb = cut_runs[min(group)][0], cut_runs[max(group)][1]
@@ -1325,17 +1329,16 @@ def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, hi,
                          "judged alone, that cut's verdict stands)", file=source, field="rpm")
 
 
-def _own_lines_db(freq, logp, floor, f_a, f_b, fmax, df) -> float:
-    """Mean excess over the floor, dB, of the harmonics k f_a (k ≤ 40, ≤ ``fmax`` Hz) that are no harmonics of f_b
-    (farther than 2 Δf + ``_MASK_REL`` f from every k' f_b): each the peak of its main lobe, ±1.5 bins."""
-    k = np.arange(1, int(min(40, fmax / f_a)) + 1)
+def _own_lines_db(freq, logp, floor, inband, f_a, f_b, df) -> float:
+    """Mean excess over the floor, dB, of the harmonics k f_a (k ≤ 40, in the band) that are no harmonics of f_b
+    (farther than 2 Δf + ``_MASK_REL`` f from every k' f_b): each the peak of its main lobe
+    (:func:`_harmonic_lobes`)."""
+    k = np.arange(1, 41)
     fk = k * f_a
-    own = np.abs(fk - np.round(fk / f_b) * f_b) > 2 * df + _MASK_REL * fk
-    if not own.any():
-        return -np.inf
-    i = np.rint(fk[own] / df).astype(int)[:, None] + np.arange(-1, 2)[None, :]
-    i = np.clip(i, 0, freq.size - 1)
-    return float(((logp - floor)[i]).max(axis=1).mean() * 10 / math.log(10))
+    own = k[np.abs(fk - np.round(fk / f_b) * f_b) > 2 * df + _MASK_REL * fk]
+    ex = logp - floor
+    peaks = [ex[j].max() for _, j in _harmonic_lobes(freq, inband, f_a, own, df)]
+    return float(np.mean(peaks) * 10 / math.log(10)) if peaks else -np.inf
 
 
 def _speed_elsewhere(freq, logp, floor, f_nom, teeth, tol, df, span=None, f_s=None, gain_db=_ELSEWHERE_GAIN_DB):
@@ -1431,7 +1434,8 @@ def _spacing(freq, logp, floor, inband, f_s, teeth, df):
 
 def _harmonic_lobes(freq, inband, f0, orders, df) -> list:
     """[(k, bins)]: the in-band bins of the main lobe (±1.5 bins) of each harmonic k f0 (k in ``orders``) that has any
-    — where the comb, the speed's reading, the tests whether the spindle is heard and the tooth-count check look."""
+    — where the comb, the speed's reading, the tests whether the spindle is heard, the tooth-count check and the
+    two-speed check look."""
     out = []
     for k in orders:
         j = np.flatnonzero(inband & (np.abs(freq - k * f0) <= 1.5 * df))
