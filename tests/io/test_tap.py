@@ -140,7 +140,7 @@ def test_text_record_errors(tmp_path):
     r = read_record(p)
     assert np.allclose(r.force_n, np.arange(10)) and np.allclose(r.response, 2 * np.arange(10))
     p.write_text("0,0,0,\n1e-4,1,2,x\n")
-    with pytest.raises(InputError, match=r"r\.txt: columns: line 1: expected 3"):
+    with pytest.raises(InputError, match=r"r\.txt: columns: line 1: column 4 is empty"):
         read_record(p)
 
 
@@ -200,6 +200,50 @@ def test_uff_time_records(tmp_path):
     with pytest.raises(InputError, match=r"bad\.uff: abscissa_inc: force and response sampling differ"):
         read_record(q)
 
+
+
+def test_a_record_of_several_responses_reads_the_channel_chosen(tmp_path, capsys):
+    """A lab's tap record often holds the hammer and a triaxial accelerometer (or two directions): time, force and
+    three responses. It was refused ("expected 3 columns, found 5"); ``channel`` (CLI ``--channel``) now picks one,
+    read exactly as a three-column file of it is, and several without a choice are refused naming them."""
+    t, f, a = S.record(fs=5000.0, hits=((0.05, 100.0),), double=None, duration=0.4)
+    ref = read_record(_write(tmp_path / "y.csv", "Time (s),Force (N),Ay (g)", t, f, a))
+    tri = tmp_path / "tri.csv"
+    tri.write_text("Time (s),Force (N),Ax (g),Ay (g),Az (g)\n" + "".join(
+        f"{x:.12g},{y:.10g},{0.3 * z:.10g},{z:.10g},{-0.1 * z:.10g}\n" for x, y, z in zip(t, f, a)))
+    got = read_record(tri, channel=1)
+    assert np.array_equal(got.response, ref.response) and np.array_equal(got.force_n, ref.force_n)
+    with pytest.raises(InputError) as exc:
+        read_record(tri)
+    assert exc.value.field == "channel" and "3 response columns: choose one with --channel (0: Ax (g), 1: Ay (g), " \
+        "2: Az (g))" in exc.value.message
+    with pytest.raises(InputError, match=r"tri\.csv: channel: channel 3 does not exist \(the record's responses "
+                                         r"has 3: 0\.\.2\)"):
+        read_record(tri, channel=3)
+    assert np.array_equal(read_record(ref.source, channel=0).response, ref.response)  # one response: 0 or nothing
+    # a UFF file's response time histories, in file order
+    u = tmp_path / "two.uff"
+    uff_record(u, t, f, a)
+    pyuff.UFF(str(u)).write_sets([pyuff.prepare_58(
+        binary=0, func_type=1, rsp_node=1, rsp_dir=2, ref_node=1, ref_dir=3, ord_data_type=4, abscissa_spacing=1,
+        abscissa_spec_data_type=17, ordinate_spec_data_type=12, orddenom_spec_data_type=0,
+        abscissa_axis_units_lab="s", data=np.asarray(2 * a, float), x=t)], mode="add")
+    assert np.allclose(read_record(u, channel=1).response, 2 * a) and np.allclose(read_record(u, channel=0).response,
+                                                                                   a)
+    with pytest.raises(InputError, match=r"two\.uff: channel: 2 response time histories: choose one with --channel "
+                                         r"\(0: dataset 1"):
+        read_record(u)
+    # the command line: the FRF of the channel chosen is that of its own file; none chosen is one line, exit 2
+    one, three = tmp_path / "one.csv", tmp_path / "three.csv"
+    assert main(["tap", str(ref.source), "--out", str(one)]) == 0
+    assert main(["tap", str(tri), "--channel", "1", "--out", str(three)]) == 0
+    assert three.read_text() == one.read_text()
+    capsys.readouterr()
+    assert main(["tap", str(tri), "--out", str(tmp_path / "none.csv")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "choose one with --channel" in err and not (tmp_path / "none.csv").exists()
+    assert main(["tap", str(tri), "--channel", "x", "--out", str(tmp_path / "none.csv")]) == 2
+    assert "--channel: must be a whole number, got 'x'" in capsys.readouterr().err
 
 def test_uff_without_time_data(tmp_path):
     from toolpoint.io.frf_files import write_frf

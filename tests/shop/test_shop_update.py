@@ -609,6 +609,54 @@ def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
     assert exc.value.field == "record"
 
 
+def test_a_table_row_names_its_part_of_a_session_record(tmp_path):
+    """A shop records a session of test cuts in one file: a row's ``start_s``/``end_s`` name its cut's part (as
+    ``cut --start --end``). Before, a row could only take the whole record: two cuts at one speed gave both rows the
+    record's verdict (chatter), and two speeds were refused with advice (``--start/--end``) a table cannot take."""
+    import soundfile as sf
+
+    from shop_synth import shop_record
+
+    a, rate, *_ = shop_record(rpm=6000, teeth=4, seed=1)
+    b, _, *_ = shop_record(rpm=8000, teeth=4, seed=3, chatter_hz=1234.0, chatter_amp=0.5)
+    c, _, *_ = shop_record(rpm=6000, teeth=4, seed=2, chatter_hz=1234.0, chatter_amp=0.5)
+    for name, x in (("session.wav", np.concatenate([a, c])), ("two.wav", np.concatenate([a, b]))):
+        sf.write(tmp_path / name, 0.5 * x / np.abs(x).max(), int(rate), subtype="PCM_16")
+    p = tmp_path / "cuts.csv"
+    p.write_text("rpm,depth_mm,result,record,start_s,end_s\n6000,0.5,,session.wav,0,4\n6000,0.8,,session.wav,4,\n"
+                 "6000,0.4,,two.wav,,4\n8000,0.7,,two.wav,4,\n")
+    cuts = read_test_cuts(p, teeth=4)
+    assert [c.stable for c in cuts] == [True, False, True, False]
+    assert cuts[1].chatter_hz == pytest.approx(1234.0, rel=0.01) and cuts[3].chatter_hz == pytest.approx(1234.0,
+                                                                                                       rel=0.01)
+    assert all(c.warnings == () for c in cuts), [c.warnings for c in cuts]  # each part holds one cut
+    assert [round(c.duration_s) for c in cuts] == [2, 2, 2, 2]
+    # the whole session for one row: warned, and told how to name the part
+    p.write_text("rpm,depth_mm,result,record\n6000,0.5,,session.wav\n")
+    (w,) = read_test_cuts(p, teeth=4)[0].warnings
+    assert "session.wav: the record holds 2 cuts" in w and "start_s and end_s" in w
+    # a record of two speeds without a part: refused in the table's words, naming the line and the record
+    p.write_text("rpm,depth_mm,result,record\n6000,0.5,,two.wav\n")
+    with pytest.raises(InputError, match=r"line 2: its record two.wav was not judged: rpm: the cut at 5\.0–7\.0 s ran "
+                                         r"at another spindle speed.*its own row \(rpm, start_s, end_s\)"):
+        read_test_cuts(p, teeth=4)
+    # the part's own refusal and contradiction name it
+    p.write_text("rpm,depth_mm,result,record,start_s,end_s\n6000,0.8,stable,session.wav,4,8\n")
+    with pytest.raises(InputError, match=r"line 2: the table says stable, its record session.wav \(4–8 s\) says "
+                                         r"chatter at 123\d\.\d Hz"):
+        read_test_cuts(p, teeth=4)
+    for body, field, said in (("6000,0.5,stable,,1,3", "start_s", "line 2: a part of a record needs the record"),
+                              ("6000,0.5,,session.wav,3,1", "end_s", "line 2: must be after start_s (3 s), got 1 s"),
+                              ("6000,0.5,,session.wav,-1,3", "start_s", "line 2: must be a finite number ≥ 0, got -1"),
+                              ("6000,0.5,,session.wav,9,", "start_s",
+                               "line 2: 9 s is after the end of its record session.wav (8 s)"),
+                              ("6000,0.5,,session.wav,,x", "end_s", "line 2: 'x' is not a number")):
+        p.write_text("rpm,depth_mm,result,record,start_s,end_s\n" + body + "\n")
+        with pytest.raises(InputError) as exc:
+            read_test_cuts(p, teeth=4)
+        assert exc.value.field == field and said in exc.value.message, (body, exc.value)
+
+
 def _prior_updates(seed0, seeds, n_speeds, truths=150):
     """Prior-only updates of the example tool (σ 0.15, ``forward="sdm"``, 500 samples, 200 lobe samples), each with
     truths drawn from the prior after it: yields (posterior, truth_limits), truth_limits(rpm) the truths' SDM limits

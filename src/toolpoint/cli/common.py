@@ -78,6 +78,17 @@ def check_number(value, flag: str, *, minimum: float | None = None, above: float
     return v
 
 
+def check_whole(value, flag: str, *, minimum: int | None = None) -> int:
+    """A whole-number command-line value (a channel, a count), ≥ ``minimum`` where given."""
+    try:
+        v = int(value)
+    except (TypeError, ValueError):
+        raise InputError(f"must be a whole number, got {value!r}", file="command line", field=flag) from None
+    if minimum is not None and v < minimum:
+        raise InputError(f"must be ≥ {minimum}, got {v}", file="command line", field=flag)
+    return v
+
+
 def check_figure_suffix(path: Path, flag: str) -> None:
     """Refuse a figure path whose extension matplotlib cannot write (before any work)."""
     from matplotlib.figure import Figure

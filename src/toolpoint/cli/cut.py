@@ -22,7 +22,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from .common import check_number, out_path, save_figure, use_agg
+from .common import check_number, check_whole, out_path, save_figure, use_agg
 
 
 def register(sub) -> None:
@@ -57,23 +57,15 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _int(value, flag):
-    try:
-        v = int(value)
-    except (TypeError, ValueError):
-        raise InputError(f"must be a whole number, got {value!r}", file="command line", field=flag) from None
-    return v
-
-
 def run(args) -> int:
     """Run ``toolpoint cut``; returns the exit code."""
     rec_path = Path(args.record)
     out = out_path(args.out, "--out", inputs=[rec_path]) if args.out else None
     plot = out_path(args.plot, "--plot", inputs=[rec_path]) if args.plot else None
     rpm = check_number(args.rpm, "--rpm", above=0, unit="rpm")
-    teeth = _int(args.teeth, "--teeth")
+    teeth = check_whole(args.teeth, "--teeth")
     rate = check_number(args.rate, "--rate", above=0, unit="Hz") if args.rate is not None else None
-    channel = _int(args.channel, "--channel") if args.channel is not None else None
+    channel = check_whole(args.channel, "--channel") if args.channel is not None else None
     tol = check_number(args.rpm_tolerance, "--rpm-tolerance", minimum=0)
     if tol >= 0.5:
         raise InputError(f"must be < 0.5, got {args.rpm_tolerance}", file="command line", field="--rpm-tolerance")

@@ -21,8 +21,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.atomic import atomic_open, atomic_path
-from .common import out_path, use_agg, warnings_to_stderr
-from .simulate import _int, add_model_options, model_and_cut, renamed
+from .common import check_whole, out_path, use_agg, warnings_to_stderr
+from .simulate import add_model_options, model_and_cut, renamed
 
 #: Most grid points one command simulates (time: ≈ 5 ms CPU per point at 40 revolutions).
 MAX_POINTS = 200_000
@@ -64,8 +64,8 @@ def run(args) -> int:
     mx, my, cut, tool, feed, opts = model_and_cut(args)
     r_lo, r_hi = _range(args.rpm, "--rpm")
     a_lo, a_hi = _range(args.depth_mm, "--depth-mm")
-    ns = _int(args.rpm_points, "--rpm-points", 1)
-    nd = _int(args.depth_points, "--depth-points", 1)
+    ns = check_whole(args.rpm_points, "--rpm-points", minimum=1)
+    nd = check_whole(args.depth_points, "--depth-points", minimum=1)
     if ns * nd > MAX_POINTS:
         raise InputError(f"{ns} × {nd} points, at most {MAX_POINTS} in one map", field="--rpm-points")
     outs = {"out": out_path(args.out, "--out", inputs=[args.modal] if args.modal else ())}

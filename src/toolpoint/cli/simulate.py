@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io.atomic import atomic_open, atomic_path
-from .common import check_number, out_path, use_agg, warnings_to_stderr
+from .common import check_number, check_whole, out_path, use_agg, warnings_to_stderr
 
 
 # ----------------------------------------------------------------- shared with ``map``
@@ -116,16 +116,6 @@ def _list(text, flag, scale=1.0):
     return vals
 
 
-def _int(text, flag, low):
-    try:
-        v = int(text)
-    except (TypeError, ValueError):
-        raise InputError(f"not an integer: {text!r}", field=flag) from None
-    if v < low:
-        raise InputError(f"must be ≥ {low}, got {v}", field=flag)
-    return v
-
-
 def model_and_cut(args):
     """(modes_x, modes_y, CuttingConditions, Tool, feed_m, options) from the shared flags, errors naming the flag."""
     from ..simulation import Tool
@@ -149,7 +139,7 @@ def model_and_cut(args):
     flags = {"teeth": "--teeth", "tangential_coeff": "--tangential-coeff", "radial_ratio": "--radial-ratio",
              "radial_immersion": "--immersion", "milling": "--down/--up"}
     try:
-        cut = CuttingConditions(teeth=_int(args.teeth, "--teeth", 1),
+        cut = CuttingConditions(teeth=check_whole(args.teeth, "--teeth", minimum=1),
                                 tangential_coeff=check_number(args.tangential_coeff, "--tangential-coeff",
                                                               above=0, unit="N/m²"),
                                 radial_ratio=check_number(args.radial_ratio, "--radial-ratio", minimum=0),
@@ -165,7 +155,7 @@ def model_and_cut(args):
     try:
         tool = Tool(diameter_m=check_number(args.diameter_mm, "--diameter-mm", minimum=0) * 1e-3,
                     helix_deg=check_number(args.helix_deg, "--helix-deg", minimum=0),
-                    slices=_int(args.slices, "--slices", 1),
+                    slices=check_whole(args.slices, "--slices", minimum=1),
                     tooth_angles_deg=_list(args.pitch_deg, "--pitch-deg"),
                     runout_m=_list(args.runout_um, "--runout-um", 1e-6),
                     edge_tangential=check_number(args.edge_tangential, "--edge-tangential", minimum=0),
@@ -174,8 +164,8 @@ def model_and_cut(args):
     except InputError as err:
         raise InputError(err.message, field=tflags.get(err.field, err.field)) from None
     feed = check_number(args.feed_mm, "--feed-mm", above=0, unit="mm") * 1e-3
-    opts = dict(revolutions=_int(args.revolutions, "--revolutions", 8),
-                steps_per_tooth=_int(args.steps_per_tooth, "--steps-per-tooth", 4))
+    opts = dict(revolutions=check_whole(args.revolutions, "--revolutions", minimum=8),
+                steps_per_tooth=check_whole(args.steps_per_tooth, "--steps-per-tooth", minimum=4))
     return mx, my, cut, tool, feed, opts
 
 
@@ -232,7 +222,7 @@ def run(args) -> int:
     mx, my, cut, tool, feed, opts = model_and_cut(args)
     rpm = check_number(args.rpm, "--rpm", above=0, unit="rpm")
     depth = check_number(args.depth_mm, "--depth-mm", minimum=0, unit="mm") * 1e-3
-    substeps = None if args.substeps is None else _int(args.substeps, "--substeps", 1)
+    substeps = None if args.substeps is None else check_whole(args.substeps, "--substeps", minimum=1)
     rate = check_number(args.rate, "--rate", above=0, unit="Hz")
     noise = check_number(args.noise, "--noise", minimum=0)
     outs = _outputs(args)

@@ -28,7 +28,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import InputError
-from .common import out_path, save_figure, use_agg, warnings_to_stderr
+from .common import check_whole, out_path, save_figure, use_agg, warnings_to_stderr
 
 
 def register(sub) -> None:
@@ -41,7 +41,9 @@ def register(sub) -> None:
     p.add_argument("records", nargs="+", metavar="RECORD", help="text (time s, force N, response) or UFF file")
     p.add_argument("--out", required=True, help="output FRF: .csv, .uff/.unv/.uf or .frf")
     p.add_argument("--response", choices=("acceleration", "velocity", "displacement"), default="acceleration",
-                   help="what the text records' third column is (m/s², m/s or m; default acceleration)")
+                   help="what the text records' response column is (m/s², m/s or m; default acceleration)")
+    p.add_argument("--channel", help="0-based response among several (the text columns after the force, a UFF "
+                   "file's response time histories), e.g. one axis of a triaxial accelerometer")
     p.add_argument("--estimator", choices=("H1", "H2"), default="H1", help="FRF estimator (default H1)")
     p.add_argument("--output-quantity", choices=("receptance", "measured"), default="receptance",
                    help="write receptance m/N (default) or the measured quantity")
@@ -108,12 +110,13 @@ def run(args) -> int:
                 drop_bad=args.drop_bad, fmax_hz=_number(args.fmax, "--fmax"),
                 force_drop_db=None if args.force_drop == "off" else _number(args.force_drop, "--force-drop"),
                 detrend=args.detrend)
+    channel = None if args.channel is None else check_whole(args.channel, "--channel")
     from ..io.frf_files import write_frf
     from ..io.impact import impact_frf, plot_tap, read_record
 
     with warnings_to_stderr(), warnings.catch_warnings():
         warnings.simplefilter("always")  # the CLI reports every warning on stderr, whatever the filters say
-        records = [read_record(r, response=args.response) for r in inputs]
+        records = [read_record(r, response=args.response, channel=channel) for r in inputs]
         res = impact_frf(records, label=out.stem, **opts)
         # all or none: the figure first (the likelier to fail), then the FRF; a failed FRF removes the figure
         if plot is not None:

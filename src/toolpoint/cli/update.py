@@ -3,7 +3,8 @@
 Bayesian update of the stability lobes from test cuts (:func:`toolpoint.shop.update`): the prior is a modal-prior
 TOML file (:mod:`toolpoint.shop.prior`) or a tool of a ``library`` output; the test cuts a CSV ``rpm, depth_mm,
 result`` (stable|chatter), optional ``chatter_hz``, ``duration_s`` (how long the tool cut) and ``record`` (a record
-of the cut, analysed as ``toolpoint cut`` does; it also gives the duration). Writes ``lobes.csv``, ``p_stable.csv``,
+of the cut, analysed as ``toolpoint cut`` does; it also gives the duration), with ``start_s``/``end_s`` where the
+record holds several cuts (the row's part of it, as ``cut --start --end``). Writes ``lobes.csv``, ``p_stable.csv``,
 ``parameters.csv``, ``update.json`` (recommended point, the next test cut and its rule), ``lobes.png`` and
 ``report.html`` in ``--out``; prints the recommendation and the next cut. Contradictory labels are refused (exit 2),
 not averaged.
@@ -28,8 +29,8 @@ def register(sub) -> None:
     p.add_argument("--tool", help="tool id in the library output")
     p.add_argument("--sigma-freq", help="with --library: log standard deviation of the natural frequencies "
                    "(default 0.01: the running spindle's shift, which the library does not model)")
-    p.add_argument("--cuts", help="test-cut table CSV (rpm, depth_mm, result[, chatter_hz][, duration_s][, record]); "
-                   "without it: the prior's lobes and the first cut")
+    p.add_argument("--cuts", help="test-cut table CSV (rpm, depth_mm, result[, chatter_hz][, duration_s][, record"
+                   "[, start_s, end_s]]); without it: the prior's lobes and the first cut")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--seed", default="0", help="random seed (default 0)")
     p.add_argument("--samples", default="1000", help="posterior samples (default 1000)")

@@ -330,12 +330,13 @@ def corrected_damping(fn_hz, zeta, tau_s: float | None) -> CorrectedDamping:
 
 
 # ---------------------------------------------------------------- reading
-def read_record(path, *, response: str = "acceleration") -> Record:
+def read_record(path, *, response: str = "acceleration", channel: int | None = None) -> Record:
     """Read an impact record: a text table (time s, force N, response) or UFF58 time histories.
 
     Text (any extension but ``.uff``/``.unv``/``.uf``): three columns separated
-    by commas, tabs or spaces; an optional header line; lines starting with
-    ``#`` or ``%`` are comments. Where the header names units (``Accel (g)``,
+    by commas, tabs or spaces, or more — time, force and several responses (a
+    triaxial accelerometer, two directions), of which ``channel`` picks one; an
+    optional header line; lines starting with ``#`` or ``%`` are comments. Where the header names units (``Accel (g)``,
     ``Time (ms)``, ``force_kn``, a DAQ's units row under the names) they are
     converted to s, N and SI; a voltage, or a response of another kind than
     ``response``, is refused. UFF: the file's datasets 58 of function type 1
@@ -348,8 +349,13 @@ def read_record(path, *, response: str = "acceleration") -> Record:
     path : str or Path
         The file.
     response : str
-        What the text file's third column is: ``"acceleration"`` (m/s²),
+        What the text file's response column is: ``"acceleration"`` (m/s²),
         ``"velocity"`` (m/s) or ``"displacement"`` (m).
+    channel : int, optional
+        Which response, 0-based (the text file's columns after the force, the
+        UFF file's response time histories in file order), where the record
+        holds several; with one it may be omitted. Several without it are
+        refused, naming them.
 
     Returns
     -------
@@ -361,21 +367,31 @@ def read_record(path, *, response: str = "acceleration") -> Record:
         One line naming the file and field (and the line of a text file).
     """
     if Path(path).suffix.lower() in (".uff", ".unv", ".uf"):
-        return _read_uff_record(path)
+        return _read_uff_record(path, channel)
     from .frf_files import _check_not_cut, _is_number, _read_text, column_names, drop_empty_columns, numeric_lines
+    from .records import channel_index
 
     rows = []
     text, open_end = _read_text(path)
     numbered = list(numeric_lines(text))
     kept, keep = drop_empty_columns(numbered)
     names = column_names(text, numbered[0][0], len(numbered[0][1])) if numbered else None
+    width = len(kept[0][1]) if kept else 0
     for n, cells in kept:
-        if len(cells) != 3:
-            raise InputError(f"line {n}: expected 3 columns (time s, force N, response), found {len(cells)}",
-                             file=path, field="columns")
+        if len(cells) < 3 or len(cells) != width:
+            raise InputError(f"line {n}: expected {'3 columns' if width < 3 else f'{width} columns as on line '}"
+                             f"{'' if width < 3 else kept[0][0]} (time s, force N, response"
+                             f"{'' if width <= 3 else 's'}), found {len(cells)}", file=path, field="columns")
+        if "" in cells:  # a cell empty on some rows only (a column empty on all is dropped above): a missing value
+            raise InputError(f"line {n}: column {cells.index('') + 1} is empty", file=path, field="columns")
         rows.append((n, cells))
     if not rows:
         raise InputError("no data rows", file=path, field="data")
+    # the response: one of several columns after the force (a triaxial accelerometer), chosen as `cut` chooses
+    k = 2 + channel_index(width - 2, channel, path, "the record's responses",
+                          [names[j] for j in keep[2:]] if names else None, kind="response columns")
+    rows = [(n, [cells[0], cells[1], cells[k]]) for n, cells in rows]
+    keep = [keep[0], keep[1], keep[k]]
     try:
         if any("_" in c for _, cells in rows for c in cells):  # float() reads "1_000"; no data file writes it
             raise ValueError("_")
@@ -436,7 +452,7 @@ def _to_si(a: np.ndarray, names: list, response: str, path) -> tuple:
 _UFF_RESPONSE = {8: "displacement", 11: "velocity", 12: "acceleration"}
 
 
-def _read_uff_record(path) -> Record:
+def _read_uff_record(path, channel: int | None = None) -> Record:
     from .frf_files import _uff_headers
 
     uff, sets, heads = _uff_headers(path)
@@ -449,9 +465,14 @@ def _read_uff_record(path) -> Record:
     resp = [(s, h) for s, h in th if h.get("ordinate_spec_data_type") in _UFF_RESPONSE]
     names = "; ".join(f"#{k}: {h.get('id1', '')!s} (ordinate type {h.get('ordinate_spec_data_type')})"
                       for k, (_, h) in enumerate(th))
-    if len(force) != 1 or len(resp) != 1:
+    if len(force) != 1 or not resp:
         raise InputError(f"need one force (ordinate type 13) and one response (8/11/12) time history, found "
                          f"{len(force)} and {len(resp)} among: {names}", file=path, field="ordinate_spec_data_type")
+    from .records import channel_index
+
+    resp = [resp[channel_index(len(resp), channel, path, "the record's responses",
+                               [f"dataset {s} {h.get('id1', '')!s}".strip() for s, h in resp],
+                               kind="response time histories")]]
     data = []
     for s, _ in (force[0], resp[0]):
         try:

@@ -206,12 +206,22 @@ def _pick(data: np.ndarray, channel: int | None, p: Path, what: str, names=None)
                                  f"{100 * np.var(mean) / each:.2g} % of their power: one is inverted?); choose one "
                                  f"with --channel (0..{n - 1})", file=p, field="channel")
             return mean, f"mean of {n}"
-        raise InputError(f"{n} signal columns: choose one with --channel "
+    k = channel_index(n, channel, p, what, names)
+    return data[:, k], label(k)
+
+
+def channel_index(n: int, channel: int | None, p, what: str, names=None, kind: str = "signal columns") -> int:
+    """The channel of ``n`` to read: the given one (0-based), or the only one; several without a choice are refused
+    listing them (``names``, e.g. the header's), as is a channel that does not exist."""
+    if channel is None:
+        if n == 1:
+            return 0
+        raise InputError(f"{n} {kind}: choose one with --channel "
                          + (f"({', '.join(f'{k}: {names[k]}' for k in range(n))})" if names else f"(0..{n - 1})"),
                          file=p, field="channel")
     if not (0 <= channel < n):
         raise InputError(f"channel {channel} does not exist ({what} has {n}: 0..{n - 1})", file=p, field="channel")
-    return data[:, channel], label(channel)
+    return channel
 
 
 def _read_audio(p: Path, channel: int | None) -> CutRecord:

@@ -119,14 +119,18 @@ class TestCut:
 
 def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
     """Read a test-cut table: CSV ``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz``,
-    ``duration_s`` (how long the tool cut, s) and ``record``; column names in any case, cells split at commas or
-    (a spreadsheet's export with the decimal comma) semicolons (:func:`toolpoint.io.table.read_rows`).
+    ``duration_s`` (how long the tool cut, s), ``record``, ``start_s`` and ``end_s``; column names in any case,
+    cells split at commas or (a spreadsheet's export with the decimal comma) semicolons
+    (:func:`toolpoint.io.table.read_rows`).
 
     A ``record`` (path relative to the table) is analysed by :func:`toolpoint.shop.analyse_cut` (needs
     ``teeth``): it gives ``result`` and ``chatter_hz`` where the table leaves them empty, and ``duration_s``
     (its longest run of entry, cut and exit); where both are given and disagree the table is refused (a
-    contradiction is reported, not averaged). What the analysis cannot rule out (chatter on a mains harmonic in a
-    record without an air cut) stays with the cut (``TestCut.warnings``) and reaches the report.
+    contradiction is reported, not averaged). ``start_s`` and ``end_s`` (s from the record's start; either may be
+    empty: its start, its end) name the part of the record that holds the row's cut, as ``toolpoint cut --start
+    --end`` does: a shop that records a session of cuts in one file gives each cut its own row and part. What the
+    analysis cannot rule out (chatter on a mains harmonic in a record without an air cut) stays with the cut
+    (``TestCut.warnings``) and reaches the report.
 
     Raises
     ------
@@ -145,9 +149,9 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             raise InputError(f"missing column {need!r} (columns: {', '.join(header) or 'none'})", file=p, field=need)
     if "result" not in header and "record" not in header:
         raise InputError("needs a column 'result' (stable|chatter) or 'record'", file=p, field="result")
-    cuts = []
+    cuts, records = [], {}
     for line, row in rows:
-        def num(name, *, required=True, lo=0.0):
+        def num(name, *, required=True, lo=0.0, at_lo=False):
             v = (row.get(name) or "").strip()
             if not v:
                 if required:
@@ -157,8 +161,9 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                 x = float(v)
             except ValueError:
                 raise InputError(f"line {line}: {v!r} is not a number", file=p, field=name) from None
-            if not (math.isfinite(x) and x > lo):
-                raise InputError(f"line {line}: must be a finite number > {lo:g}, got {v}", file=p, field=name)
+            if not (math.isfinite(x) and (x >= lo if at_lo else x > lo)):
+                raise InputError(f"line {line}: must be a finite number {'≥' if at_lo else '>'} {lo:g}, got {v}",
+                                 file=p, field=name)
             return x
         rpm, depth = num("rpm"), num("depth_mm")
         if rpm > 200_000:
@@ -173,6 +178,15 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
         if res and res not in ("stable", "chatter"):
             raise InputError(f"line {line}: must be 'stable' or 'chatter', got {res!r}", file=p, field="result")
         rec = (row.get("record") or "").strip()
+        t0, t1 = num("start_s", required=False, at_lo=True), num("end_s", required=False)
+        if (t0 is not None or t1 is not None) and not rec:
+            raise InputError(f"line {line}: a part of a record needs the record", file=p,
+                             field="start_s" if t0 is not None else "end_s")
+        if t0 is not None and t1 is not None and t1 <= t0:
+            raise InputError(f"line {line}: must be after start_s ({t0:g} s), got {t1:g} s", file=p, field="end_s")
+        span = None if t0 is None and t1 is None else (t0 or 0.0, math.inf if t1 is None else t1)
+        what = rec if span is None else (f"{rec} ({t0:g}–{t1:g} s)" if t0 is not None and t1 is not None
+                                         else f"{rec} (from {t0:g} s)" if t0 is not None else f"{rec} (to {t1:g} s)")
         warns = ()
         if rec:
             if teeth is None:
@@ -181,36 +195,43 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             from .detect import analyse_cut
 
             rp = (p.parent / rec) if not Path(rec).is_absolute() else Path(rec)
-            r = read_cut_record(rp)
+            if rp not in records:  # a session's record, one row per cut in it, is read once
+                records[rp] = read_cut_record(rp)
+            r = records[rp]
+            if span is not None and span[0] >= r.duration_s:
+                raise InputError(f"line {line}: {span[0]:g} s is after the end of its record {rec} "
+                                 f"({r.duration_s:.4g} s)", file=p, field="start_s")
             try:
                 a = analyse_cut(r.samples, r.rate_hz, rpm=rpm, teeth=teeth, full_scale=r.full_scale, source=str(rp),
-                                **(cut_options or {}))
+                                span_s=span, **(cut_options or {}))
             except InputError as e:  # a record `cut` will not judge (its spindle not heard, clipped, too short …)
-                why = (f"{e.field}: " if e.field else "") + e.message
+                # `cut`'s advice in the table's words: a row's part of a record is its start_s and end_s
+                why = (f"{e.field}: " if e.field else "") + e.message.replace(
+                    "its own --rpm and --start/--end", "its own row (rpm, start_s, end_s)")
                 if not res:
-                    raise InputError(f"line {line}: its record {rec} was not judged: {why}", file=p,
+                    raise InputError(f"line {line}: its record {what} was not judged: {why}", file=p,
                                      field="record") from None
                 a = None  # the table's own label stands, and the user hears why the record did not count
-                warns = (f"its record {rec} was not judged ({why}); the table's '{res}' stands",)
+                warns = (f"its record {what} was not judged ({why}); the table's '{res}' stands",)
         if rec and a is not None:
             if res and res != a.verdict:
                 # what `cut` doubted of the record may be the contradiction's cause (a wrong tooth count makes the
                 # cutter's own tooth harmonics "chatter"): the refusal says it, so `cut` need not be run to find it
                 doubts = a.criterion.get("warnings", ())
-                raise InputError(f"line {line}: the table says {res}, its record {rec} says {a.verdict}"
+                raise InputError(f"line {line}: the table says {res}, its record {what} says {a.verdict}"
                                  + (f" at {a.chatter_hz:.1f} Hz" if a.chatter_hz else "")
-                                 + ("".join(f"; {rec}: {w}" for w in doubts)), file=p, field="result")
+                                 + ("".join(f"; {what}: {w}" for w in doubts)), file=p, field="result")
             res = a.verdict
             if fc is None and a.chatter_hz is not None:
                 fc = a.chatter_hz
             if dur is None:
                 dur = _cutting_s(a)
-            warns = tuple(f"{rec}: {w}" for w in a.criterion.get("warnings", ()))
+            warns = tuple(f"{what}: {w}" for w in a.criterion.get("warnings", ()))
             if len({v for *_, v, _ in a.cuts}) > 1:  # a row is one cut; its record holds cuts that disagree
-                warns += (f"{rec}: the record holds {len(a.cuts)} cuts ("
-                          + "; ".join(f"{t0:.1f}–{t1:.1f} s {v}" for t0, t1, v, _ in a.cuts)
-                          + f"): the row takes the record's verdict, {a.verdict}; give each cut its own row and "
-                          "record",)
+                warns += (f"{what}: the {'record' if span is None else 'part'} holds {len(a.cuts)} cuts ("
+                          + "; ".join(f"{ta:.1f}–{tb:.1f} s {v}" for ta, tb, v, _ in a.cuts)
+                          + f"): the row takes the record's verdict, {a.verdict}; give each cut its own row, and "
+                          "its part of the record in start_s and end_s",)
         if not res:
             raise InputError(f"line {line}: empty (and no record)", file=p, field="result")
         if res == "stable" and fc is not None:
