@@ -3,6 +3,7 @@ bands out of sample, contradictory tables, the files, the library adapter, a vir
 
 import json
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -475,7 +476,6 @@ def test_library_prior_is_not_surer_than_the_library(tmp_path):
     own 5–95 % band of the limit at every speed (the adapter may add what the library does not model — the
     running spindle's frequency shift, the peak-picking — never remove what it sampled), around the same median."""
     import sys
-    from pathlib import Path
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "recommend"))
     from test_library import small_run
@@ -655,6 +655,60 @@ def test_a_table_row_names_its_part_of_a_session_record(tmp_path):
         with pytest.raises(InputError) as exc:
             read_test_cuts(p, teeth=4)
         assert exc.value.field == field and said in exc.value.message, (body, exc.value)
+
+
+EXAMPLE_SHOP = Path(__file__).resolve().parents[2] / "examples" / "shop"
+
+
+def test_the_example_session_is_heard_as_the_true_tool_s_sdm_limit_says():
+    """The README's session of test cuts (examples/shop/, written by examples/make_test_cuts.py): the prior file is
+    the code's Cornelius case; the table read through its record gives each cut the verdict the virtual shop heard
+    alone, and against the true tool's SDM limit (recomputed here from the true θ, not read) each cut's verdict is
+    right outside ±5 % of the limit and the chatter frequency is the SDM's within 1 %."""
+    from toolpoint.shop.model import sdm_limits
+
+    prior = read_modal_prior(EXAMPLE_SHOP / "cornelius_prior.toml")
+    assert prior == cornelius_2024(0.1)
+    truth = json.loads((EXAMPLE_SHOP / "truth.json").read_text())
+    cuts = read_test_cuts(EXAMPLE_SHOP / "test_cuts.csv", teeth=prior.cutting.teeth)
+    speeds = np.unique([c.rpm for c in cuts])
+    lim, fc = sdm_limits(prior, np.array(truth["theta"]), speeds)
+    assert len(cuts) == len(truth["cuts"]) >= 3 and {c.stable for c in cuts} == {True, False}
+    for c, t in zip(cuts, truth["cuts"]):
+        k = int(np.searchsorted(speeds, c.rpm))
+        assert ("stable" if c.stable else "chatter") == t["heard_alone"] and c.warnings == ()
+        assert t["sdm_limit_mm"] == pytest.approx(1e3 * lim[k], rel=1e-3)
+        ratio = c.depth_m / lim[k]
+        if abs(ratio - 1) > 0.05:
+            assert c.stable == (ratio < 1), (c, ratio)
+        if not c.stable:
+            assert c.chatter_hz == pytest.approx(fc[k], rel=0.01)
+
+
+@pytest.mark.slow
+def test_the_example_session_is_the_cuts_update_proposed(tmp_path, capsys):
+    """examples/shop/test_cuts.csv is what examples/make_test_cuts.py writes, and each of its cuts is the next cut
+    `toolpoint update --forward sdm` proposes from the rows before it (the README's tour says so)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_test_cuts", EXAMPLE_SHOP.parent / "make_test_cuts.py")
+    gen = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gen)
+    gen.main(tmp_path)
+    capsys.readouterr()
+    assert (tmp_path / "test_cuts.csv").read_text() == (EXAMPLE_SHOP / "test_cuts.csv").read_text()
+    assert json.loads((tmp_path / "truth.json").read_text())["cuts"] == json.loads(
+        (EXAMPLE_SHOP / "truth.json").read_text())["cuts"]
+    rows = (EXAMPLE_SHOP / "test_cuts.csv").read_text().splitlines()
+    for n in range(len(rows) - 1):
+        table = tmp_path / f"first{n}.csv"
+        table.write_text("\n".join(rows[:n + 1]) + "\n")
+        args = ["update", "--prior", str(EXAMPLE_SHOP / "cornelius_prior.toml"), "--forward", "sdm", "--out",
+                str(tmp_path / f"u{n}")]
+        assert main(args + (["--cuts", str(table)] if n else [])) == 0
+        nc = json.loads((tmp_path / f"u{n}" / "update.json").read_text())["next_cut"]
+        rpm, depth = (float(v) for v in rows[n + 1].split(",")[:2])
+        assert (round(nc["rpm"]), round(nc["depth_mm"], 3)) == (rpm, depth), (n, nc)
 
 
 def _prior_updates(seed0, seeds, n_speeds, truths=150):
