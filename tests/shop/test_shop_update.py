@@ -16,6 +16,10 @@ from toolpoint.shop.prior import prior_from_library, read_modal_prior
 from toolpoint.shop.update import TestCut, log_likelihood, read_test_cuts, update
 from toolpoint.stability.zoa_batch import zoa_limits
 
+# the command line's tests of parsing, files and messages run the cheaper zero-order model (the default is "sdm":
+# test_the_example_session_is_the_cuts_update_proposed runs it)
+UPDATE_ZOA = ["update", "--forward", "zoa"]
+
 
 def test_limit_at_speeds_matches_zoa_limits_on_two_modes():
     """Second method: the lobe crossings at single speeds vs zoa_limits' interpolated lobes (same K_t, K_r)."""
@@ -170,7 +174,7 @@ def test_smc_posterior_matches_quadrature_on_one_parameter():
     cdf = np.cumsum(w) / w.sum()
     exact = np.interp([0.05, 0.5, 0.95], cdf, zg)
     post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(0, 0),
-                  label_growth=(0, 0))
+                  forward="zoa", label_growth=(0, 0))
     got = np.quantile(post.z[:, pr.sigma.size - 2], [0.05, 0.5, 0.95])
     np.testing.assert_allclose(got, exact, atol=0.08)
     assert exact[2] - exact[0] < 0.6 * 2 * 1.645  # the cuts did narrow it
@@ -192,11 +196,11 @@ def test_smc_posterior_matches_quadrature_with_the_label_offset():
     cdf = np.cumsum(w) / w.sum()
     exact = np.interp([0.05, 0.5, 0.95], cdf, zg)
     post = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(mu, sd),
-                  label_growth=(0, 0))
+                  forward="zoa", label_growth=(0, 0))
     got = np.quantile(post.z[:, pr.sigma.size - 2], [0.05, 0.5, 0.95])
     np.testing.assert_allclose(got, exact, atol=0.08)
     none = update(pr, cuts, rng=np.random.default_rng(3), n_samples=2000, lobe_samples=50, label_offset=(0, 0),
-                  label_growth=(0, 0))
+                  forward="zoa", label_growth=(0, 0))
     j = int(np.argmin(np.abs(post.rpm - 20000)))
     # K_t lower (a higher limit) with δ = 0 than with δ ≈ 0.05: the limit at the cut speed moves down by about e^-μ
     ratio = post.limit_q_m[1, j] / none.limit_q_m[1, j]
@@ -220,7 +224,8 @@ def test_bands_are_calibrated_out_of_sample():
         depth = a_true[0] * np.exp(rng.normal(0, 0.3, 3))
         cuts = [TestCut(r, d, bool(d < a), None if d < a else float(f))
                 for r, d, a, f in zip(rpm, depth, a_true[0], fc[0])]
-        post = update(pr, cuts, rng=rng, n_samples=500, lobe_samples=200, rpm_grid=np.linspace(5000, 25000, 40))
+        post = update(pr, cuts, rng=rng, forward="zoa", n_samples=500, lobe_samples=200,
+                      rpm_grid=np.linspace(5000, 25000, 40))
         g = rng.integers(40)
         truth_lim = zoa_limits(pr.freq_grid(), receptance(pr, truth, pr.freq_grid()) * truth[0, 6] / 2003e6,
                                replace(pr.cutting, radial_ratio=float(truth[0, 7])), post.rpm[g:g + 1])[0, 0]
@@ -245,11 +250,12 @@ def test_a_missed_chatter_rate_weakens_stable_labels_only():
     far_below = log_likelihood(pr, th, [TestCut(rpm, a0 / 3, True)], label_noise=eps, miss_rate=m)
     assert np.exp(far_below) == pytest.approx(1 - eps + m * eps, rel=1e-6)
     cut = [TestCut(rpm, 1.3 * a0, True)]
-    q = {mr: update(pr, cut, rng=np.random.default_rng(0), n_samples=400, lobe_samples=200, rpm_grid=[rpm],
-                    miss_rate=mr, label_offset=(0, 0), label_growth=(0, 0)).limit_q_m[:, 0] for mr in (0.0, m)}
+    q = {mr: update(pr, cut, rng=np.random.default_rng(0), forward="zoa", n_samples=400, lobe_samples=200,
+                    rpm_grid=[rpm], miss_rate=mr, label_offset=(0, 0), label_growth=(0, 0)).limit_q_m[:, 0]
+         for mr in (0.0, m)}
     assert q[0.0][0] > 1.2 * a0 and q[m][0] < q[0.0][0] and q[m][1] < q[0.0][1], q
     with pytest.raises(InputError, match="miss_rate|0, 1"):
-        update(pr, cut, rng=np.random.default_rng(0), n_samples=50, miss_rate=1.0)
+        update(pr, cut, rng=np.random.default_rng(0), forward="zoa", n_samples=50, miss_rate=1.0)
 
 
 def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):
@@ -259,7 +265,7 @@ def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):
         read_test_cuts(p)
     prior = tmp_path / "prior.toml"
     prior.write_text(PRIOR_TOML)
-    assert main(["update", "--prior", str(prior), "--cuts", str(p), "--out", str(tmp_path / "o")]) == 2
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(p), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "cuts.csv" in err and "result" in err
     assert not (tmp_path / "o" / "report.html").exists()
@@ -307,12 +313,12 @@ def test_a_depth_far_outside_the_prior_s_lobes_is_warned(tmp_path, capsys):
     prior.write_text(PRIOR_TOML)
     cuts = tmp_path / "cuts.csv"
     cuts.write_text("rpm,depth_mm,result\n20000,0.0005,stable\n20000,0.5,stable\n")
-    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o"),
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o"),
                  "--samples", "200"]) == 0
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cuts.csv: line 2: warning: depth 0.0005 mm" in err[0] and "in mm?" in err[0]
     cuts.write_text("rpm,depth_mm,result\n20000,0.5,stable\n")
-    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o2"),
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o2"),
                  "--samples", "200"]) == 0
     assert capsys.readouterr().err == ""
 
@@ -343,7 +349,7 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     cuts = tmp_path / "cuts.csv"
     cuts.write_text("rpm,depth_mm,result,chatter_hz\n20000,0.5,stable,\n20000,0.9,chatter,1290\n12000,0.3,stable,\n")
     out = tmp_path / "out"
-    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(out), "--samples", "300"]) == 0
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(out), "--samples", "300"]) == 0
     printed = capsys.readouterr().out
     assert "next test cut (info)" in printed
     # the band away from the cut speeds rests on the model alone (calibrated on average, not for every tool): said on
@@ -367,14 +373,14 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     # the stable cut at 20000 rpm, 0.5 mm: the posterior 5 % limit there is near or above it
     k = np.argmin(np.abs(lobes["rpm"] - 20000))
     assert lobes["p05_mm"][k] > 0.45 and lobes["p95_mm"][k] < 0.95
-    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o5"),
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o5"),
                  "--risk-after-chatter", "0.35"]) == 2
     assert "--risk-after-chatter: must be ≤ the bound before any chatter" in capsys.readouterr().err
     assert not (tmp_path / "o5").exists()
-    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o3"),
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o3"),
                  "--min-step", "-1"]) == 2
     assert "--min-step" in capsys.readouterr().err and not (tmp_path / "o3").exists()
-    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o4"),
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o4"),
                  "--min-step", "0.1", "--rule", "risk"]) == 2
     assert "min_step" in capsys.readouterr().err and not (tmp_path / "o4").exists()
     # --label-offset MEAN,SD: the labels' boundary e^δ above the limit. The default (0.035, 0.035) puts the band at
@@ -383,13 +389,13 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     assert rows["label_offset_ln"][1] == "ln" and [float(v) for v in rows["label_offset_ln"][2:5]] == \
         pytest.approx([0.035 - 1.645 * 0.035, 0.035, 0.035 + 1.645 * 0.035], abs=1e-4)
     o0 = tmp_path / "o0"
-    assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(o0), "--samples", "300",
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(o0), "--samples", "300",
                  "--label-offset", "0,0"]) == 0
     lobes0 = np.genfromtxt(o0 / "lobes.csv", delimiter=",", names=True)
     assert lobes0["p05_mm"][k] > lobes["p05_mm"][k], (lobes0["p05_mm"][k], lobes["p05_mm"][k])
     for bad in ("0.1", "0.1,x", "0.1,-0.1", "0.9,0.1", "nan,0.1"):
         capsys.readouterr()
-        assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o5"),
+        assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o5"),
                      "--label-offset", bad]) == 2, bad
         err = capsys.readouterr().err
         assert "--label-offset" in err and "Traceback" not in err and not (tmp_path / "o5").exists(), (bad, err)
@@ -400,7 +406,7 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     for flag, bad in (("--label-growth", "2"), ("--label-growth", "-1,0.5"), ("--label-growth", "2,x"),
                       ("--label-growth", "30,0.5"), ("--cut-duration", "0"), ("--cut-duration", "inf")):
         capsys.readouterr()
-        assert main(["update", "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o6"),
+        assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o6"),
                      f"{flag}={bad}"]) == 2, bad
         err = capsys.readouterr().err
         assert flag in err and "Traceback" not in err and not (tmp_path / "o6").exists(), (bad, err)
@@ -424,7 +430,7 @@ def test_cli_update_steps_above_stable_cuts_that_crept(tmp_path, capsys):
         for ms in ((), ("--min-step", "0")):
             capsys.readouterr()
             o = tmp_path / f"{name}{len(ms)}"
-            assert main(["update", "--prior", str(prior), "--cuts", str(tmp_path / f"{name}.csv"), "--out", str(o),
+            assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(tmp_path / f"{name}.csv"), "--out", str(o),
                          "--samples", "300", *ms]) == 0
             nxt[name, bool(ms)] = (json.loads((o / "update.json").read_text())["next_cut"], capsys.readouterr().out)
     for key, (nc, printed) in nxt.items():
@@ -494,10 +500,10 @@ def test_library_prior_is_not_surer_than_the_library(tmp_path):
         assert holds.mean() >= 0.95, (tool, holds.mean())
         assert np.median(np.abs(np.log(qp[1] / q[1]))) < 0.1, tool
     # the CLI: --sigma-freq overrides the library prior's σ_f, and only a library prior's
-    assert main(["update", "--library", str(out), "--tool", "B12", "--sigma-freq", "0.02", "--samples", "100",
+    assert main([*UPDATE_ZOA, "--library", str(out), "--tool", "B12", "--sigma-freq", "0.02", "--samples", "100",
                  "--out", str(tmp_path / "u")]) == 0
     assert (tmp_path / "u" / "report.html").exists()
-    assert main(["update", "--library", str(out), "--tool", "B12", "--sigma-freq", "2", "--out",
+    assert main([*UPDATE_ZOA, "--library", str(out), "--tool", "B12", "--sigma-freq", "2", "--out",
                  str(tmp_path / "v")]) == 2
 
 
@@ -505,7 +511,7 @@ def test_library_prior_is_not_surer_than_the_library(tmp_path):
 def test_virtual_campaign_converges_with_few_chatters():
     """The loop on the update's own forward model (zero-order shop): converges within 8 cuts, ≤ 2 chatter."""
     pr = cornelius_2024(0.1)
-    r = virtual_campaign(pr, rng=np.random.default_rng(0), max_cuts=8, n_samples=400, lobe_samples=200)
+    r = virtual_campaign(pr, rng=np.random.default_rng(0), forward="zoa", max_cuts=8, n_samples=400, lobe_samples=200)
     assert r.converged_after is not None and r.converged_after <= 8
     assert r.chatter_cuts <= 2
     assert r.width[-1] <= 0.2 and r.coverage[-1] >= 0.9
@@ -526,7 +532,7 @@ def test_stable_cuts_climb_by_the_boundary_width_not_by_the_risk_quantile():
         # the zero-order shop labels by the limit itself: δ = 0 known (the default prior of δ widens the band
         # by its own spread, which this test of the next-cut rule is not about)
         r = virtual_campaign(pr, rng=np.random.default_rng(3), theta_true=truth, max_cuts=9, n_samples=300,
-                             lobe_samples=150, min_step=ms, label_offset=(0, 0), label_growth=(0, 0))
+                             forward="zoa", lobe_samples=150, min_step=ms, label_offset=(0, 0), label_growth=(0, 0))
         top[ms] = max(c.depth_m for c in r.cuts[:7] if c.stable)
         conv[ms] = np.inf if r.converged_after is None else r.converged_after
         runs[ms] = [(round(1e3 * c.depth_m, 3), c.stable) for c in r.cuts]
@@ -685,10 +691,31 @@ def test_the_example_session_is_heard_as_the_true_tool_s_sdm_limit_says():
             assert c.chatter_hz == pytest.approx(fc[k], rel=0.01)
 
 
+
+def test_the_update_plot_shows_the_cuts_near_the_recommendation():
+    """lobes.png's right panel holds every cut, the recommended point and the next cut inside its limits (over the
+    whole speed range they sat on each other: the README's figure), with the band there."""
+    from toolpoint.shop.report import plot_update
+
+    prior = read_modal_prior(EXAMPLE_SHOP / "cornelius_prior.toml")
+    cuts = [TestCut(20176.0, 0.504e-3, True), TestCut(20276.0, 0.542e-3, True), TestCut(20276.0, 0.599e-3, False,
+                                                                                         1850.8)]
+    post = update(prior, cuts, rng=np.random.default_rng(0), forward="zoa", n_samples=200, lobe_samples=100)
+    full, near = plot_update(post).axes[:2]
+    (x0, x1), (y0, y1) = near.get_xlim(), near.get_ylim()
+    pts = [(c.rpm, 1e3 * c.depth_m) for c in cuts] + [(d["rpm"], 1e3 * d["depth_m"]) for d in (post.next_cut,
+                                                                                               post.recommended)]
+    assert all(x0 < x < x1 and y0 < y < y1 for x, y in pts), (pts, near.get_xlim(), near.get_ylim())
+    assert x1 - x0 < 0.2 * (full.get_xlim()[1] - full.get_xlim()[0])  # a zoom, not the range again
+    j = (post.rpm > x0) & (post.rpm < x1)
+    assert y1 >= 1e3 * post.limit_q_m[2][j].max()  # the band's top is in view
+    labels = near.get_legend_handles_labels()[1]
+    assert "stable cut" in labels and "chatter cut" in labels
+
 @pytest.mark.slow
 def test_the_example_session_is_the_cuts_update_proposed(tmp_path, capsys):
     """examples/shop/test_cuts.csv is what examples/make_test_cuts.py writes, and each of its cuts is the next cut
-    `toolpoint update --forward sdm` proposes from the rows before it (the README's tour says so)."""
+    `toolpoint update` proposes from the rows before it (the README's tour says so)."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("make_test_cuts", EXAMPLE_SHOP.parent / "make_test_cuts.py")
@@ -703,10 +730,11 @@ def test_the_example_session_is_the_cuts_update_proposed(tmp_path, capsys):
     for n in range(len(rows) - 1):
         table = tmp_path / f"first{n}.csv"
         table.write_text("\n".join(rows[:n + 1]) + "\n")
-        args = ["update", "--prior", str(EXAMPLE_SHOP / "cornelius_prior.toml"), "--forward", "sdm", "--out",
-                str(tmp_path / f"u{n}")]
+        args = ["update", "--prior", str(EXAMPLE_SHOP / "cornelius_prior.toml"), "--out", str(tmp_path / f"u{n}")]
         assert main(args + (["--cuts", str(table)] if n else [])) == 0
-        nc = json.loads((tmp_path / f"u{n}" / "update.json").read_text())["next_cut"]
+        doc = json.loads((tmp_path / f"u{n}" / "update.json").read_text())
+        nc = doc["next_cut"]
+        assert doc["sampler"]["forward"] == "sdm"  # the default: what the README's tour and the campaigns use
         rpm, depth = (float(v) for v in rows[n + 1].split(",")[:2])
         assert (round(nc["rpm"]), round(nc["depth_mm"], 3)) == (rpm, depth), (n, nc)
 
@@ -771,7 +799,7 @@ def test_a_lower_risk_after_the_first_chatter():
     # proposal is the default's (same draws); after a chatter it is shallower, within the lower bound (or a step
     # above stable cuts that crept, which the option leaves alone), and the proposal says which bound it used.
     pr = cornelius_2024(0.1)
-    kw = dict(n_samples=300, lobe_samples=150, label_offset=(0, 0), label_growth=(0, 0))
+    kw = dict(n_samples=300, lobe_samples=150, label_offset=(0, 0), label_growth=(0, 0), forward="zoa")
     stable = [TestCut(20000.0, 0.45e-3, True)]
     a = update(pr, stable, rng=np.random.default_rng(4), **kw).next_cut
     b = update(pr, stable, rng=np.random.default_rng(4), risk_after_chatter=0.1, **kw).next_cut
@@ -812,7 +840,7 @@ def test_a_doubtful_record_s_warning_reaches_update_s_report(tmp_path, capsys):
     assert len(read[0].warnings) == 1 and read[0].warnings[0].startswith("hum.wav: chatter at 50.0 Hz sits on")
     assert read[1].warnings == () and read[2].warnings == ()
     out = tmp_path / "out"
-    assert main(["update", "--prior", str(tmp_path / "prior.toml"), "--cuts", str(cuts), "--out", str(out),
+    assert main([*UPDATE_ZOA, "--prior", str(tmp_path / "prior.toml"), "--cuts", str(cuts), "--out", str(out),
                  "--samples", "200"]) == 0
     err = capsys.readouterr().err.strip().splitlines()
     assert err[0].startswith(f"{cuts}: line 2: warning: hum.wav: chatter at 50.0 Hz"), err
@@ -840,9 +868,9 @@ def test_virtual_campaigns_on_the_example_tool_meet_the_targets():
     pr = example_tool(0.15)
     cuts, chat = [], []
     for seed in range(5):
-        r = virtual_campaign(pr, rng=np.random.default_rng(seed), max_cuts=8, n_samples=500, lobe_samples=200,
-                             label_offset=(0, 0), label_growth=(0, 0))  # the zero-order shop labels by the limit
-        # itself: δ = 0 and G = 0 known
+        # the zero-order shop labels by the limit itself: δ = 0 and G = 0 known
+        r = virtual_campaign(pr, rng=np.random.default_rng(seed), forward="zoa", max_cuts=8, n_samples=500,
+                             lobe_samples=200, label_offset=(0, 0), label_growth=(0, 0))
         cuts.append(np.inf if r.converged_after is None else r.converged_after)
         made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
         chat.append(sum(not c.stable for c in made))
@@ -921,7 +949,8 @@ def test_a_campaign_without_a_stop_makes_the_same_cuts_and_reports_calibration()
     from toolpoint.shop.update import _limits
 
     pr = cornelius_2024(0.1)
-    kw = dict(max_cuts=4, n_samples=200, lobe_samples=100, label_offset=(0, 0), label_growth=(0, 0))
+    kw = dict(max_cuts=4, n_samples=200, lobe_samples=100, label_offset=(0, 0), label_growth=(0, 0),
+              forward="zoa")
     a = virtual_campaign(pr, rng=np.random.default_rng(1), **kw)
     b = virtual_campaign(pr, rng=np.random.default_rng(1), stop=False, **kw)
     assert a.converged_after == b.converged_after is not None and len(b.cuts) == 4
@@ -933,7 +962,8 @@ def test_a_campaign_without_a_stop_makes_the_same_cuts_and_reports_calibration()
     # against the truth's zero-order limit at the recommended speed
     rng = np.random.default_rng(1)
     rng.standard_normal(pr.sigma.size)
-    post = update(pr, [], rng=rng, n_samples=200, lobe_samples=100, label_offset=(0, 0), label_growth=(0, 0))
+    post = update(pr, [], rng=rng, forward="zoa", n_samples=200, lobe_samples=100, label_offset=(0, 0),
+                  label_growth=(0, 0))
     truth = _limits(pr, b.theta_true[None, :], pr.freq_grid(), post.rpm)[0]
     j = int(np.argmin(np.abs(post.rpm - post.recommended["rpm"])))
     assert b.below_recommended[0] == bool(truth[j] < post.recommended["depth_m"])
@@ -952,7 +982,7 @@ def test_cli_update_says_when_a_cut_lies_off_the_lobes_or_its_chatter_off_the_mo
     p = tmp_path / "cuts.csv"
     p.write_text("rpm,depth_mm,result,chatter_hz\n40000,0.5,stable,\n20000,0.9,chatter,50000\n"
                  "20000,0.95,chatter,3080\n")
-    assert main(["update", "--prior", str(prior), "--cuts", str(p), "--out", str(tmp_path / "o"),
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(p), "--out", str(tmp_path / "o"),
                  "--samples", "300"]) == 0
     err = [w for w in capsys.readouterr().err.splitlines() if "warning" in w]
     assert len(err) == 2, err

@@ -57,10 +57,10 @@ def register(sub) -> None:
     p.add_argument("--cut-duration",
                    help="how long each test cut lasted, s, where the table has no duration_s and no record "
                    "(default 1; shorter is the safer guess)")
-    p.add_argument("--forward", choices=("zoa", "sdm"), default="zoa",
-                   help="forward model: zoa = zero-order limit (default); sdm = zero-order corrected by the "
-                   "semi-discretisation at posterior samples (cuts that follow the SDM, low radial immersion; "
-                   "slower)")
+    p.add_argument("--forward", choices=("sdm", "zoa"), default="sdm",
+                   help="forward model: sdm = zero-order limit corrected by the semi-discretisation at posterior "
+                   "samples, as a machine's cuts follow it (default; what the virtual campaigns were measured "
+                   "with); zoa = zero-order limit alone (faster; biased at low radial immersion)")
     p.set_defaults(func=run)
 
 

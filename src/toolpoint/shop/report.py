@@ -6,8 +6,9 @@ In the output folder (written atomically, all or none of each file):
 * ``p_stable.csv`` — first row ``depth_mm\\rpm`` and the speeds, then one row per depth (mm) of P(stable);
 * ``parameters.csv`` — ``name, unit, prior_p05, prior_p50, prior_p95, post_p05, post_p50, post_p95``
   (K_t in N/mm²);
-* ``update.json`` — recommended point, next test cut (rule, rpm, depth_mm, P(chatter)), the test cuts,
-  sampler diagnostics (method, ESS per tempering step, acceptance, CPU s);
+* ``update.json`` — recommended point, next test cut (rule, rpm, depth_mm, P(chatter)), the test cuts (each with
+  its record and part, where the table named one), the forward model and sampler diagnostics (method, ESS per
+  tempering step, acceptance, CPU s);
 * ``lobes.png`` — prior and posterior bands, the P(stable) map, the test cuts, the next cut;
 * ``report.html`` — one self-contained page (figure embedded) of all of the above.
 """
@@ -40,30 +41,49 @@ def _unit(name):
 
 
 def plot_update(post: Posterior):
-    """Figure: P(stable) map, prior band (grey), posterior 5/50/95 % (blue), test cuts, next cut."""
+    """Figure: P(stable) map, prior band (grey), posterior 5/50/95 % (blue), test cuts, next cut — over the whole
+    speed range (left) and near the cuts, the recommended speed and the next cut (right), where a few % of speed
+    and depth decide and the full range's markers sit on each other."""
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(9, 5))
-    ax = fig.add_subplot()
+    fig = Figure(figsize=(12, 5))
+    full, near = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 2]})
     mm = 1e3
-    mesh = ax.pcolormesh(post.rpm, post.depth_m * mm, post.p_stable, cmap="RdYlGn", vmin=0, vmax=1,
-                         shading="nearest", alpha=0.5, rasterized=True)
-    fig.colorbar(mesh, ax=ax, label="P(stable)")
-    ax.fill_between(post.rpm, post.prior_limit_q_m[0] * mm, post.prior_limit_q_m[2] * mm, color="grey", alpha=0.25,
-                    label="prior 5–95 %")
-    ax.fill_between(post.rpm, post.limit_q_m[0] * mm, post.limit_q_m[2] * mm, color="tab:blue", alpha=0.3,
-                    label="posterior 5–95 %")
-    ax.plot(post.rpm, post.limit_q_m[1] * mm, color="tab:blue", lw=1.5, label="posterior median")
-    for c in post.cuts:
-        ax.plot(c.rpm, c.depth_m * mm, "o" if c.stable else "x", color="green" if c.stable else "red", ms=7, mew=2)
     nc, rc = post.next_cut, post.recommended
-    ax.plot(nc["rpm"], nc["depth_m"] * mm, "D", mfc="none", mec="k", ms=9, label=f"next cut ({nc['rule']})")
-    ax.plot(rc["rpm"], rc["depth_m"] * mm, "*", color="gold", mec="k", ms=13, label="recommended (P stable 0.95)")
-    ax.set_ylim(0, post.depth_m[-1] * mm)
-    ax.set_xlabel("spindle speed, rpm")
-    ax.set_ylabel("axial depth, mm")
-    ax.set_title(f"{post.prior.name}: {len(post.cuts)} test cuts ({post.method})", fontsize=10)
-    ax.legend(fontsize=7, loc="upper left")
+    for ax in (full, near):
+        mesh = ax.pcolormesh(post.rpm, post.depth_m * mm, post.p_stable, cmap="RdYlGn", vmin=0, vmax=1,
+                             shading="nearest", alpha=0.5, rasterized=True)
+        ax.fill_between(post.rpm, post.prior_limit_q_m[0] * mm, post.prior_limit_q_m[2] * mm, color="grey",
+                        alpha=0.25, label="prior 5–95 %")
+        ax.fill_between(post.rpm, post.limit_q_m[0] * mm, post.limit_q_m[2] * mm, color="tab:blue", alpha=0.3,
+                        label="posterior 5–95 %")
+        ax.plot(post.rpm, post.limit_q_m[1] * mm, color="tab:blue", lw=1.5, label="posterior median")
+        for stable, mark, color, label in ((True, "o", "green", "stable cut"), (False, "x", "red", "chatter cut")):
+            cs = [c for c in post.cuts if c.stable == stable]
+            if cs:
+                ax.plot([c.rpm for c in cs], [c.depth_m * mm for c in cs], mark, color=color, ms=7, mew=2,
+                        ls="none", label=label, zorder=5)
+        ax.plot(nc["rpm"], nc["depth_m"] * mm, "D", mfc="none", mec="k", ms=9, label=f"next cut ({nc['rule']})",
+                zorder=4)
+        ax.plot(rc["rpm"], rc["depth_m"] * mm, "*", color="gold", mec="k", ms=13,
+                label=f"recommended (P stable {rc['p_stable']:.2f})", zorder=4)
+        ax.set_xlabel("spindle speed, rpm")
+    fig.colorbar(mesh, ax=near, label="P(stable)")
+    full.set_ylim(0, post.depth_m[-1] * mm)
+    full.set_ylabel("axial depth, mm")
+    full.set_title(f"{post.prior.name}: {len(post.cuts)} test cuts ({post.method}, {post.forward})", fontsize=10)
+    full.legend(fontsize=7, loc="upper left")
+    # near: the speeds of the cuts, the recommendation and the next cut, ±4 % around them; depths to 1.3 × the
+    # deepest of the cuts and the band there
+    r = np.array([c.rpm for c in post.cuts] + [nc["rpm"], rc["rpm"]])
+    lo, hi = 0.96 * r.min(), 1.04 * r.max()
+    inside = (post.rpm >= lo) & (post.rpm <= hi)
+    top = max([c.depth_m for c in post.cuts] + [nc["depth_m"], rc["depth_m"]]
+              + list(post.limit_q_m[2][inside]))
+    near.set_xlim(lo, hi)
+    near.set_ylim(0, min(1.3 * top, post.depth_m[-1]) * mm)
+    near.set_title("near the cuts and the recommendation", fontsize=10)
+    fig.tight_layout()
     return fig
 
 
@@ -82,9 +102,10 @@ def _doc(post: Posterior) -> dict:
                         "own_sdm_held_out": rc["own_sdm_held_out"]},
         "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},
         "cuts": [{"rpm": c.rpm, "depth_mm": round(1e3 * c.depth_m, 6), "result": "stable" if c.stable else "chatter",
-                  "chatter_hz": c.chatter_hz, "duration_s": c.duration_s,
+                  "chatter_hz": c.chatter_hz, "duration_s": c.duration_s, "record": c.record,
                   "warnings": [f"line {c.line}: {w}" if c.line else w for w in c.warnings]} for c in post.cuts],
-        "sampler": {"method": post.method, "samples": int(post.z.shape[0]), "ess": [round(e, 1) for e in post.ess],
+        "sampler": {"method": post.method, "forward": post.forward, "samples": int(post.z.shape[0]),
+                    "ess": [round(e, 1) for e in post.ess],
                     "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
                     "cpu_s": round(post.cpu_s, 2)},
     }
@@ -151,8 +172,8 @@ def _html(post, doc, rows, png) -> str:
     e = html.escape
     rc, nc = doc["recommended"], doc["next_cut"]
     cut_rows = "".join(f"<tr><td>{c['rpm']:.0f}</td><td>{c['depth_mm']:.3f}</td><td>{c['result']}</td>"
-                       f"<td>{'' if c['chatter_hz'] is None else format(c['chatter_hz'], '.1f')}</td></tr>"
-                       for c in doc["cuts"])
+                       f"<td>{'' if c['chatter_hz'] is None else format(c['chatter_hz'], '.1f')}</td>"
+                       f"<td>{e(c['record'] or '')}</td></tr>" for c in doc["cuts"])
     par_rows = "".join("<tr>" + "".join(f"<td>{e(str(v))}</td>" for v in r) + "</tr>" for r in rows)
     s = doc["sampler"]
     caveat = f"<p><b>Note</b>: {e(away_note(doc['cuts']))}</p>" if doc["cuts"] else ""
@@ -171,10 +192,12 @@ def _html(post, doc, rows, png) -> str:
         f"{e(nc['description'])}): {nc['rpm']:.0f} rpm at {nc['depth_mm']:.3f} mm, P(chatter) "
         f"{nc['p_chatter']:.2f}.</p>{caveat}"
         f"<img alt='lobes' style='max-width:100%' src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
-        f"<h2>Test cuts</h2><table><tr><th>rpm</th><th>depth mm</th><th>result</th><th>chatter Hz</th></tr>"
+        "<h2>Test cuts</h2><table><tr><th>rpm</th><th>depth mm</th><th>result</th><th>chatter Hz</th>"
+        "<th>record</th></tr>"
         f"{cut_rows}</table>"
         "<h2>Parameters (5 / 50 / 95 %)</h2><table><tr><th>name</th><th>unit</th><th>prior 5</th><th>prior 50</th>"
         f"<th>prior 95</th><th>post 5</th><th>post 50</th><th>post 95</th></tr>{par_rows}</table>"
-        f"<p>Sampler: {e(s['method'])}, {s['samples']} samples, ESS per step {e(str(s['ess']))}, acceptance "
+        f"<p>Forward model: {e(s['forward'])}. Sampler: {e(s['method'])}, {s['samples']} samples, ESS per step "
+        f"{e(str(s['ess']))}, acceptance "
         f"{s['acceptance']}, {s['cpu_s']} s CPU. Files: lobes.csv, p_stable.csv, parameters.csv, update.json.</p>"
         "</body></html>")

@@ -102,8 +102,9 @@ DEFAULT_RISK = {"info": 0.3, "risk": 0.1}
 @dataclass(frozen=True)
 class TestCut:
     """One test cut: speed (rpm), depth (m), stable or not, measured chatter frequency (Hz) if any, how long
-    the tool cut (s; None: not known, :func:`update`'s ``cut_duration_s``), and what the analysis of its record
-    could not rule out (``warnings``: :func:`toolpoint.shop.analyse_cut`'s, e.g. chatter on a mains harmonic)."""
+    the tool cut (s; None: not known, :func:`update`'s ``cut_duration_s``), what the analysis of its record
+    could not rule out (``warnings``: :func:`toolpoint.shop.analyse_cut`'s, e.g. chatter on a mains harmonic) and
+    the record (``record``: the table's file name, with its part ``(start–end s)`` where the row names one)."""
 
     __test__ = False  # a shop's test cut, not a pytest test class
 
@@ -115,6 +116,7 @@ class TestCut:
     source: str | None = None
     duration_s: float | None = None
     warnings: tuple = ()
+    record: str | None = None
 
 
 def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
@@ -236,7 +238,7 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             raise InputError(f"line {line}: empty (and no record)", file=p, field="result")
         if res == "stable" and fc is not None:
             raise InputError(f"line {line}: a stable cut has no chatter frequency", file=p, field="chatter_hz")
-        cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p), dur, warns))
+        cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p), dur, warns, what if rec else None))
     if not cuts:
         raise InputError("no test cuts", file=p, field="rpm")
     check_consistent(cuts, source=str(p))
@@ -384,6 +386,7 @@ class Posterior:
     cpu_s: float
     label_offset: tuple = (0.0, 0.0)
     label_growth: tuple = (0.0, 0.0)
+    forward: str = "sdm"
 
     @property
     def theta(self) -> np.ndarray:
@@ -420,7 +423,7 @@ def _ess(logw):
 def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int = 1000, method: str = "smc",
            rpm_grid=None, n_moves: int = 3, boundary_width: float = 0.05, label_noise: float = 0.002,
            freq_sigma: float = 0.02, rule: str = "info", risk: float | None = None, lobe_samples: int = 400,
-           n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "zoa", sdm_refs: int = 4,
+           n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "sdm", sdm_refs: int = 4,
            min_step: float | None = None, sdm_train: int = 0, miss_rate: float = 0.0,
            label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
            cut_duration_s: float = 1.0, risk_after_chatter: float | None = None,
@@ -453,9 +456,13 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         Depths of the P(stable) map.
     chatter_cost : float, default 0
         ``"info"`` rule: added to the expected log width per unit P(chatter) (0: only the ``risk`` bound).
-    forward : {"zoa", "sdm"}, default "zoa"
-        ``"sdm"``: after the zero-order posterior, the semi-discretisation limit of ``sdm_refs`` posterior
-        samples at the cut speeds and on the lobe grid gives ln(a_SDM / a_ZOA); the posterior is sampled again
+    forward : {"sdm", "zoa"}, default "sdm"
+        ``"zoa"``: the zero-order limit alone — cheaper, and biased against a machine's cuts where the ZOA is
+        (low radial immersion, the flip lobes at low speeds); the whole-loop figures of ``docs/design/shop.md``
+        were all measured with ``"sdm"``, the default since 2026-11-28 (*The default forward model* there says
+        what ``"zoa"`` gives in that loop). ``"sdm"``: after the zero-order posterior, the semi-discretisation
+        limit of ``sdm_refs`` posterior samples at the cut speeds and on the lobe grid gives ln(a_SDM / a_ZOA);
+        the posterior is sampled again
         with the zero-order limit times the references' mean ratio at each cut speed (their spread added to
         the boundary width), and each lobe sample is multiplied by one reference's ratio. For cuts that
         follow the SDM (time domain, a real machine) where the ZOA is biased (low radial immersion). Without
@@ -688,7 +695,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         if not cuts:  # measured calibrated with the lobe samples (docs/design/shop.md): kept on them
             nxt = _first_cut_own(prior, z[pick, :P], f, grid, lim, nxt, bound)
     return Posterior(prior, cuts, method, z, tuple(ess_hist), float(np.mean(acc)) if acc else float("nan"), grid, q,
-                     depths, p_st, qp, rec, nxt, time.process_time() - c0, (off_mu, off_sd), (g_med, g_sd))
+                     depths, p_st, qp, rec, nxt, time.process_time() - c0, (off_mu, off_sd), (g_med, g_sd), forward)
 
 
 def _draw_z(rng, n, free):
