@@ -217,8 +217,8 @@ def test_a_record_of_several_responses_reads_the_channel_chosen(tmp_path, capsys
         read_record(tri)
     assert exc.value.field == "channel" and "3 response columns: choose one with --channel (0: Ax (g), 1: Ay (g), " \
         "2: Az (g))" in exc.value.message
-    with pytest.raises(InputError, match=r"tri\.csv: channel: channel 3 does not exist \(the record's responses "
-                                         r"has 3: 0\.\.2\)"):
+    with pytest.raises(InputError, match=r"tri\.csv: channel: channel 3 does not exist \(the record has 3 response "
+                                         r"columns: 0\.\.2\)"):
         read_record(tri, channel=3)
     assert np.array_equal(read_record(ref.source, channel=0).response, ref.response)  # one response: 0 or nothing
     # a UFF file's response time histories, in file order

@@ -731,7 +731,8 @@ def test_a_record_of_cuts_at_two_speeds_is_refused_and_judged_in_parts(tmp_path,
     b, _, *_ = shop_record(rpm=8000, teeth=4, seed=3, chatter_hz=1234.0, chatter_amp=0.5)
     c, _, *_ = shop_record(rpm=6000, teeth=4, seed=2, chatter_hz=1234.0, chatter_amp=0.5)
     x = np.concatenate([a, b])
-    with pytest.raises(InputError, match=r"rpm: the cut at 5\.0–7\.0 s ran at another spindle speed, ≈ 8000 rpm"):
+    with pytest.raises(InputError, match=r"rpm: the cut at 5\.0–7\.0 s ran at another spindle speed, ≈ 8000 rpm.*"
+                                         r"--start/--end \(that cut with its air: 4\.0–7\.5 s\)"):
         analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0)
     with pytest.raises(InputError, match=r"rpm: the cut at 1\.0–3\.0 s ran at another spindle speed, ≈ 600[01] rpm"):
         analyse_cut(x, rate, rpm=8000, teeth=4, full_scale=1.0)
@@ -767,6 +768,15 @@ def test_a_record_of_cuts_at_two_speeds_is_refused_and_judged_in_parts(tmp_path,
     said = capsys.readouterr().out.splitlines()
     assert said[0].startswith("session.wav: chatter at 123") and said[1].startswith("session.wav: 2 cuts: 1.0–3.0 s "
                                                                                        "stable; 5.0–7.0 s chatter at")
+    # … each with the part that holds its air: judged there, a cut keeps its verdict; a part of the cut alone warns
+    assert said[1].endswith("(each with its air, to judge alone with --start/--end: 0.5–4.0 s, 4.0–7.5 s)"), said[1]
+    assert np.allclose([c["part_s"] for c in json.loads((tmp_path / "s.json").read_text())["cuts"]],
+                       [[0.5, 4.0], [4.0, 7.5]], atol=0.02)
+    assert analyse_cut(y, rate, rpm=6000, teeth=4, full_scale=1.0, span_s=same.parts[1]).verdict == "chatter"
+    alone = analyse_cut(y, rate, rpm=6000, teeth=4, full_scale=1.0, span_s=(5.2, 6.8))
+    assert any(w.startswith("the part 5.2–6.8 s holds no air cut") for w in alone.criterion["warnings"])
+    assert not any("holds no air cut" in w for w in analyse_cut(y, rate, rpm=6000, teeth=4, full_scale=1.0,
+                                                             span_s=same.parts[0]).criterion.get("warnings", ()))
     # … and a test-cut table's row, which is one cut, is warned that its record holds two that disagree
     from toolpoint.shop.update import read_test_cuts
 

@@ -644,7 +644,8 @@ def test_a_table_row_names_its_part_of_a_session_record(tmp_path):
     # a record of two speeds without a part: refused in the table's words, naming the line and the record
     p.write_text("rpm,depth_mm,result,record\n6000,0.5,,two.wav\n")
     with pytest.raises(InputError, match=r"line 2: its record two.wav was not judged: rpm: the cut at 5\.0–7\.0 s ran "
-                                         r"at another spindle speed.*its own row \(rpm, start_s, end_s\)"):
+                                         r"at another spindle speed.*its own row \(rpm; start_s, end_s: that cut with "
+                                         r"its air is 4\.0–7\.5 s\)"):
         read_test_cuts(p, teeth=4)
     # the part's own refusal and contradiction name it
     p.write_text("rpm,depth_mm,result,record,start_s,end_s\n6000,0.8,stable,session.wav,4,8\n")

@@ -111,7 +111,9 @@ def run(args) -> int:
     print(msg, file=sys.stderr if out is None else sys.stdout)
     if len(res.cuts) > 1:  # a session's record: each cut's verdict
         print(f"{rec_path.name}: {len(res.cuts)} cuts: " + "; ".join(
-            f"{a:.1f}–{b:.1f} s {v}" + (f" at {hz:.1f} Hz" if hz else "") for a, b, v, hz in res.cuts),
+            f"{a:.1f}–{b:.1f} s {v}" + (f" at {hz:.1f} Hz" if hz else "") for a, b, v, hz in res.cuts)
+            + " (each with its air, to judge alone with --start/--end: "
+            + ", ".join(f"{p0:.1f}–{p1:.1f} s" for p0, p1 in res.parts) + ")",
             file=sys.stderr if out is None else sys.stdout)
     for w in res.criterion.get("warnings", ()):
         print(f"{rec_path.name}: warning: {w}", file=sys.stderr)

@@ -336,7 +336,8 @@ def read_record(path, *, response: str = "acceleration", channel: int | None = N
     Text (any extension but ``.uff``/``.unv``/``.uf``): three columns separated
     by commas, tabs or spaces, or more — time, force and several responses (a
     triaxial accelerometer, two directions), of which ``channel`` picks one; an
-    optional header line; lines starting with ``#`` or ``%`` are comments. Where the header names units (``Accel (g)``,
+    optional header line; lines starting with ``#`` or ``%`` are comments.
+    Where the header names units (``Accel (g)``,
     ``Time (ms)``, ``force_kn``, a DAQ's units row under the names) they are
     converted to s, N and SI; a voltage, or a response of another kind than
     ``response``, is refused. UFF: the file's datasets 58 of function type 1
@@ -388,8 +389,8 @@ def read_record(path, *, response: str = "acceleration", channel: int | None = N
     if not rows:
         raise InputError("no data rows", file=path, field="data")
     # the response: one of several columns after the force (a triaxial accelerometer), chosen as `cut` chooses
-    k = 2 + channel_index(width - 2, channel, path, "the record's responses",
-                          [names[j] for j in keep[2:]] if names else None, kind="response columns")
+    k = 2 + channel_index(width - 2, channel, path, "the record", [names[j] for j in keep[2:]] if names else None,
+                          kind="response columns")
     rows = [(n, [cells[0], cells[1], cells[k]]) for n, cells in rows]
     keep = [keep[0], keep[1], keep[k]]
     try:
@@ -470,7 +471,7 @@ def _read_uff_record(path, channel: int | None = None) -> Record:
                          f"{len(force)} and {len(resp)} among: {names}", file=path, field="ordinate_spec_data_type")
     from .records import channel_index
 
-    resp = [resp[channel_index(len(resp), channel, path, "the record's responses",
+    resp = [resp[channel_index(len(resp), channel, path, "the record",
                                [f"dataset {s} {h.get('id1', '')!s}".strip() for s, h in resp],
                                kind="response time histories")]]
     data = []

@@ -206,13 +206,14 @@ def _pick(data: np.ndarray, channel: int | None, p: Path, what: str, names=None)
                                  f"{100 * np.var(mean) / each:.2g} % of their power: one is inverted?); choose one "
                                  f"with --channel (0..{n - 1})", file=p, field="channel")
             return mean, f"mean of {n}"
-    k = channel_index(n, channel, p, what, names)
+    k = channel_index(n, channel, p, what, names, kind="channels" if what == "audio" else "signal columns")
     return data[:, k], label(k)
 
 
 def channel_index(n: int, channel: int | None, p, what: str, names=None, kind: str = "signal columns") -> int:
-    """The channel of ``n`` to read: the given one (0-based), or the only one; several without a choice are refused
-    listing them (``names``, e.g. the header's), as is a channel that does not exist."""
+    """The channel of ``n`` ``kind`` (``what`` holds them) to read: the given one (0-based), or the only one;
+    several without a choice are refused listing them (``names``, e.g. the header's), as is a channel that does not
+    exist."""
     if channel is None:
         if n == 1:
             return 0
@@ -220,7 +221,8 @@ def channel_index(n: int, channel: int | None, p, what: str, names=None, kind: s
                          + (f"({', '.join(f'{k}: {names[k]}' for k in range(n))})" if names else f"(0..{n - 1})"),
                          file=p, field="channel")
     if not (0 <= channel < n):
-        raise InputError(f"channel {channel} does not exist ({what} has {n}: 0..{n - 1})", file=p, field="channel")
+        raise InputError(f"channel {channel} does not exist ({what} has {n} {kind}: 0..{n - 1})", file=p,
+                         field="channel")
     return channel
 
 

@@ -347,12 +347,29 @@ class CutAnalysis:
             run = []
         return tuple(out)
 
+    @property
+    def parts(self) -> tuple:
+        """Each of :attr:`cuts` with its air: (start s, end s) from the middle of the air cut before it to the middle
+        of the air cut after it (the record's ends where there is none) — what ``cut --start --end`` or a test-cut
+        table's ``start_s``/``end_s`` should name to judge that cut alone: a part of the cut alone has no air cut
+        to tell the machine's lines from chatter (a part warns of it)."""
+        segs, out = self.segments, []
+        for a, b, *_ in self.cuts:
+            i = next(k for k, g in enumerate(segs) if g.start_s == a)
+            j = next(k for k, g in enumerate(segs) if g.end_s == b)
+            p0 = 0.5 * (segs[i - 1].start_s + a) if i > 0 and segs[i - 1].kind == "air" else a
+            p1 = 0.5 * (b + segs[j + 1].end_s) if j + 1 < len(segs) and segs[j + 1].kind == "air" else b
+            out.append((p0, p1))
+        return tuple(out)
+
     def to_dict(self) -> dict:
         """The JSON document of ``toolpoint cut`` (no spectrogram)."""
         return {"verdict": self.verdict,
                 "chatter_hz": None if self.chatter_hz is None else round(float(self.chatter_hz), 2),
                 "cuts": [{"start_s": round(float(a), 4), "end_s": round(float(b), 4), "verdict": v,
-                          "chatter_hz": None if hz is None else round(float(hz), 2)} for a, b, v, hz in self.cuts],
+                          "chatter_hz": None if hz is None else round(float(hz), 2),
+                          "part_s": [round(float(p0), 2), round(float(p1), 2)]}
+                         for (a, b, v, hz), (p0, p1) in zip(self.cuts, self.parts)],
                 "segments": [s.to_dict() for s in self.segments],
                 "rpm_nominal": float(self.rpm_nominal), "rpm_measured": round(float(self.rpm), 2),
                 "teeth": int(self.teeth),
@@ -713,6 +730,11 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         k0 = int(round(a * rate_hz))
         res = analyse_cut(x[k0:int(round(min(b, dur) * rate_hz))], rate_hz, **kw)
         crit = dict(res.criterion, span_s=[a, min(b, dur)])
+        if not any(g.kind == "air" for g in res.segments):  # the air cut may lie just outside the part given
+            crit["warnings"] = [*crit.get("warnings", ()), (
+                f"the part {a:g}–{min(b, dur):.4g} s holds no air cut: its verdict rests on the cut alone (a chatter "
+                "line must stand out by its own strength, aliases or growth, not by rising over the air); where the "
+                "record has air cut before and after this cut, take it in (the cuts' part_s in cut.json)")]
         if "digital_silence_s" in crit:
             crit["digital_silence_s"] = [[u + a, v + a] for u, v in crit["digital_silence_s"]]
         return _shifted(res, a, crit)
@@ -1321,11 +1343,15 @@ def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, inb
             continue  # … while they hear the speed read: else it is the whole record's speed that is off
         ref = cut_runs[rest[0]]
         ta, tb = cut_runs[min(group)][0], cut_runs[max(group)][1]
+        # that cut with its air: from the middle of the air before it to the middle of the air after it
+        pa = next((0.5 * (u + w) for u, w, v in runs if not v and w == ta), ta)
+        pb = next((0.5 * (u + w) for u, w, v in runs if not v and u == tb), tb)
         raise InputError(f"the cut at {ta:.1f}–{tb:.1f} s ran at another spindle speed, ≈ {60 * f_run:.0f} rpm: the "
                          f"harmonics of that speed that are none of {60 * f_s:.0f} rpm's stand {u_e:.0f} dB over "
                          f"the floor there, those of {60 * f_s:.0f} rpm (the speed of the cut at {ref[0]:.1f}–"
                          f"{ref[1]:.1f} s) {u_s:.0f} dB; one --rpm judges one speed: judge each part with its own "
-                         "--rpm and --start/--end, or cut the record in two (heavy chatter can make such lines: "
+                         f"--rpm and --start/--end (that cut with its air: {pa:.1f}–{pb:.1f} s), or cut the record "
+                         "in two (heavy chatter can make such lines: "
                          "judged alone, that cut's verdict stands)", file=source, field="rpm")
 
 

@@ -82,6 +82,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -208,8 +209,9 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                                 span_s=span, **(cut_options or {}))
             except InputError as e:  # a record `cut` will not judge (its spindle not heard, clipped, too short …)
                 # `cut`'s advice in the table's words: a row's part of a record is its start_s and end_s
-                why = (f"{e.field}: " if e.field else "") + e.message.replace(
-                    "its own --rpm and --start/--end", "its own row (rpm, start_s, end_s)")
+                why = (f"{e.field}: " if e.field else "") + re.sub(
+                    r"its own --rpm and --start/--end \(that cut with its air: ([^)]*)\)",
+                    r"its own row (rpm; start_s, end_s: that cut with its air is \1)", e.message)
                 if not res:
                     raise InputError(f"line {line}: its record {what} was not judged: {why}", file=p,
                                      field="record") from None
