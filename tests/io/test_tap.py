@@ -221,6 +221,13 @@ def test_a_record_of_several_responses_reads_the_channel_chosen(tmp_path, capsys
                                          r"columns: 0\.\.2\)"):
         read_record(tri, channel=3)
     assert np.array_equal(read_record(ref.source, channel=0).response, ref.response)  # one response: 0 or nothing
+    # the force where the header puts it (a DAQ orders its channels by number): by its unit, or by its name
+    for head, cols, ch in (("Time (s),Ay (g),Force (N)", (t, a / 9.80665, f), None),
+                           ("time,ax,hammer,ay", (t, 0.5 * a, f, a), 1)):
+        q = tmp_path / "order.csv"
+        q.write_text(head + "\n" + "".join(",".join(f"{v:.12g}" for v in row) + "\n" for row in zip(*cols)))
+        got = read_record(q, channel=ch)
+        assert np.allclose(got.force_n, f, rtol=1e-9) and np.allclose(got.response, a, rtol=1e-6), head
     # a UFF file's response time histories, in file order
     u = tmp_path / "two.uff"
     uff_record(u, t, f, a)

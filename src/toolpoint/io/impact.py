@@ -71,6 +71,7 @@ Bad input raises :class:`~toolpoint.errors.InputError` naming the file and field
 from __future__ import annotations
 
 import os
+import re
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -336,7 +337,9 @@ def read_record(path, *, response: str = "acceleration", channel: int | None = N
     Text (any extension but ``.uff``/``.unv``/``.uf``): three columns separated
     by commas, tabs or spaces, or more — time, force and several responses (a
     triaxial accelerometer, two directions), of which ``channel`` picks one; an
-    optional header line; lines starting with ``#`` or ``%`` are comments.
+    optional header line; lines starting with ``#`` or ``%`` are comments. The
+    force is the second column, or the one column the header names a force (a
+    unit of force, or "force"/"hammer" in its name) wherever it stands.
     Where the header names units (``Accel (g)``,
     ``Time (ms)``, ``force_kn``, a DAQ's units row under the names) they are
     converted to s, N and SI; a voltage, or a response of another kind than
@@ -369,7 +372,8 @@ def read_record(path, *, response: str = "acceleration", channel: int | None = N
     """
     if Path(path).suffix.lower() in (".uff", ".unv", ".uf"):
         return _read_uff_record(path, channel)
-    from .frf_files import _check_not_cut, _is_number, _read_text, column_names, drop_empty_columns, numeric_lines
+    from .frf_files import (_check_not_cut, _is_number, _read_text, column_names, column_unit, drop_empty_columns,
+                             numeric_lines)
     from .records import channel_index
 
     rows = []
@@ -388,11 +392,20 @@ def read_record(path, *, response: str = "acceleration", channel: int | None = N
         rows.append((n, cells))
     if not rows:
         raise InputError("no data rows", file=path, field="data")
-    # the response: one of several columns after the force (a triaxial accelerometer), chosen as `cut` chooses
-    k = 2 + channel_index(width - 2, channel, path, "the record", [names[j] for j in keep[2:]] if names else None,
-                          kind="response columns")
-    rows = [(n, [cells[0], cells[1], cells[k]]) for n, cells in rows]
-    keep = [keep[0], keep[1], keep[k]]
+    # the force: the second column, unless the header puts it elsewhere (a DAQ orders its channels by number, and the
+    # hammer's need not be the first: "Time (s), Accel (g), Force (N)"): the one column whose unit is a force or
+    # whose name says force or hammer
+    force = 1
+    if names:
+        said = [j for j in range(1, width) if (column_unit(names[keep[j]]) or ("", ""))[1] == "force"
+                or re.search(r"force|hammer", names[keep[j]], re.I)]
+        force = said[0] if len(said) == 1 else 1
+    # the response: one of the other columns (a triaxial accelerometer), chosen as `cut` chooses
+    resp = [j for j in range(1, width) if j != force]
+    k = resp[channel_index(len(resp), channel, path, "the record", [names[keep[j]] for j in resp] if names else None,
+                           kind="response columns")]
+    rows = [(n, [cells[0], cells[force], cells[k]]) for n, cells in rows]
+    keep = [keep[0], keep[force], keep[k]]
     try:
         if any("_" in c for _, cells in rows for c in cells):  # float() reads "1_000"; no data file writes it
             raise ValueError("_")
