@@ -13,9 +13,10 @@ not averaged.
 from __future__ import annotations
 
 import sys
+import warnings
 
 from ..errors import InputError
-from .common import check_number, out_folder, use_agg
+from .common import check_number, out_folder, use_agg, warnings_to_stderr
 
 
 def register(sub) -> None:
@@ -24,9 +25,12 @@ def register(sub) -> None:
                        description="Update the stability lobes of a tool from test cuts (sequential Monte Carlo "
                        "over modal parameters and K_t) and propose the next test cut.")
     src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--prior", help="modal-prior TOML (modes with σ, cut with K_t in N/mm²)")
+    src.add_argument("--prior", help="modal-prior TOML (modes with σ, or a [measured] table naming a tap test's "
+                     "FRF with the σ you state; cut with K_t in N/mm²)")
     src.add_argument("--library", help="a library output folder (with --tool)")
     p.add_argument("--tool", help="tool id in the library output")
+    p.add_argument("--frf", help="with --prior: the measured tool-point FRF (a tap test: toolpoint tap's output, "
+                   "CSV/UFF/CutPro) whose modes the prior takes, in place of the file's [[mode]] tables")
     p.add_argument("--sigma-freq", help="with --library: log standard deviation of the natural frequencies "
                    "(default 0.01: the running spindle's shift, which the library does not model)")
     p.add_argument("--cuts", help="test-cut table CSV (rpm, depth_mm, result[, chatter_hz][, duration_s][, record"
@@ -111,10 +115,20 @@ def run(args) -> int:
     from ..shop.report import away_note, write_update
     from ..shop.update import read_test_cuts, update
 
+    if args.frf is not None and not args.prior:
+        raise InputError("only with --prior (its [cut] and the σ of the measured modes)", file="command line",
+                         field="--frf")
     if args.prior:
-        prior = read_modal_prior(args.prior)
+        with warnings_to_stderr(), warnings.catch_warnings():  # the modal fit's notes on a measured FRF (modes of
+            warnings.simplefilter("always")  # negative modal mass): on stderr, whatever the filters say
+            prior = read_modal_prior(args.prior, frf=args.frf)
     else:
         prior = prior_from_library(args.library, args.tool, **({} if sig_f is None else {"sigma_freq": sig_f}))
+    # the modes the prior rests on (a measured FRF's fit, a library tool's peaks, or the file's own), said
+    print(f"prior {prior.name}: " + "; ".join(
+        f"{f:.1f} Hz, k {k:.3g} N/m, ζ {100 * z:.2f} % (σ {sf:.3g}, {sk:.3g}, {sz:.3g})" for f, k, z, sf, sk, sz in
+        zip(prior.freq_hz, prior.stiffness_n_m, prior.damping, prior.sigma_freq, prior.sigma_stiffness,
+            prior.sigma_damping)) + f"; K_t {prior.cutting.tangential_coeff / 1e6:.4g} N/mm² (σ {prior.sigma_kt:.3g})")
     cuts = read_test_cuts(args.cuts, teeth=prior.cutting.teeth) if args.cuts else []
     use_agg()
     post = update(prior, cuts, rng=np.random.default_rng(int(seed)), n_samples=int(n), method=args.method,

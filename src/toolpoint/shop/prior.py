@@ -21,6 +21,19 @@ Modal-prior TOML (mm and N/mm² at the boundary like the tool library; σ are lo
     sigma_stiffness = 0.1
     sigma_damping = 0.1
 
+Instead of ``[[mode]]`` tables, a ``[measured]`` table takes the modes from a measured tool-point FRF (a tap
+test: ``toolpoint tap``'s output, or any FRF file :func:`toolpoint.io.frf_files.read_frf` reads), with the
+uncertainty the shop states (:func:`prior_from_frf`; path relative to the TOML file, or given to
+:func:`read_modal_prior` as ``frf``)::
+
+    [measured]
+    frf = "tap_frf.csv"
+    sigma_freq = 0.01                  # defaults: FREQ_SIGMA, MEASURED_SIGMA_STIFFNESS, 0.2
+    sigma_stiffness = 0.1
+    sigma_damping = 0.2
+    band_hz = [300, 3000]              # optional: else the trusted band found in the data
+    max_modes = 3                      # optional: the most flexible modes kept
+
 A ``library`` output (``OUT/tools/<id>.npz`` and ``.json``, :mod:`toolpoint.recommend.run`) holds the
 tool's nominal tool-point FRF, the 5/50/95 % quantiles of |Φ| over its sampled joints and its cutting
 conditions. :func:`prior_from_library` is the one adapter from that output to a :class:`ModalPrior`
@@ -46,16 +59,20 @@ from ..errors import InputError
 from ..stability.cutting import CuttingConditions
 from .model import ModalPrior
 
-__all__ = ["read_modal_prior", "prior_from_library", "modes_from_frf", "FREQ_SIGMA"]
+__all__ = ["read_modal_prior", "prior_from_library", "prior_from_frf", "modes_from_frf", "FREQ_SIGMA",
+           "MEASURED_SIGMA_STIFFNESS"]
 
 
-def read_modal_prior(path: str | os.PathLike) -> ModalPrior:
+def read_modal_prior(path: str | os.PathLike, *, frf: str | os.PathLike | None = None) -> ModalPrior:
     """Read a modal-prior TOML file (format in the module docstring).
+
+    ``frf``: a measured tool-point FRF file whose modes the prior takes (:func:`prior_from_frf`), in place of
+    the file's ``[[mode]]`` tables and of its ``[measured]`` table's ``frf`` (that table's σ stay).
 
     Raises
     ------
     InputError
-        Naming the file and the field (``cut.teeth``, ``mode[1].damping``, …).
+        Naming the file and the field (``cut.teeth``, ``mode[1].damping``, ``measured.frf``, …).
     """
     p = Path(path)
     try:
@@ -84,9 +101,22 @@ def read_modal_prior(path: str | os.PathLike) -> ModalPrior:
     cut_t = doc.get("cut")
     if not isinstance(cut_t, dict):
         raise InputError("missing table [cut]", file=p, field="cut")
-    modes = doc.get("mode")
-    if not isinstance(modes, list) or not modes:
-        raise InputError("needs at least one [[mode]]", file=p, field="mode")
+    meas = doc.get("measured")
+    if meas is not None and not isinstance(meas, dict):
+        raise InputError("must be a table", file=p, field="measured")
+    if frf is not None or meas is not None:
+        if "mode" in doc:
+            raise InputError("[[mode]] tables and measured modes ([measured] or an FRF given) both: keep one",
+                             file=p, field="mode")
+        meas = meas or {}
+        if frf is None and "frf" not in meas:
+            raise InputError("missing: the measured FRF file", file=p, field="measured.frf")
+        src = Path(frf) if frf is not None else p.parent / get(meas, "frf", "measured", kind=str)
+    else:
+        modes = doc.get("mode")
+        if not isinstance(modes, list) or not modes:
+            raise InputError("needs at least one [[mode]] (or a [measured] table with the FRF of a tap test)",
+                             file=p, field="mode")
     try:
         cut = CuttingConditions(get(cut_t, "teeth", "cut", kind=int),
                                 get(cut_t, "tangential_coeff_n_mm2", "cut") * 1e6,
@@ -94,6 +124,27 @@ def read_modal_prior(path: str | os.PathLike) -> ModalPrior:
                                 get(cut_t, "milling", "cut", default="down", kind=str))
     except InputError as err:
         raise InputError(err.message, file=p, field=f"cut.{err.field}" if err.field else "cut") from None
+    rng = None
+    if "rpm_min" in cut_t or "rpm_max" in cut_t:
+        rng = (get(cut_t, "rpm_min", "cut"), get(cut_t, "rpm_max", "cut"))
+    sig_kt, sig_kr = get(cut_t, "sigma_kt", "cut", default=0.1), get(cut_t, "sigma_kr", "cut", default=0.05)
+    if meas is not None:
+        band = meas.get("band_hz")
+        if band is not None and not (isinstance(band, list) and len(band) == 2
+                                     and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in band)):
+            raise InputError(f"must be [LO, HI] in Hz, got {band!r}", file=p, field="measured.band_hz")
+        sig = {k: get(meas, k, "measured", default=d) for k, d in
+               (("sigma_freq", FREQ_SIGMA), ("sigma_stiffness", MEASURED_SIGMA_STIFFNESS), ("sigma_damping", 0.2))}
+        for k, v in sig.items():
+            if not 0 <= v <= 1:
+                raise InputError(f"must be from 0 to 1 (a log standard deviation), got {v}", file=p,
+                                 field=f"measured.{k}")
+        n = get(meas, "max_modes", "measured", default=3, kind=int)
+        from ..io.frf_files import read_frf
+
+        return prior_from_frf(read_frf(src, min_points=3), cut, **sig, sigma_kt=sig_kt, sigma_kr=sig_kr,
+                              band=None if band is None else tuple(float(v) for v in band), max_modes=n,
+                              name=str(doc.get("name", p.stem)), rpm_range=rng, source=str(src))
     cols = {k: [] for k in ("freq_hz", "stiffness_n_m", "damping", "sigma_freq", "sigma_stiffness", "sigma_damping")}
     defaults = {"sigma_freq": 0.03, "sigma_stiffness": 0.15, "sigma_damping": 0.2}
     for i, m in enumerate(modes):
@@ -101,13 +152,8 @@ def read_modal_prior(path: str | os.PathLike) -> ModalPrior:
             raise InputError("must be a table", file=p, field=f"mode[{i}]")
         for k in cols:
             cols[k].append(get(m, k, f"mode[{i}]", default=defaults.get(k)))
-    rng = None
-    if "rpm_min" in cut_t or "rpm_max" in cut_t:
-        rng = (get(cut_t, "rpm_min", "cut"), get(cut_t, "rpm_max", "cut"))
     try:
-        return ModalPrior(**{k: tuple(v) for k, v in cols.items()}, cutting=cut,
-                          sigma_kt=get(cut_t, "sigma_kt", "cut", default=0.1),
-                          sigma_kr=get(cut_t, "sigma_kr", "cut", default=0.05),
+        return ModalPrior(**{k: tuple(v) for k, v in cols.items()}, cutting=cut, sigma_kt=sig_kt, sigma_kr=sig_kr,
                           name=str(doc.get("name", p.stem)), rpm_range=rng)
     except InputError as err:
         raise InputError(err.message, file=p, field=err.field) from None
@@ -159,6 +205,96 @@ say how the peaks move, but it bounds it: on the seed-3 campaign's EM12-60 its 5
 on the peaks' flanks, where a frequency shift σ_f would show as ±1.645 σ_f / (2ζ) (≈ ±70 % for σ_f 0.01, ζ
 0.012): the joint and subassembly it samples move the peaks by about 0.1 %. What it never modelled is the
 running spindle (speed and temperature move tool-point modes by about a percent): 0.01, not less."""
+
+
+MEASURED_SIGMA_STIFFNESS = 0.1
+"""Log σ of the modal stiffnesses of a prior made from a measured FRF (stated; a shop that knows its own sets it).
+What it covers: the hammer's and the accelerometer's calibration (a few % each, their certificates), the fit's own
+scatter on a tap test's noise (on 8 virtual tap records of :func:`toolpoint.io.virtual_tap.lab_like_tap`: ln σ
+0.6–1.5 %, within 3.1 % of the modes the records were made from; ``test_a_prior_from_a_measured_frf_holds_its_modes``)
+and the tool as it is clamped for the cut rather than for the tap (a re-clamped tool moves its tool-point stiffness
+by several %). Not measured here on a shop's repeated taps."""
+
+
+def prior_from_frf(frf, cutting: CuttingConditions, *, sigma_freq: float = FREQ_SIGMA,
+                   sigma_stiffness: float = MEASURED_SIGMA_STIFFNESS, sigma_damping: float = 0.2,
+                   sigma_kt: float = 0.1, sigma_kr: float = 0.05, band=None, max_modes: int = 3,
+                   min_share: float = 0.1, name: str = "measured tool", rpm_range=None,
+                   source: str | None = None) -> ModalPrior:
+    """A :class:`ModalPrior` from a measured tool-point FRF (a tap test) and the uncertainty the shop states.
+
+    The FRF enters as every measured FRF does (:func:`toolpoint.trust.common_band`: the trusted band, or ``band``
+    (Hz) given) and its modes are a driving point's modal fit there (:func:`toolpoint.dynamics.modal.fit_frfs`,
+    weighted in the quantity whose noise is white, modes of positive modal mass): f_r, ζ_r and k_r = m_r ω_r² (m_r
+    the real-mode modal mass, :meth:`~toolpoint.dynamics.modal.ModalFit.modal_mass`). Kept: up to ``max_modes``
+    modes whose static flexibility at resonance 1 / (2 ζ_r k_r) is at least ``min_share`` of the largest (the modes
+    that set the lobes). σ: ``sigma_freq`` (default :data:`FREQ_SIGMA`: the running spindle moves the modes a
+    tap test of the stationary one measured), ``sigma_stiffness`` (:data:`MEASURED_SIGMA_STIFFNESS`),
+    ``sigma_damping`` (0.2: damping is the least repeatable of the three and changes with speed), per mode.
+
+    Parameters
+    ----------
+    frf : FRF
+        The measured FRF (any quantity; converted to receptance, m/N).
+    cutting : CuttingConditions
+        The cut (K_t, K_r the medians).
+
+    Returns
+    -------
+    ModalPrior
+
+    Raises
+    ------
+    InputError
+        No trusted band, a fit that fails, or no mode of positive modal mass in the band (naming ``source``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from toolpoint.frf import FRF
+    >>> f = np.arange(10.0, 4000.0, 2.0)
+    >>> h = sum(1 / (k * (1 - (f / fn) ** 2 + 2j * z * f / fn)) for fn, k, z in ((1243, 2.92e6, 0.0619),
+    ...                                                                         (1747, 1.2e7, 0.0288)))
+    >>> pr = prior_from_frf(FRF(f, h), CuttingConditions(4, 2003e6, 0.404, 0.5))
+    >>> [(round(a), round(b / 1e6, 2), round(c, 4)) for a, b, c in zip(pr.freq_hz, pr.stiffness_n_m, pr.damping)]
+    [(1243, 2.92, 0.0619), (1747, 12.0, 0.0288)]
+    """
+    import warnings
+
+    from ..dynamics.modal import DrivingPointWarning, fit_frfs
+    from ..trust import common_band
+
+    h = frf.to_receptance()
+    b = common_band([h], band=band, files=[source], field="measured.band_hz", hint="band_hz = [LO, HI]")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            fit = fit_frfs([b.cut(h)], noise=b.noise_quantity or None, driving_point=0)
+        except InputError as err:
+            raise InputError(f"modal fit of the measured FRF: {err.message}", file=source,
+                             field="measured.frf") from None
+    for w in caught:  # the fit kept modes of negative modal mass: said, with what the prior does with them
+        if issubclass(w.category, DrivingPointWarning):
+            warnings.warn(f"{source or 'the measured FRF'}: {w.message}; the prior leaves those modes out",
+                          DrivingPointWarning, stacklevel=2)
+        else:
+            warnings.warn(w.message, w.category, stacklevel=2)
+    mass = fit.modal_mass(0)
+    ok = np.isfinite(mass) & (mass > 0) & (fit.zeta > 0)
+    if not ok.any():
+        raise InputError(f"no mode of positive modal mass in the band {b.lo_hz:g}–{b.hi_hz:g} Hz (is it the tool "
+                         "tip's direct FRF, a driving point?)", file=source, field="measured.frf")
+    fn, z = fit.fn_hz[ok], fit.zeta[ok]
+    k = mass[ok] * (2 * np.pi * fn) ** 2
+    flex = 1 / (2 * z * k)
+    keep = np.flatnonzero(flex >= min_share * flex.max())
+    keep = keep[np.argsort(-flex[keep])][:max_modes]
+    keep = np.sort(keep)  # by frequency
+    m = keep.size
+    return ModalPrior(tuple(float(v) for v in fn[keep]), tuple(float(v) for v in k[keep]),
+                      tuple(float(v) for v in z[keep]), (sigma_freq,) * m, (sigma_stiffness,) * m,
+                      (sigma_damping,) * m, cutting, sigma_kt=sigma_kt, sigma_kr=sigma_kr, name=name,
+                      rpm_range=rpm_range)
 
 
 def prior_from_library(out_dir: str | os.PathLike, tool_id: str, *, sigma_freq: float = FREQ_SIGMA,
