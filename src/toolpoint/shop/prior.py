@@ -140,6 +140,8 @@ def read_modal_prior(path: str | os.PathLike, *, frf: str | os.PathLike | None =
                 raise InputError(f"must be from 0 to 1 (a log standard deviation), got {v}", file=p,
                                  field=f"measured.{k}")
         n = get(meas, "max_modes", "measured", default=3, kind=int)
+        if n < 1:
+            raise InputError(f"must be ≥ 1, got {n}", file=p, field="measured.max_modes")
         from ..io.frf_files import read_frf
 
         return prior_from_frf(read_frf(src, min_points=3), cut, **sig, sigma_kt=sig_kt, sigma_kr=sig_kr,
