@@ -775,6 +775,18 @@ def test_a_prior_from_a_measured_frf_holds_its_modes(tmp_path, capsys):
             prior_from_frf(FRF(np.arange(1.0, a.size), a[1:], "accelerance"), cut, source=f"meas_point_{k}.txt")
         assert exc.value.field == "measured.frf" and said in exc.value.message, exc.value
 
+def test_a_band_above_the_samples_own_sdm_limit_is_noted():
+    """The band's 5 % limit at the recommended speed more than 5 % above the posterior samples' own SDM 5 % limit (a
+    pocket's peak: 26 % of prior truths below the band's line on the README's tap prior, 4 % below the depth) is said;
+    within 5 %, or without the check, nothing."""
+    from toolpoint.shop.report import pocket_note
+
+    said = pocket_note({"rpm": 13165.8, "limit_p05_mm": 6.4346, "own_sdm_p05_mm": 4.337})
+    assert said.startswith("at 13166 rpm the band's 5 % limit (6.435 mm) lies 48 % above the posterior samples' own "
+                           "SDM 5 % limit (4.337 mm)")
+    assert pocket_note({"rpm": 9000.0, "limit_p05_mm": 1.04, "own_sdm_p05_mm": 1.0}) is None
+    assert pocket_note({"rpm": 9000.0, "limit_p05_mm": 1.5, "own_sdm_p05_mm": None}) is None
+
 def test_the_update_plot_shows_the_cuts_near_the_recommendation():
     """lobes.png's right panel holds every cut, the recommended point and the next cut inside its limits (over the
     whole speed range they sat on each other: the README's figure), with the band there."""

@@ -112,7 +112,7 @@ def run(args) -> int:
     import numpy as np
 
     from ..shop.prior import prior_from_library, read_modal_prior
-    from ..shop.report import away_note, write_update
+    from ..shop.report import away_note, pocket_note, write_update
     from ..shop.update import read_test_cuts, update
 
     if args.frf is not None and not args.prior:
@@ -151,6 +151,10 @@ def run(args) -> int:
               "samples leave fewer than 100 beyond them); --samples 1000 checks it by held-out samples")
     if cuts:
         print("note: " + away_note([{"rpm": c.rpm} for c in cuts]))
+    pocket = pocket_note({"rpm": rc["rpm"], "limit_p05_mm": 1e3 * rc["limit_p05_m"],
+                          "own_sdm_p05_mm": None if rc["own_sdm_p05_m"] is None else 1e3 * rc["own_sdm_p05_m"]})
+    if pocket is not None:
+        print("note: " + pocket)
     for c in cuts:  # a label that rests on a doubtful record: said where the user looks
         for w in c.warnings:
             print(f"{args.cuts}: line {c.line}: warning: {w}", file=sys.stderr)
