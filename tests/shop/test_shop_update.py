@@ -740,7 +740,8 @@ def test_a_prior_from_a_measured_frf_holds_its_modes(tmp_path, capsys):
     assert main([*UPDATE_ZOA, "--prior", str(toml), "--frf", str(path), "--samples", "200", "--out",
                  str(tmp_path / "u")]) == 0
     said = capsys.readouterr()
-    assert said.out.startswith("prior tapped: 1071.") and "0 test cuts; recommended" in said.out
+    assert said.out.startswith("prior tapped (modes of tap.csv, 86–7929 Hz): 1071.")
+    assert "0 test cuts; recommended" in said.out
     toml.write_text('[measured]\nfrf = "tap.csv"\nsigma_stiffness = 0.2\n' + body)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the fit's note on extra poles (the command line prints it)

@@ -304,9 +304,11 @@ def prior_from_frf(frf, cutting: CuttingConditions, *, sigma_freq: float = FREQ_
                          "stiffness are not in the data — measure with finer lines (a longer record: Δf = 1/T) or "
                          "state the modes in [[mode]] tables", file=source, field="measured.frf")
     m = keep.size
+    # the name says where the modes came from and over which band (a mode above a soft tip's band is not in it)
+    where = f"modes of {Path(source).name if source else 'the FRF'}, {b.lo_hz:.0f}–{b.hi_hz:.0f} Hz"
     return ModalPrior(tuple(float(v) for v in fn[keep]), tuple(float(v) for v in k[keep]),
                       tuple(float(v) for v in z[keep]), (sigma_freq,) * m, (sigma_stiffness,) * m,
-                      (sigma_damping,) * m, cutting, sigma_kt=sigma_kt, sigma_kr=sigma_kr, name=name,
+                      (sigma_damping,) * m, cutting, sigma_kt=sigma_kt, sigma_kr=sigma_kr, name=f"{name} ({where})",
                       rpm_range=rpm_range)
 
 

@@ -46,7 +46,8 @@ is plain sampling–importance resampling from the prior, kept to measure agains
 ``docs/design/shop.md``.
 
 Lobes: the posterior samples' zero-order limits on a speed grid (:func:`~toolpoint.stability.zoa_batch.zoa_limits`),
-their 5/50/95 % quantiles and P(stable) = share of samples whose limit exceeds a depth.
+corrected by the semi-discretisation (``forward="sdm"``, the default: a machine's cuts follow the SDM), their
+5/50/95 % quantiles and P(stable) = share of samples whose limit exceeds a depth.
 
 Recommended point: the speed that maximises n · a₀₅(n) (removal rate at a fixed feed per tooth and width)
 at the depth a₀₅ (P(stable) = 0.95); with ``forward="sdm"`` the depth is lowered to the own SDM 5 % limit, at
