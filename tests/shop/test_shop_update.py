@@ -638,6 +638,20 @@ def test_a_table_row_names_its_part_of_a_session_record(tmp_path):
                                                                                                        rel=0.01)
     assert all(c.warnings == () for c in cuts), [c.warnings for c in cuts]  # each part holds one cut
     assert [round(c.duration_s) for c in cuts] == [2, 2, 2, 2]
+    # `cut --table` writes the rows, parts and all; update refuses them until the depths are filled in
+    table = tmp_path / "sub" / "t.csv"
+    table.parent.mkdir()
+    assert main(["cut", str(tmp_path / "session.wav"), "--rpm", "6000", "--teeth", "4", "--out",
+                 str(tmp_path / "s.json"), "--table", str(table)]) == 0
+    rows = table.read_text().splitlines()
+    assert rows[0] == "rpm,depth_mm,result,record,start_s,end_s" and len(rows) == 3
+    assert rows[1].startswith("6000,,,../session.wav,0.5") and rows[2].startswith("6000,,,../session.wav,4.0")
+    with pytest.raises(InputError, match="line 2: empty") as exc:
+        read_test_cuts(table, teeth=4)
+    assert exc.value.field == "depth_mm"
+    table.write_text(rows[0] + "\n" + "\n".join(r.replace("6000,,", f"6000,{d},") for r, d in zip(rows[1:], (0.5, 0.8)))
+                     + "\n")
+    assert [c.stable for c in read_test_cuts(table, teeth=4)] == [True, False]
     # the whole session for one row: warned, and told how to name the part
     p.write_text("rpm,depth_mm,result,record\n6000,0.5,,session.wav\n")
     (w,) = read_test_cuts(p, teeth=4)[0].warnings

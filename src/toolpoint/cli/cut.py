@@ -1,5 +1,5 @@
 """``toolpoint cut RECORD --rpm N --teeth Z [--rate HZ] [--channel K] [--start S] [--end S] [--out cut.json]
-[--plot cut.png]``.
+[--plot cut.png] [--table cuts.csv]``.
 
 Chatter detection from a record of a cut: microphone audio (WAV, FLAC, OGG, MP3), accelerometer or
 displacement time histories (CSV/text columns, time first; one column with ``--rate``; UFF58). Spindle
@@ -8,16 +8,19 @@ strongest remaining peak is tested (:func:`toolpoint.shop.analyse_cut` documents
 segment (air cut, entry, cut windows, exit).
 
 ``cut.json``: ``verdict`` (stable|chatter), ``chatter_hz`` (null when stable), ``cuts`` (start_s, end_s, verdict,
-chatter_hz of each cut between air cuts), ``segments`` (kind, start_s, end_s, verdict, chatter_hz, …),
-``rpm_measured`` (from the spindle harmonics), ``recommended_rpm`` (a tooth-passing harmonic on the chatter
-frequency) and the criterion used. A one-line summary goes to stdout (and a line of each cut's verdict where the
-record holds several). Bad input: one line naming file and field, exit 2.
+chatter_hz of each cut between air cuts, and part_s: the part that holds it with its air), ``segments`` (kind,
+start_s, end_s, verdict, chatter_hz, …), ``rpm_measured`` (from the spindle harmonics), ``recommended_rpm`` (a
+tooth-passing harmonic on the chatter frequency) and the criterion used. A one-line summary goes to stdout (and a
+line of each cut's verdict where the record holds several). ``--table``: a test-cut table for ``toolpoint update``
+(``rpm, depth_mm, result, record, start_s, end_s``, one row per cut, ``depth_mm`` left for the user, ``result`` to
+the record). Bad input: one line naming file and field, exit 2.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -52,6 +55,8 @@ def register(sub) -> None:
                    "several speeds; times stay the record's)")
     p.add_argument("--end", help="judge the record up to this time, s")
     p.add_argument("--out", help="result JSON (default: print it)")
+    p.add_argument("--table", help="also write a test-cut table for `toolpoint update`: one row per cut, with the "
+                   "record and the part that holds the cut with its air (start_s, end_s); fill in depth_mm")
     p.add_argument("--plot", help="spectrogram with the harmonics and segments marked, and the chattering cut's "
                    "mean spectrum against the air cut's (.png/.pdf/.svg)")
     p.set_defaults(func=run)
@@ -62,6 +67,7 @@ def run(args) -> int:
     rec_path = Path(args.record)
     out = out_path(args.out, "--out", inputs=[rec_path]) if args.out else None
     plot = out_path(args.plot, "--plot", inputs=[rec_path]) if args.plot else None
+    table = out_path(args.table, "--table", inputs=[rec_path]) if args.table else None
     rpm = check_number(args.rpm, "--rpm", above=0, unit="rpm")
     teeth = check_whole(args.teeth, "--teeth")
     rate = check_number(args.rate, "--rate", above=0, unit="Hz") if args.rate is not None else None
@@ -99,6 +105,11 @@ def run(args) -> int:
     if out is not None:
         with atomic_open(out) as fh:
             fh.write(text + "\n")
+    if table is not None:  # rows update reads: the record's path relative to the table, each cut's part
+        rel = os.path.relpath(rec_path.resolve(), table.resolve().parent)
+        with atomic_open(table) as fh:
+            fh.write("rpm,depth_mm,result,record,start_s,end_s\n" + "".join(
+                f"{res.rpm_nominal:g},,,{rel},{p0:.2f},{p1:.2f}\n" for p0, p1 in res.parts))
     if fig is not None:
         save_figure(fig, plot)
     if out is None:
