@@ -763,6 +763,7 @@ def test_a_prior_from_a_measured_frf_holds_its_modes(tmp_path, capsys):
     for text, field in (("[measured]\nsigma_freq = 0.01\n" + body, "measured.frf"),
                         ('[measured]\nfrf = "tap.csv"\nsigma_damping = 3\n' + body, "measured.sigma_damping"),
                         ('[measured]\nfrf = "tap.csv"\nmax_modes = 0\n' + body, "measured.max_modes"),
+                        ('[measured]\nfrf = "tap.csv"\nband_hz = [3000, 300]\n' + body, "measured.band_hz"),
                         ('[measured]\nfrf = "none.csv"\n' + body, None),
                         ('[measured]\nfrf = "tap.csv"\n[[mode]]\nfreq_hz = 900\nstiffness_n_m = 1e7\n'
                          'damping = 0.03\n' + body, "mode"),

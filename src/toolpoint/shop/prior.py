@@ -131,7 +131,8 @@ def read_modal_prior(path: str | os.PathLike, *, frf: str | os.PathLike | None =
     if meas is not None:
         band = meas.get("band_hz")
         if band is not None and not (isinstance(band, list) and len(band) == 2
-                                     and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in band)):
+                                     and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in band)
+                                     and 0 <= band[0] < band[1] and math.isfinite(band[1])):
             raise InputError(f"must be [LO, HI] in Hz, got {band!r}", file=p, field="measured.band_hz")
         sig = {k: get(meas, k, "measured", default=d) for k, d in
                (("sigma_freq", FREQ_SIGMA), ("sigma_stiffness", MEASURED_SIGMA_STIFFNESS), ("sigma_damping", 0.2))}
