@@ -776,6 +776,12 @@ def test_a_prior_from_a_measured_frf_holds_its_modes(tmp_path, capsys):
     assert main([*UPDATE_ZOA, "--library", str(tmp_path), "--tool", "x", "--frf", str(path), "--out",
                  str(tmp_path / "v")]) == 2
     assert "--frf: only with --prior" in capsys.readouterr().err
+    # a band that leaves out a dominant mode (a soft tip's, or one given too narrow): the fit's residual pole says
+    # so, and the prior is refused rather than made without it (cut at 1500 Hz: the 1981 Hz mode; at 1100: 1071 Hz)
+    for band, near in (((300.0, 1500.0), "near 20"), ((1100.0, 3000.0), "near 107")):
+        with warnings.catch_warnings(), pytest.raises(InputError, match=f"a mode just outside the band .*{near}"):
+            warnings.simplefilter("ignore")
+            prior_from_frf(frf, cut, band=band, source="tap.csv")
     # real measured accelerances (pyuff's samples, 1 Hz lines, a lightly damped structure): the driving point's
     # dominant mode (51.5 Hz, ζ 0.03 %) falls between the lines, a transfer FRF has no mode of positive mass — both
     # refused, saying what would decide, where a prior "51.5 Hz, ζ 0.03 % ± 20 %" would have claimed what the data

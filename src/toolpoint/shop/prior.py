@@ -249,7 +249,8 @@ def prior_from_frf(frf, cutting: CuttingConditions, *, sigma_freq: float = FREQ_
     Raises
     ------
     InputError
-        No trusted band, a fit that fails, no mode of positive modal mass in the band, or a kept mode narrower than
+        No trusted band, a fit that fails, no mode of positive modal mass in the band, a mode just outside the band
+        as flexible as those inside (the fit's residual pole: the prior would lack it), or a kept mode narrower than
         the line spacing (its damping is not in the data) — naming ``source``.
 
     Examples
@@ -294,6 +295,23 @@ def prior_from_frf(frf, cutting: CuttingConditions, *, sigma_freq: float = FREQ_
     keep = np.flatnonzero(flex >= min_share * flex.max())
     keep = keep[np.argsort(-flex[keep])][:max_modes]
     keep = np.sort(keep)  # by frequency
+    # a mode just outside the band that the fit needed as a residual pole, as flexible as those inside: the prior
+    # would lack it (a band cut at 1100 Hz left out the tap example's 1071 Hz mode, one cut at 1500 Hz its 1981 Hz
+    # mode; the lobes they set would be missing)
+    rp = np.asarray(fit.residual_poles)
+    if rp.size:
+        w_r = np.abs(rp)
+        a_r = -2 * (np.asarray(fit.residual_residues)[:, 0] * np.conj(rp)).real  # 1 / modal mass, as real_modes
+        z_r = -rp.real / w_r
+        with np.errstate(divide="ignore", invalid="ignore"):
+            flex_r = np.where((a_r > 0) & (z_r > 0), a_r / (2 * z_r * w_r ** 2), 0.0)
+        if flex_r.max() >= min_share * flex.max():
+            r = int(np.argmax(flex_r))
+            raise InputError(f"a mode just outside the band {b.lo_hz:.0f}–{b.hi_hz:.0f} Hz, near "
+                             f"{w_r[r] / (2 * np.pi):.0f} Hz, is {flex_r[r] / flex.max():.2g} × as flexible as the "
+                             "strongest inside: the prior would "
+                             "lack it — widen the band (band_hz) or measure there (a harder hammer tip for modes above "
+                             "the band)", file=source, field="measured.frf")
     # a mode whose half-power band 2ζf is narrower than the line spacing is not resolved: its peak, and so its
     # damping and stiffness, fall between the lines (a real driving point at 1 Hz lines: "51.5 Hz, ζ 0.03 %")
     df = float(np.min(np.diff(frf.freq_hz)))
