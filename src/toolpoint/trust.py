@@ -347,7 +347,9 @@ def _noise_slope(frf: FRF) -> str:
     h1, h2 = np.diff(f)[:-1], np.diff(f)[1:]
     r = h[1:-1] - (h2 * h[:-2] + h1 * h[2:]) / (h1 + h2)
     resid = np.abs(r) / np.sqrt(1.0 + (h1**2 + h2**2) / (h1 + h2) ** 2)
-    n = 4 * WINDOW + 1
+    # the window, or the widest odd one the lines hold (a soft tip's band of 45–63 lines made np.convolve's "same"
+    # return the kernel's length, and the slope a broadcasting error)
+    n = min(4 * WINDOW + 1, r.size - 1 - (r.size % 2))
     sigma = _running_median(resid, n) / math.sqrt(math.log(2.0))
     # Noise or curvature? For white noise neighbouring residuals correlate at −2/3; for a smooth FRF's curvature
     # at ≈ +1. Only points where the local lag-1 correlation is clearly negative measure noise.

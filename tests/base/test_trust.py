@@ -341,6 +341,22 @@ def test_noise_quantity_says_accelerance_for_noise_growing_as_one_over_omega_squ
     assert trusted_band(FRF(f, mob)).noise_quantity in ("", "mobility")
 
 
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_soft_tip_s_short_frf_is_judged_not_a_traceback(seed):
+    """A soft hammer tip's band holds few lines (the virtual tap with a rubber tip: 55 lines up to 786 Hz): there
+    np.convolve's "same" returned the 61-point kernel's length and the noise slope raised a broadcasting error —
+    `toolpoint check`, `lobes` and `update` on such an FRF gave a traceback. The window now fits the lines."""
+    from toolpoint.io.impact import Record, impact_frf
+    from toolpoint.io.virtual_tap import lab_like_tap
+
+    rec = lab_like_tap(seed=seed, hits=3, spacing_s=0.07, tip="rubber")
+    frf = impact_frf(Record(rec.time_s, rec.force_n, rec.acceleration_ms2, source="v")).frf.to_receptance()
+    assert 45 <= frf.freq_hz.size < 64  # the lines that crashed
+    b = trusted_band(frf)
+    assert frf.freq_hz[0] <= b.lo_hz < 500 and b.hi_hz == frf.freq_hz[-1]
+
+
 def test_running_median_is_the_windowed_median_with_edge_padding():
     from toolpoint.trust import _running_median
 

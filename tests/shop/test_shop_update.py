@@ -782,6 +782,12 @@ def test_a_prior_from_a_measured_frf_holds_its_modes(tmp_path, capsys):
         with warnings.catch_warnings(), pytest.raises(InputError, match=f"a mode just outside the band .*{near}"):
             warnings.simplefilter("ignore")
             prior_from_frf(frf, cut, band=band, source="tap.csv")
+    # … and a rubber tip's own band (up to 786 Hz), which ends below the dominant mode
+    soft = lab_like_tap(seed=1, hits=3, spacing_s=0.07, tip="rubber")
+    soft_frf = impact_frf(Record(soft.time_s, soft.force_n, soft.acceleration_ms2, source="virtual")).frf
+    with warnings.catch_warnings(), pytest.raises(InputError, match="a mode just outside the band 71–786 Hz, near 10"):
+        warnings.simplefilter("ignore")
+        prior_from_frf(soft_frf, cut, source="rubber.csv")
     # real measured accelerances (pyuff's samples, 1 Hz lines, a lightly damped structure): the driving point's
     # dominant mode (51.5 Hz, ζ 0.03 %) falls between the lines, a transfer FRF has no mode of positive mass — both
     # refused, saying what would decide, where a prior "51.5 Hz, ζ 0.03 % ± 20 %" would have claimed what the data
