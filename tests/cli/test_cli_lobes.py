@@ -423,3 +423,35 @@ def test_trusted_bands_of_x_and_y_on_other_grids_intersect(tmp_path, capsys):
     edges = [float(n.split("trusted band ")[1].split("–")[0]) for n in notes]
     _, data = read(out)
     assert np.all(data[:, 2] >= max(edges)) and data[:, 1].min() == pytest.approx(2.88, abs=0.02)
+
+
+def test_no_chatter_is_not_claimed_from_a_band_below_the_resonance(tmp_path, capsys):
+    """A soft hammer tip's FRF ends below the tool's dominant mode (the virtual tap with a rubber tip: band 71–786 Hz,
+    the 1071 Hz mode above it): no lobe reaches the speeds, and `lobes` wrote inf everywhere with "no chatter found" —
+    a safe-looking answer the data do not hold. Now refused in one line saying what would decide. Where limits are
+    found but the band's largest |H| still sits at its edge (a mode above a band given too narrow), it is warned."""
+    import warnings
+
+    from toolpoint.io.frf_files import write_frf
+    from toolpoint.io.impact import Record, impact_frf
+    from toolpoint.io.virtual_tap import lab_like_tap
+
+    rec = lab_like_tap(seed=1, hits=3, spacing_s=0.07, tip="rubber")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        frf = impact_frf(Record(rec.time_s, rec.force_n, rec.acceleration_ms2, source="v")).frf
+    soft = tmp_path / "rubber.csv"
+    write_frf(soft, frf)
+    cut = ["--teeth", "4", "--tangential-coeff", "796e6", "--radial-ratio", "0.212", "--immersion", "0.5"]
+    out = tmp_path / "l.csv"
+    assert main(["lobes", str(soft), *cut, "--rpm", "5000:20000", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "rubber.csv: FRF: no lobe within the band" in err[0] and "upper edge" in err[0]
+    assert not out.exists()
+    # two modes, the band given up to below the stronger: limits from the weaker one, and a warning
+    f = np.linspace(0.0, 3000.0, 3001)
+    two = ModalModel([500.0, 1000.0], [0.03, 0.02], [1.0, 0.05]).frf(f)
+    path = write_csv(tmp_path / "two.csv", f, two.values)
+    assert main(["lobes", str(path), *BASE, "--band", "50:900", "--out", str(out)]) == 0
+    cap = capsys.readouterr()
+    assert "the largest |H| sits at the band's upper edge (900 Hz)" in cap.err and out.exists()

@@ -174,6 +174,26 @@ def lobes_from_frf(frf_x: FRF, cutting: CuttingConditions, rpm, *, frf_y: FRF | 
         for fit in modal:  # the driving-point rule's notes (modes of negative modal mass dropped or kept)
             notes += [n for n in fit.notes if n not in notes]
         notes += _agreement(res, zoa)
+    for flag in ("FRF", "--frf-y"):  # a direct FRF whose largest |H| sits at the band's edge: its resonance is out
+        if flag not in cut:
+            continue
+        mag = np.abs(cut[flag].values)
+        k = int(np.argmax(mag))
+        if mag.size > 4 and k in (0, 1, mag.size - 2, mag.size - 1):
+            side, f_edge = ("upper", b.hi_hz) if k >= mag.size - 2 else ("lower", b.lo_hz)
+            if not np.isfinite(res.depth_m).any():  # "no chatter" would rest on a band that lacks the resonance
+                raise InputError(f"no lobe within the band {b.lo_hz:g}–{b.hi_hz:g} Hz reaches these speeds, and the "
+                                 f"largest |H| sits at the band's {side} edge ({f_edge:g} Hz): the resonance that "
+                                 "sets the lobes lies outside the band, so 'no chatter' is not in the data — measure "
+                                 "there (a harder hammer tip for modes above) or set --band LO:HI",
+                                 file=files[flag], field=flag)
+            out_of_band = (f"warning: {files[flag] or flag}: the largest |H| sits at the band's {side} edge "
+                           f"({f_edge:g} Hz): the resonance that sets the lobes may lie outside the band "
+                           f"{b.lo_hz:g}–{b.hi_hz:g} Hz, and the limits where it would chatter are missing or too "
+                           "high")
+            break
+    else:
+        out_of_band = None
     data_hz = frf_x.freq_hz
     edge = edge_hits(res.chatter_hz, (b.lo_hz, b.hi_hz), data_hz) & np.isfinite(res.depth_m)
     min_at_edge = bool(edge_hits([res.min_chatter_hz], (b.lo_hz, b.hi_hz), data_hz)[0])
@@ -183,6 +203,8 @@ def lobes_from_frf(frf_x: FRF, cutting: CuttingConditions, rpm, *, frf_y: FRF | 
                      f"limiting chatter frequency lies at the edge of the band {b.lo_hz:g}–{b.hi_hz:g} Hz: those "
                      "limits are not trusted (the resonance behind them may lie outside the band); check the FRF "
                      "there and set --band LO:HI")
+    elif out_of_band is not None:  # no limit at the edge, yet the band's largest |H| is there: said once
+        notes.append(out_of_band)
     return MeasuredLobes(res, method, b, zoa, modal, edge, min_at_edge, tuple(notes))
 
 
