@@ -713,6 +713,7 @@ def test_a_prior_from_a_measured_frf_holds_its_modes(tmp_path, capsys):
     the virtual tap's three dominant modes — against the modes the records were made from, not against the fit — and
     its median lobes are the zero-order lobes of the measured FRF itself (a second method: no modal model) where
     they matter; the fit's own scatter over seeds is what MEASURED_SIGMA_STIFFNESS says it is (under 2 %)."""
+    from toolpoint.frf import FRF
     from toolpoint.io.impact import Record, impact_frf
     from toolpoint.io.virtual_tap import LAB_MODES, close_xy_modes, lab_like_tap
     from toolpoint.shop.prior import MEASURED_SIGMA_STIFFNESS, prior_from_frf
@@ -756,6 +757,19 @@ def test_a_prior_from_a_measured_frf_holds_its_modes(tmp_path, capsys):
     said = capsys.readouterr()
     assert said.out.startswith("prior tapped (modes of tap.csv, 86–7929 Hz): 1071.")
     assert "0 test cuts; recommended" in said.out
+    # an accelerance in a CSV (tap --output-quantity measured: the file does not say it) is refused for its size,
+    # and read as what the [measured] table says it is
+    acc = tmp_path / "acc.csv"
+    write_frf(acc, impact_frf(Record(rec.time_s, rec.force_n, rec.acceleration_ms2, source="virtual"),
+                              output="measured").frf, as_measured=True)
+    toml.write_text('[measured]\nfrf = "acc.csv"\n' + body)
+    with pytest.raises(InputError, match=r"acc\.csv: measured\.frf: the largest \|H\| is .* m/N, orders of magnitude "
+                                         r"from a tool point's .*quantity = \"accelerance\""):
+        read_modal_prior(toml)
+    toml.write_text('[measured]\nfrf = "acc.csv"\nquantity = "accelerance"\n' + body)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert np.allclose(read_modal_prior(toml).freq_hz, pr.freq_hz, rtol=1e-6)
     toml.write_text('[measured]\nfrf = "tap.csv"\nsigma_stiffness = 0.2\n' + body)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the fit's note on extra poles (the command line prints it)
@@ -788,15 +802,17 @@ def test_a_prior_from_a_measured_frf_holds_its_modes(tmp_path, capsys):
     with warnings.catch_warnings(), pytest.raises(InputError, match="a mode just outside the band 71–786 Hz, near 10"):
         warnings.simplefilter("ignore")
         prior_from_frf(soft_frf, cut, source="rubber.csv")
-    # real measured accelerances (pyuff's samples, 1 Hz lines, a lightly damped structure): the driving point's
-    # dominant mode (51.5 Hz, ζ 0.03 %) falls between the lines, a transfer FRF has no mode of positive mass — both
-    # refused, saying what would decide, where a prior "51.5 Hz, ζ 0.03 % ± 20 %" would have claimed what the data
-    # do not hold
-    from toolpoint.frf import FRF
-
+    # an accelerometer mounted the wrong way round (the FRF's sign flipped): every mode of negative mass, refused
+    with warnings.catch_warnings(), pytest.raises(InputError, match="no mode of positive modal mass"):
+        warnings.simplefilter("ignore")
+        prior_from_frf(FRF(frf.freq_hz, -frf.values), cut, source="reversed.csv")
+    # real measured accelerances (pyuff's samples, 1 Hz lines, a lightly damped structure, not a tool point): the
+    # driving point's dominant mode (51.5 Hz, ζ 0.03 %) falls between the lines, the transfer FRF is 20 × softer than
+    # any tool point — both refused, saying what would decide, where a prior "51.5 Hz, ζ 0.03 % ± 20 %" would have
+    # claimed what the data do not hold
     data = Path(__file__).resolve().parents[1] / "data" / "pyuff"
     for k, said in ((1, "the mode at 51.5 Hz (ζ 0.0317 %) is narrower than the FRF's line spacing"),
-                    (2, "no mode of positive modal mass")):
+                    (2, "the largest |H| is 0.0022 m/N, orders of magnitude from a tool point's")):
         a = np.genfromtxt(data / f"meas_point_{k}.txt", dtype=complex)
         with warnings.catch_warnings(), pytest.raises(InputError) as exc:
             warnings.simplefilter("ignore")

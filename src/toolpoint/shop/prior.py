@@ -33,6 +33,7 @@ uncertainty the shop states (:func:`prior_from_frf`; path relative to the TOML f
     sigma_damping = 0.2
     band_hz = [300, 3000]              # optional: else the trusted band found in the data
     max_modes = 3                      # optional: the most flexible modes kept
+    quantity = "receptance"            # optional: what a CSV or CutPro file holds (UFF says it itself)
 
 A ``library`` output (``OUT/tools/<id>.npz`` and ``.json``, :mod:`toolpoint.recommend.run`) holds the
 tool's nominal tool-point FRF, the 5/50/95 % quantiles of |Φ| over its sampled joints and its cutting
@@ -140,12 +141,13 @@ def read_modal_prior(path: str | os.PathLike, *, frf: str | os.PathLike | None =
             if not 0 <= v <= 1:
                 raise InputError(f"must be from 0 to 1 (a log standard deviation), got {v}", file=p,
                                  field=f"measured.{k}")
+        q = get(meas, "quantity", "measured", default="receptance", kind=str)
         n = get(meas, "max_modes", "measured", default=3, kind=int)
         if n < 1:
             raise InputError(f"must be ≥ 1, got {n}", file=p, field="measured.max_modes")
         from ..io.frf_files import read_frf
 
-        return prior_from_frf(read_frf(src, min_points=3), cut, **sig, sigma_kt=sig_kt, sigma_kr=sig_kr,
+        return prior_from_frf(read_frf(src, min_points=3, quantity=q), cut, **sig, sigma_kt=sig_kt, sigma_kr=sig_kr,
                               band=None if band is None else tuple(float(v) for v in band), max_modes=n,
                               name=str(doc.get("name", p.stem)), rpm_range=rng, source=str(src))
     cols = {k: [] for k in ("freq_hz", "stiffness_n_m", "damping", "sigma_freq", "sigma_stiffness", "sigma_damping")}
@@ -269,8 +271,16 @@ def prior_from_frf(frf, cutting: CuttingConditions, *, sigma_freq: float = FREQ_
     from ..dynamics.modal import DrivingPointWarning, fit_frfs
     from ..trust import common_band
 
+    from ..trust import RECEPTANCE_RANGE
+
     h = frf.to_receptance()
     b = common_band([h], band=band, files=[source], field="measured.band_hz", hint="band_hz = [LO, HI]")
+    peak = float(np.max(np.abs(b.cut(h).values)))
+    if not RECEPTANCE_RANGE[0] <= peak <= RECEPTANCE_RANGE[1]:  # a mode's stiffness would be off as far
+        raise InputError(f"the largest |H| is {peak:.2g} m/N, orders of magnitude from a tool point's "
+                         f"({RECEPTANCE_RANGE[0]:g}–{RECEPTANCE_RANGE[1]:g} m/N): the file holds another unit or "
+                         "quantity (toolpoint tap --output-quantity measured writes an accelerance: say quantity = "
+                         "\"accelerance\" in [measured])", file=source, field="measured.frf")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
