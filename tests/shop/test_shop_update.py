@@ -652,6 +652,20 @@ def test_a_table_row_names_its_part_of_a_session_record(tmp_path):
     table.write_text(rows[0] + "\n" + "\n".join(r.replace("6000,,", f"6000,{d},") for r, d in zip(rows[1:], (0.5, 0.8)))
                      + "\n")
     assert [c.stable for c in read_test_cuts(table, teeth=4)] == [True, False]
+    # a record named as a recorder may name it (a comma; a leading '-' a spreadsheet would run as a formula): quoted
+    # and prefixed in the table, read back as the file
+    import shutil
+
+    odd = tmp_path / "-take, 1.wav"
+    shutil.copy(tmp_path / "session.wav", odd)
+    beside = tmp_path / "t2.csv"
+    assert main(["cut", str(odd), "--rpm", "6000", "--teeth", "4", "--out", str(tmp_path / "o.json"), "--table",
+                 str(beside)]) == 0
+    text = beside.read_text()
+    assert "\"'-take, 1.wav\"" in text
+    beside.write_text(text.replace("6000,,", "6000,0.5,", 1).replace("6000,,", "6000,0.8,", 1))
+    got = read_test_cuts(beside, teeth=4)
+    assert [c.stable for c in got] == [True, False] and all(c.record.startswith("-take, 1.wav (") for c in got)
     # the whole session for one row: warned, and told how to name the part
     p.write_text("rpm,depth_mm,result,record\n6000,0.5,,session.wav\n")
     (w,) = read_test_cuts(p, teeth=4)[0].warnings

@@ -107,9 +107,15 @@ def run(args) -> int:
             fh.write(text + "\n")
     if table is not None:  # rows update reads: the record's path relative to the table, each cut's part
         rel = os.path.relpath(rec_path.resolve(), table.resolve().parent)
-        with atomic_open(table) as fh:
-            fh.write("rpm,depth_mm,result,record,start_s,end_s\n" + "".join(
-                f"{res.rpm_nominal:g},,,{rel},{p0:.2f},{p1:.2f}\n" for p0, p1 in res.parts))
+        import csv
+
+        from ..io.table import csv_safe
+
+        with atomic_open(table) as fh:  # csv quotes a record path that holds a comma; no cell runs as a formula
+            w = csv.writer(fh, lineterminator="\n")
+            w.writerow(["rpm", "depth_mm", "result", "record", "start_s", "end_s"])
+            w.writerows([f"{res.rpm_nominal:g}", "", "", csv_safe(rel), f"{p0:.2f}", f"{p1:.2f}"]
+                        for p0, p1 in res.parts)
     if fig is not None:
         save_figure(fig, plot)
     if out is None:

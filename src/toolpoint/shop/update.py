@@ -141,7 +141,7 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
     InputError
         Naming the file, the line and the field.
     """
-    from ..io.table import read_table
+    from ..io.table import csv_unsafe, read_table
 
     p = Path(path)
     header, rows = read_table(p, what="the test-cut table")
@@ -181,7 +181,7 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
         res = (row.get("result") or "").strip().lower()
         if res and res not in ("stable", "chatter"):
             raise InputError(f"line {line}: must be 'stable' or 'chatter', got {res!r}", file=p, field="result")
-        rec = (row.get("record") or "").strip()
+        rec = csv_unsafe((row.get("record") or "").strip())  # "'-take1.wav" as `cut --table` writes it
         t0, t1 = num("start_s", required=False, at_lo=True), num("end_s", required=False)
         if (t0 is not None or t1 is not None) and not rec:
             raise InputError(f"line {line}: a part of a record needs the record", file=p,
