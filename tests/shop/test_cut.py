@@ -789,6 +789,11 @@ def test_a_record_of_cuts_at_two_speeds_is_refused_and_judged_in_parts(tmp_path,
     assert json.loads(out.read_text())["verdict"] == "chatter"
     assert main(["cut", str(wav), "--rpm", "8000", "--teeth", "4", "--start", "9"]) == 2
     assert "two.wav: --start: 9 s is after the record's end (8 s)" in capsys.readouterr().err
+    # one file named for two outputs: refused before any work (the table replaced the JSON without a word)
+    both = tmp_path / "both.csv"
+    assert main(["cut", str(sess), "--rpm", "6000", "--teeth", "4", "--out", str(both), "--table", str(both)]) == 2
+    assert "--table: --out, --plot and --table must be different files" in capsys.readouterr().err
+    assert not both.exists()
 
 
 def test_a_daq_s_high_rate_is_decimated_to_the_band_judged():

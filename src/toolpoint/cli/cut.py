@@ -68,6 +68,10 @@ def run(args) -> int:
     out = out_path(args.out, "--out", inputs=[rec_path]) if args.out else None
     plot = out_path(args.plot, "--plot", inputs=[rec_path]) if args.plot else None
     table = out_path(args.table, "--table", inputs=[rec_path]) if args.table else None
+    given = [(f, q.resolve()) for f, q in (("--out", out), ("--plot", plot), ("--table", table)) if q is not None]
+    for k, (flag, q) in enumerate(given):  # one file for two outputs: the later write would replace the earlier
+        if any(q == q0 for _, q0 in given[:k]):
+            raise InputError("--out, --plot and --table must be different files", file="command line", field=flag)
     rpm = check_number(args.rpm, "--rpm", above=0, unit="rpm")
     teeth = check_whole(args.teeth, "--teeth")
     rate = check_number(args.rate, "--rate", above=0, unit="Hz") if args.rate is not None else None

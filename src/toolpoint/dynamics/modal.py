@@ -212,8 +212,14 @@ class ModalFit:
         tuple of numpy.ndarray
             (a, b), each (n, m): a in 1/kg, b in s/kg.
         """
-        a = -2 * (self.residues * np.conj(self.poles)[:, None]).real
-        return a, 2 * self.residues.real
+        return _real_form(self.poles, self.residues)
+
+    def residual_real_modes(self) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`real_modes` of the residual poles outside the band (``residual_poles``): (a, b), each (k, m)."""
+        if self.residual_poles is None or self.residual_residues is None or not np.size(self.residual_poles):
+            empty = np.zeros((0, self.residues.shape[1]))
+            return empty, empty.copy()
+        return _real_form(self.residual_poles, self.residual_residues)
 
     def modal_mass(self, index: int = 0) -> np.ndarray:
         """Real-mode-equivalent modal masses 1 / a_r (kg), (n,), of the driving-point FRF ``index``.
@@ -269,6 +275,12 @@ class ModalFit:
 
 
 # --------------------------------------------------------------------------- model pieces
+def _real_form(poles, residues) -> tuple[np.ndarray, np.ndarray]:
+    """(a, b) of A/(iω − λ) + c.c. = (a + iω b)/(ω_r² − ω² + 2iζ_r ω_r ω): a = −2 Re(A conj λ), b = 2 Re A."""
+    poles, residues = np.asarray(poles), np.asarray(residues)
+    return -2 * (residues * np.conj(poles)[:, None]).real, 2 * residues.real
+
+
 def _power(quantity: str) -> int:
     if quantity not in _POWER:
         raise InputError(f"unknown quantity {quantity!r} (one of {', '.join(QUANTITIES)})", field="quantity")

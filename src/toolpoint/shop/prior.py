@@ -311,7 +311,7 @@ def prior_from_frf(frf, cutting: CuttingConditions, *, sigma_freq: float = FREQ_
     rp = np.asarray(fit.residual_poles)
     if rp.size:
         w_r = np.abs(rp)
-        a_r = -2 * (np.asarray(fit.residual_residues)[:, 0] * np.conj(rp)).real  # 1 / modal mass, as real_modes
+        a_r = fit.residual_real_modes()[0][:, 0]  # 1 / modal mass
         z_r = -rp.real / w_r
         with np.errstate(divide="ignore", invalid="ignore"):
             flex_r = np.where((a_r > 0) & (z_r > 0), a_r / (2 * z_r * w_r ** 2), 0.0)
