@@ -422,7 +422,7 @@ def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01, s
 
 
 def noisy_shop(prior, rng_blur=0.03, f_noise=0.005):
-    def shop(theta, rpm, depth, rng):
+    def shop(theta, rpm, depth, rng, duration_s=None):  # labels by a limit: no growth in time
         a, fc = limit_at_speeds(prior, theta[None, :], [rpm])
         stable = bool(depth < a[0, 0] * np.exp(rng.normal(0, rng_blur)))
         f_meas = None if stable else float(fc[0, 0] * (1 + rng.normal(0, f_noise)))
@@ -435,7 +435,7 @@ def sdm_shop(prior, rng_blur=0.03, f_noise=0.005):
     the whole loop's forward model (the SDM truth) without the simulation and the detector."""
     from toolpoint.shop.model import sdm_limits
 
-    def shop(theta, rpm, depth, rng):
+    def shop(theta, rpm, depth, rng, duration_s=None):  # labels by a limit: no growth in time
         lim, fc = sdm_limits(prior, theta, [float(rpm)])
         stable = bool(depth < lim[0] * np.exp(rng.normal(0, rng_blur)))
         f_meas = None if stable else float(fc[0] * (1 + rng.normal(0, f_noise)))
@@ -509,7 +509,8 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                 fails += r.converged_after is None
                 if verbose:
                     print(f"   seed {seed}: converged after {r.converged_after}, {chat[-1]} chattering; cuts "
-                          + " ".join(f"{c.rpm:.0f}/{1e3 * c.depth_m:.2f}{'s' if c.stable else 'C'}" for c in r.cuts)
+                          + " ".join(f"{c.rpm:.0f}/{1e3 * c.depth_m:.2f}{'s' if c.stable else 'C'}"
+                                     + ("" if c.duration_s is None else f"({c.duration_s:.1f}s)") for c in r.cuts)
                           + f"; width {np.round(r.width, 2).tolist()}; coverage {np.round(r.coverage, 2).tolist()}"
                           + ("; truth below the recommended depth after "
                              + ",".join(str(n) for n, b in enumerate(r.below_recommended) if b)

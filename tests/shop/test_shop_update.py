@@ -2,6 +2,7 @@
 bands out of sample, contradictory tables, the files, the library adapter, a virtual campaign."""
 
 import json
+import math
 import warnings
 from dataclasses import replace
 from pathlib import Path
@@ -161,6 +162,53 @@ def test_the_label_growth_against_the_time_domain_a_longer_cut_hears_slow_chatte
         assert short.stable and short.duration_s == pytest.approx(250 * 60 / rpm), (seed, short)
         assert long.duration_s == pytest.approx(t, abs=60 / rpm), (seed, long)
         assert not long.stable and long.chatter_hz == pytest.approx(750.0, rel=0.01), (seed, long)
+
+
+def test_the_next_cut_lasts_long_enough_for_slow_chatter_to_be_heard(tmp_path, capsys):
+    """The next cut's duration with ``update``'s ``audible_margin`` 0.05: t = G̃ / (κ₂₅ · 0.05) at its speed, so
+    chatter 5 % past the limit grows by e^G̃ within it — the duration the time-domain test above hears (on one 750 Hz
+    mode of ζ 0.5 %, κ ≈ ζω_n: about 2 s against a 1 s default; speeds 16000–18000 rpm, between its pockets — at a
+    pocket's peak the chatter sits off the resonance and grows at ~1000 /s). Never shorter than the cuts so far,
+    never lengthened past the cap; a well-damped tool's cuts (Cornelius, κ ≈ 400 /s) keep the default; 0 (the
+    default) proposes the cuts' own length."""
+    from toolpoint.shop.model import growth_rate
+
+    one, th = _one_slow_mode()
+    kw = dict(rng=np.random.default_rng(0), n_samples=100, lobe_samples=60, forward="zoa",
+              rpm_grid=np.linspace(16000.0, 18000.0, 21), audible_margin=0.05)
+    nc = update(one, [], **kw).next_cut
+    _, fc = limit_at_speeds(one, th[None, :], [nc["rpm"]])
+    kap = growth_rate(one, th[None, :], [nc["rpm"]], fc)[0, 0]
+    assert 0.5 < kap / (0.005 * 2 * np.pi * 750.0) < 2, kap
+    assert nc["growth_rate_p25_per_s"] == pytest.approx(kap, rel=1e-9)  # one θ: every sample's κ
+    assert nc["duration_s"] == pytest.approx(2.5 / (kap * 0.05), rel=1e-9) and nc["duration_s"] > 1.5
+    assert nc["duration_by_growth"] and nc["revolutions"] == math.ceil(nc["duration_s"] * nc["rpm"] / 60)
+    assert update(one, [], max_cut_duration_s=1.2, **dict(kw, rng=np.random.default_rng(0))).next_cut[
+        "duration_s"] == pytest.approx(1.2)
+    off = update(one, [], **dict(kw, rng=np.random.default_rng(0), audible_margin=0.0)).next_cut
+    assert off["duration_s"] == 1.0 and not off["duration_by_growth"]
+    # cuts of 8 s so far: the next lasts as long (the 5 s cap bounds the lengthening, not the cuts made)
+    cut = TestCut(nc["rpm"], 0.5 * nc["depth_m"], True, duration_s=8.0)
+    assert update(one, [cut], **dict(kw, rng=np.random.default_rng(0))).next_cut["duration_s"] == pytest.approx(8.0)
+    corn = update(cornelius_2024(0.1), [], **dict(kw, rng=np.random.default_rng(0), rpm_grid=None)).next_cut
+    assert corn["duration_s"] == 1.0 and not corn["duration_by_growth"] and corn["growth_rate_p25_per_s"] > 200
+    with pytest.raises(InputError, match="audible_margin"):
+        update(one, [], **dict(kw, audible_margin=-0.1))
+    # the CLI says it, and --max-cut-duration caps it
+    toml = tmp_path / "slow.toml"
+    toml.write_text(PRIOR_TOML.split("[[mode]]")[0].replace("rpm_min = 5000", "rpm_min = 16000").replace(
+        "rpm_max = 25000", "rpm_max = 18000") + "[[mode]]\nfreq_hz = 750\nstiffness_n_m = 2e7\ndamping = 0.005\n")
+    assert main([*UPDATE_ZOA, "--prior", str(toml), "--out", str(tmp_path / "d"), "--samples", "100"]) == 0
+    assert "for at least 1.0 s" in capsys.readouterr().out  # by default as long as the cuts so far (none: 1 s)
+    assert main([*UPDATE_ZOA, "--prior", str(toml), "--out", str(tmp_path / "o"), "--samples", "100",
+                 "--audible-margin", "0.05"]) == 0
+    printed = capsys.readouterr().out
+    assert "s (" in printed and "rev: chatter grows slowly there)" in printed, printed
+    assert float(printed.split("for at least ")[1].split(" s")[0]) > 1.5
+    assert "and a shorter cut would sound stable" in (tmp_path / "o" / "report.html").read_text()
+    assert main([*UPDATE_ZOA, "--prior", str(toml), "--out", str(tmp_path / "p"), "--samples", "100",
+                 "--audible-margin", "0.05", "--max-cut-duration", "1.2"]) == 0
+    assert "for at least 1.2 s" in capsys.readouterr().out
 
 
 def test_smc_posterior_matches_quadrature_on_one_parameter():
@@ -363,6 +411,10 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     doc = json.loads((out / "update.json").read_text())
     nc = doc["next_cut"]
     assert nc["rule"] == "info" and nc["p_chatter"] <= 0.3 and not nc["stepped"]
+    # how long the next cut must last: the table's cuts state none, so the default 1 s (κ of this tool ~400 /s)
+    assert nc["duration_s"] == 1.0 and nc["revolutions"] == math.ceil(nc["rpm"] / 60) and \
+        f"for at least 1.0 s ({nc['revolutions']} rev)" in printed
+    assert f"for at least 1.0 s ({nc['revolutions']} revolutions)" in (out / "report.html").read_text()
     assert 5000 <= doc["recommended"]["rpm"] <= 25000 and len(doc["cuts"]) == 3
     # the zero-order forward model has no SDM check: the recommended depth is the band's 5 % limit
     assert doc["recommended"]["depth_mm"] == doc["recommended"]["limit_p05_mm"]
@@ -405,7 +457,9 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     assert [float(v) for v in rows["label_growth_ln"][2:5]] == \
         pytest.approx([2.5 * np.exp(-1.645 * 0.5), 2.5, 2.5 * np.exp(1.645 * 0.5)], rel=1e-3)
     for flag, bad in (("--label-growth", "2"), ("--label-growth", "-1,0.5"), ("--label-growth", "2,x"),
-                      ("--label-growth", "30,0.5"), ("--cut-duration", "0"), ("--cut-duration", "inf")):
+                      ("--label-growth", "30,0.5"), ("--cut-duration", "0"), ("--cut-duration", "inf"),
+                      ("--max-cut-duration", "0"), ("--max-cut-duration", "1e5"), ("--audible-margin", "-0.1"),
+                      ("--audible-margin", "0.9")):
         capsys.readouterr()
         assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o6"),
                      f"{flag}={bad}"]) == 2, bad
@@ -478,7 +532,7 @@ def test_library_adapter_reads_modes_and_cutting(tmp_path):
         prior_from_library(tmp_path, "T9")
 
 
-def test_library_prior_is_not_surer_than_the_library(tmp_path):
+def test_library_prior_is_not_surer_than_the_library(tmp_path, capsys):
     """A real ``library`` output (the shared small run): the prior update makes of each tool holds the library's
     own 5–95 % band of the limit at every speed (the adapter may add what the library does not model — the
     running spindle's frequency shift, the peak-picking — never remove what it sampled), around the same median."""
@@ -504,6 +558,10 @@ def test_library_prior_is_not_surer_than_the_library(tmp_path):
     assert main([*UPDATE_ZOA, "--library", str(out), "--tool", "B12", "--sigma-freq", "0.02", "--samples", "100",
                  "--out", str(tmp_path / "u")]) == 0
     assert (tmp_path / "u" / "report.html").exists()
+    # the modes it rests on, said in order of frequency (the library lists them strongest first)
+    said = [float(m.split(" Hz")[0].split(": ")[-1]) for m in capsys.readouterr().out.splitlines()[0].split("; ")
+            if " Hz, k " in m]
+    assert len(said) == prior_from_library(out, "B12").modes and said == sorted(said), said
     assert main([*UPDATE_ZOA, "--library", str(out), "--tool", "B12", "--sigma-freq", "2", "--out",
                  str(tmp_path / "v")]) == 2
 

@@ -56,8 +56,9 @@ def _check_parent(parent: Path, p: Path, flag: str) -> None:
 
 
 def check_number(value, flag: str, *, minimum: float | None = None, above: float | None = None,
-                 unit: str = "") -> float:
-    """A numeric command-line value that must be finite and ≥ ``minimum`` (or > ``above``).
+                 unit: str = "", maximum: float | None = None, why: str = "") -> float:
+    """A numeric command-line value that must be finite and ≥ ``minimum`` (or > ``above``), and ≤ ``maximum``
+    where given (``why``: what the bound is, said in the message).
 
     Python's ``float`` accepts ``nan`` and ``inf``; they would reach the numerics
     (a NaN noise level writes a campaign of NaNs), so every numeric option is judged here.
@@ -75,6 +76,9 @@ def check_number(value, flag: str, *, minimum: float | None = None, above: float
     if not ok:
         raise InputError(f"must be a finite number{bound}{(' ' + unit) if unit else ''}, got {value!r}",
                          file="command line", field=flag)
+    if maximum is not None and v > maximum:
+        raise InputError(f"must be ≤ {maximum:g}{(' ' + unit) if unit else ''}{f' ({why})' if why else ''}, "
+                         f"got {value}", file="command line", field=flag)
     return v
 
 

@@ -61,6 +61,12 @@ def register(sub) -> None:
     p.add_argument("--cut-duration",
                    help="how long each test cut lasted, s, where the table has no duration_s and no record "
                    "(default 1; shorter is the safer guess)")
+    p.add_argument("--audible-margin", metavar="LN",
+                   help="propose the next cut longer than the cuts so far where chatter grows slowly, so that chatter "
+                   "LN past the limit (e.g. 0.05) grows audibly within it (default 0: as long as the cuts so far; "
+                   "measured a trade: a narrower band sooner, more chattering cuts, docs/design/shop.md)")
+    p.add_argument("--max-cut-duration",
+                   help="with --audible-margin: the longest next test cut proposed, s (default 5)")
     p.add_argument("--forward", choices=("sdm", "zoa"), default="sdm",
                    help="forward model: sdm = zero-order limit corrected by the semi-discretisation at posterior "
                    "samples, as a machine's cuts follow it (default; what the virtual campaigns were measured "
@@ -75,9 +81,7 @@ def run(args) -> int:
     if seed != int(seed):
         raise InputError(f"must be a whole number, got {args.seed!r}", file="command line", field="--seed")
     n = check_number(args.samples, "--samples", minimum=50)
-    risk = None if args.risk is None else check_number(args.risk, "--risk", above=0)
-    if risk is not None and risk > 0.5:
-        raise InputError(f"must be ≤ 0.5, got {args.risk}", file="command line", field="--risk")
+    risk = None if args.risk is None else check_number(args.risk, "--risk", above=0, maximum=0.5)
     rac = None if args.risk_after_chatter is None else check_number(args.risk_after_chatter, "--risk-after-chatter",
                                                                       above=0)
     from ..shop.update import DEFAULT_RISK
@@ -85,30 +89,29 @@ def run(args) -> int:
     if rac is not None and rac > (risk if risk is not None else DEFAULT_RISK[args.rule]):
         raise InputError(f"must be ≤ the bound before any chatter (--risk), got {args.risk_after_chatter}",
                          file="command line", field="--risk-after-chatter")
-    min_step = None if args.min_step is None else check_number(args.min_step, "--min-step", minimum=0)
-    if min_step is not None and min_step > 0.5:
-        raise InputError(f"must be ≤ 0.5 (a log step: ×1.65), got {args.min_step}", file="command line",
-                         field="--min-step")
+    min_step = None if args.min_step is None else check_number(args.min_step, "--min-step", minimum=0, maximum=0.5,
+                                                               why="a log step: ×1.65")
     offset = {}
     if args.label_offset is not None:
         offset["label_offset"] = _pair(args.label_offset, "--label-offset", "MEAN,SD", (-0.2, 0.5), (0, 0.5))
     if args.label_growth is not None:
         offset["label_growth"] = _pair(args.label_growth, "--label-growth", "MEDIAN,SD", (0, 20), (0, 1.5))
     if args.cut_duration is not None:
-        t = check_number(args.cut_duration, "--cut-duration", above=0)
-        if t > 3600:
-            raise InputError(f"must be ≤ 3600 s (as a table's duration_s), got {args.cut_duration}",
-                             file="command line", field="--cut-duration")
-        offset["cut_duration_s"] = t
+        offset["cut_duration_s"] = check_number(args.cut_duration, "--cut-duration", above=0, maximum=3600,
+                                                unit="s", why="as a table's duration_s")
+    if args.audible_margin is not None:
+        offset["audible_margin"] = check_number(args.audible_margin, "--audible-margin", minimum=0, maximum=0.5,
+                                                why="ln")
+    if args.max_cut_duration is not None:
+        offset["max_cut_duration_s"] = check_number(args.max_cut_duration, "--max-cut-duration", above=0,
+                                                    maximum=3600, unit="s")
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")
     if args.sigma_freq is not None and not args.library:
         raise InputError("only with --library (a prior file states its own σ)", file="command line",
                          field="--sigma-freq")
-    sig_f = None if args.sigma_freq is None else check_number(args.sigma_freq, "--sigma-freq", minimum=0)
-    if sig_f is not None and sig_f > 0.5:
-        raise InputError(f"must be ≤ 0.5 (a log standard deviation), got {args.sigma_freq}", file="command line",
-                         field="--sigma-freq")
+    sig_f = None if args.sigma_freq is None else check_number(args.sigma_freq, "--sigma-freq", minimum=0, maximum=0.5,
+                                                              why="a log standard deviation")
     import numpy as np
 
     from ..shop.prior import prior_from_library, read_modal_prior
@@ -124,11 +127,13 @@ def run(args) -> int:
             prior = read_modal_prior(args.prior, frf=args.frf)
     else:
         prior = prior_from_library(args.library, args.tool, **({} if sig_f is None else {"sigma_freq": sig_f}))
-    # the modes the prior rests on (a measured FRF's fit, a library tool's peaks, or the file's own), said
+    # the modes the prior rests on (a measured FRF's fit, a library tool's peaks, or the file's own), said in order
+    # of frequency (a library tool lists them strongest first)
     print(f"prior {prior.name}: " + "; ".join(
         f"{f:.1f} Hz, k {k:.3g} N/m, ζ {100 * z:.2f} % (σ {sf:.3g}, {sk:.3g}, {sz:.3g})" for f, k, z, sf, sk, sz in
-        zip(prior.freq_hz, prior.stiffness_n_m, prior.damping, prior.sigma_freq, prior.sigma_stiffness,
-            prior.sigma_damping)) + f"; K_t {prior.cutting.tangential_coeff / 1e6:.4g} N/mm² (σ {prior.sigma_kt:.3g})")
+        sorted(zip(prior.freq_hz, prior.stiffness_n_m, prior.damping, prior.sigma_freq, prior.sigma_stiffness,
+                   prior.sigma_damping))) + f"; K_t {prior.cutting.tangential_coeff / 1e6:.4g} N/mm² "
+          f"(σ {prior.sigma_kt:.3g})")
     cuts = read_test_cuts(args.cuts, teeth=prior.cutting.teeth) if args.cuts else []
     use_agg()
     post = update(prior, cuts, rng=np.random.default_rng(int(seed)), n_samples=int(n), method=args.method,
@@ -142,7 +147,9 @@ def run(args) -> int:
           + (f"; the band's 5 % limit {1e3 * rc['limit_p05_m']:.3f} mm, lowered by posterior samples' own SDM limits"
              if low else "")
           + f"); next test cut ({nc['rule']}) {nc['rpm']:.0f} rpm at "
-          f"{1e3 * nc['depth_m']:.3f} mm, P(chatter) {nc['p_chatter']:.2f}"
+          f"{1e3 * nc['depth_m']:.3f} mm for at least {nc['duration_s']:.1f} s ({nc['revolutions']} rev"
+          f"{': chatter grows slowly there' if nc['duration_by_growth'] else ''}), "
+          f"P(chatter) {nc['p_chatter']:.2f}"
           f"{' (a step above the stable cut there)' if nc.get('stepped') else ''}"
           f"{' (it repeats a cut already made there: none within the bound would be new)' if nc.get('repeat') else ''}"
           f"; wrote {out}/report.html")

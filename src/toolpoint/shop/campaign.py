@@ -6,7 +6,8 @@ Loop (seeded by one ``numpy.random.Generator``):
 2. update the prior with the cuts so far (:func:`toolpoint.shop.update.update`), propose the next cut;
 3. stop when the posterior 5–95 % band holds the true limit at ≥ ``coverage`` of the speeds and its relative
    width (a₉₅ − a₀₅)/a₅₀ at the recommended speed is ≤ ``width`` — or after ``max_cuts``;
-4. make the proposed cut with ``shop(theta_true, rpm, depth_m, rng) -> TestCut`` and go to 2.
+4. make the proposed cut with ``shop(theta_true, rpm, depth_m, rng, duration_s) -> TestCut`` (``duration_s`` None:
+   the shop's usual cut; the proposal's where ``update``'s ``audible_margin`` lengthened it) and go to 2.
 
 Shops: :func:`zoa_shop` labels a cut by the true zero-order limit (and gives the true chatter frequency) —
 the update's own forward model, a check of the sampler and the rule; :func:`simulated_shop` makes the cut in
@@ -68,7 +69,7 @@ class CampaignResult:
 
 def zoa_shop(prior: ModalPrior):
     """A shop whose cuts chatter exactly above the true zero-order limit, at the true chatter frequency."""
-    def shop(theta_true, rpm, depth_m, rng):
+    def shop(theta_true, rpm, depth_m, rng, duration_s=None):  # the labels need no time to grow here
         a, fc = limit_at_speeds(prior, theta_true[None, :], [rpm])
         stable = bool(depth_m < a[0, 0])
         return TestCut(float(rpm), float(depth_m), stable, None if stable else float(fc[0, 0]))
@@ -199,7 +200,9 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
         if n == max_cuts:
             break
         nc = post.next_cut
-        cuts.append(shop(theta_true, nc["rpm"], nc["depth_m"], rng))
+        # the shop makes its usual cut unless the proposal asks for a longer one (update's audible_margin)
+        cuts.append(shop(theta_true, nc["rpm"], nc["depth_m"], rng,
+                         nc["duration_s"] if nc.get("duration_by_growth") else None))
     chat = sum(not c.stable for c in (cuts if converged is None else cuts[:converged]))
     return CampaignResult(np.asarray(theta_true), tuple(cuts), converged, chat, tuple(cov_h), tuple(wid_h),
                           tuple(cpu), tuple(below), tuple(near_h), tuple(away_h))

@@ -6,9 +6,9 @@ In the output folder (written atomically, all or none of each file):
 * ``p_stable.csv`` — first row ``depth_mm\\rpm`` and the speeds, then one row per depth (mm) of P(stable);
 * ``parameters.csv`` — ``name, unit, prior_p05, prior_p50, prior_p95, post_p05, post_p50, post_p95``
   (K_t in N/mm²);
-* ``update.json`` — recommended point, next test cut (rule, rpm, depth_mm, P(chatter)), the test cuts (each with
-  its record and part, where the table named one), the forward model and sampler diagnostics (method, ESS per
-  tempering step, acceptance, CPU s);
+* ``update.json`` — recommended point, next test cut (rule, rpm, depth_mm, duration_s, P(chatter)), the test
+  cuts (each with its record and part, where the table named one), the forward model and sampler diagnostics
+  (method, ESS per tempering step, acceptance, CPU s);
 * ``lobes.png`` — prior and posterior bands, the P(stable) map, the test cuts, the next cut;
 * ``report.html`` — one self-contained page (figure embedded) of all of the above.
 """
@@ -205,8 +205,13 @@ def _html(post, doc, rows, png) -> str:
         + (f"the band's 5 % limit {rc['limit_p05_mm']:.3f} mm, lowered by posterior samples' own SDM limits; "
            if rc["limit_p05_mm"] > rc["depth_mm"] else "") +
         f"median limit {rc['limit_p50_mm']:.3f} mm).<br><b>Next test cut</b> ({e(nc['rule'])}: "
-        f"{e(nc['description'])}): {nc['rpm']:.0f} rpm at {nc['depth_mm']:.3f} mm, P(chatter) "
-        f"{nc['p_chatter']:.2f}.</p>{caveat}"
+        f"{e(nc['description'])}): {nc['rpm']:.0f} rpm at {nc['depth_mm']:.3f} mm"
+        + (f" for at least {nc['duration_s']:.1f} s ({nc['revolutions']} revolutions"
+           + (": chatter a few % past the limit grows slowly at this speed (κ "
+              f"{nc['growth_rate_p25_per_s']:.0f} /s in a quarter of the samples), and a shorter cut would sound "
+              "stable" if nc.get("duration_by_growth") else "")
+           + ")" if nc.get("duration_s") is not None else "")
+        + f", P(chatter) {nc['p_chatter']:.2f}.</p>{caveat}"
         f"<img alt='lobes' style='max-width:100%' src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
         "<h2>Test cuts</h2><table><tr><th>rpm</th><th>depth mm</th><th>result</th><th>chatter Hz</th>"
         "<th>record</th></tr>"

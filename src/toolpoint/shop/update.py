@@ -77,6 +77,15 @@ cut**, two rules:
   shallower than a chattering one) is not proposed (``skip_repeats``);
 * ``"risk"``: the most productive cut (max n · a) whose P(chatter) ≤ ``risk`` (default 0.1) — the depth
   a_risk(n), the ``risk`` quantile of the limit.
+
+Either rule also says how long the cut should last (``next_cut["duration_s"]``, ``["revolutions"]``): as long as
+the cuts so far (their median; ``cut_duration_s`` before the first), the duration its expected outcome assumes.
+``audible_margin`` > 0 lengthens it where chatter grows slowly, so that chatter that far past the limit grows by
+e^G̃ within the cut, t = G̃ / (margin · κ₂₅), κ₂₅ the lower quartile of the lobe samples' growth rates at its speed:
+a lightly damped mode between its pockets (κ ≈ ζω_n ≈ 25 /s) asks for about 2 s at 0.05, a well-damped one or a
+pocket's peak (κ ≈ 400–1000 /s) no more than the cuts already made; the time domain hears chatter 5 % past the
+limit in such a cut and not in a 0.9 s one (``tests/shop/test_shop_update.py``). Off by default: in the whole loop
+it traded a narrower band after 2–3 cuts for more chattering cuts (``update``'s ``audible_margin``).
 """
 
 from __future__ import annotations
@@ -430,7 +439,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            min_step: float | None = None, sdm_train: int = 0, miss_rate: float = 0.0,
            label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
            cut_duration_s: float = 1.0, risk_after_chatter: float | None = None,
-           skip_repeats: bool = True) -> Posterior:
+           skip_repeats: bool = True, audible_margin: float = 0.0, max_cut_duration_s: float = 5.0) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -514,8 +523,23 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         truths 40–49: its cuts at the 750 Hz mode, κ ≈ 25–40 /s, were heard as chatter only 7–12 % above the SDM limit,
         those at its 2000 Hz mode, κ ≈ 900 /s, at 1–3 %; ``docs/design/shop.md``). (0, 0): off.
     cut_duration_s : float, default 1.0
-        Duration (s) of the cuts whose :class:`TestCut` does not state it, and of the next cut. Shorter is the
-        safer guess (chatter had less time to grow, so a stable label says less).
+        Duration (s) of the cuts whose :class:`TestCut` does not state it, and the shortest next cut. Shorter is
+        the safer guess (chatter had less time to grow, so a stable label says less).
+    audible_margin : float, default 0
+        The next cut's duration (``next_cut["duration_s"]``, what the rule's expected outcomes assume) is that of
+        the cuts so far (their median, else ``cut_duration_s``). With ``audible_margin`` > 0 it is lengthened
+        where chatter grows slowly: long enough that chatter ``audible_margin`` (ln) past the limit grows by e^G̃
+        within it, t = G̃ / (κ₂₅ · audible_margin), κ₂₅ the lower quartile of the lobe samples' growth rates at
+        its speed (:func:`~toolpoint.shop.model.growth_rate`), at most ``max_cut_duration_s``; the rule then
+        weighs each candidate with the duration it would get. A short cut leaves chatter on a lightly damped mode
+        unheard well past the limit, and its stable label says little (``label_growth``). Measured in the whole
+        loop (EM12-60, truths 40–59, 6 cuts; ``docs/design/shop.md``, *The next cut's duration*): 0.05 narrowed
+        the band at the recommended speed after 2–3 cuts (median 0.48 / 0.36 against 0.59 / 0.46) but not after
+        6 (0.36 against 0.40; ≤ 0.25 for 2 truths against 6), heard more of the cuts past the limit as chatter
+        (24 chattering cuts against 18) and converged for 0 truths against 3: a trade, off by default.
+    max_cut_duration_s : float, default 5.0
+        The longest next cut ``audible_margin`` proposes (s); it bounds the lengthening, not the length of the
+        cuts already made.
     skip_repeats : bool, default True
         ``"info"`` rule: no candidate at the speed of an earlier cut (±0.5 %) that is no deeper than a stable cut there,
         or no shallower than a chattering one — the shop already knows how it ends. The likelihood takes each cut's
@@ -591,6 +615,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                          field="label_growth")
     if not (math.isfinite(cut_duration_s) and 0 < cut_duration_s <= 3600):
         raise InputError(f"must be in (0, 3600] s, got {cut_duration_s}", field="cut_duration_s")
+    if not (math.isfinite(audible_margin) and 0 <= audible_margin <= 0.5):
+        raise InputError(f"must be in [0, 0.5] (ln), got {audible_margin}", field="audible_margin")
+    if not (math.isfinite(max_cut_duration_s) and 0 < max_cut_duration_s <= 3600):
+        raise InputError(f"must be in (0, 3600] s, got {max_cut_duration_s}", field="max_cut_duration_s")
     if min_step > 0 and rule != "info":
         raise InputError("the step above stable cuts belongs to the info rule; the risk rule has none",
                          field="min_step")
@@ -663,6 +691,21 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            "limit_p50_m": float(q[1, j]), "limit_p95_m": float(q[2, j])}
     # once a cut has chattered the bracket has its upper side: the remaining cuts may be bounded lower
     bound = risk if risk_after_chatter is None or all(c.stable for c in cuts) else risk_after_chatter
+    known = [c.duration_s for c in cuts if c.duration_s is not None]
+    t_next = float(np.median(known)) if known else cut_duration_s  # the next cut lasts as the others did
+    th_pick = prior.theta(z[pick, :P])
+    g_pick = g_med * np.exp(g_sd * z[pick, P + 1])
+
+    def duration(ks):
+        """The next cut's duration at the speeds grid[ks] (len(ks),), s, and the lobe samples' κ₂₅ there."""
+        if audible_margin <= 0 or g_med <= 0:
+            return np.full(len(ks), t_next), np.full(len(ks), np.nan)
+        _, fc = limit_at_speeds(prior, th_pick, grid[ks], f)
+        kap = growth_rate(prior, th_pick, grid[ks], fc)
+        kp = np.where(kap > 0, kap, np.nan)  # nan: no lobe reaches the speed (or no growth there)
+        k25 = np.array([np.quantile(c[np.isfinite(c)], 0.25) if np.isfinite(c).any() else np.nan for c in kp.T])
+        t = np.where(np.isfinite(k25), g_med / (np.where(np.isfinite(k25), k25, 1.0) * audible_margin), t_next)
+        return np.clip(t, t_next, max(max_cut_duration_s, t_next)), k25
     if rule == "risk":
         # the deepest sample limit with at most bound × m samples at or below it (an interpolated quantile sat
         # up to 1/m above the bound: P(chatter) 0.053 for a bound of 0.05 with 150 samples)
@@ -675,16 +718,13 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                "p_chatter": float(np.mean(lim[:, k] <= qr[k])),
                "description": f"most productive cut (max rpm × depth) with P(chatter) ≤ {bound:g}"}
     else:
-        known = [c.duration_s for c in cuts if c.duration_s is not None]
-        t_next = float(np.median(known)) if known else cut_duration_s  # the next cut lasts as the others did
-        th_pick, off_pick = prior.theta(z[pick, :P]), off_mu + off_sd * z[pick, P]
-        g_pick = g_med * np.exp(g_sd * z[pick, P + 1])
+        off_pick = off_mu + off_sd * z[pick, P]
 
         def offset(ks):  # each lobe sample's label offset at the candidate speeds grid[ks], (m, len(ks))
             if g_med <= 0:
                 return np.broadcast_to(off_pick[:, None], (m, len(ks)))
             _, fc = limit_at_speeds(prior, th_pick, grid[ks], f)
-            return off_pick[:, None] + growth_offset(prior, th_pick, grid[ks], fc, g_pick, t_next)
+            return off_pick[:, None] + growth_offset(prior, th_pick, grid[ks], fc, g_pick, duration(ks)[0])
 
         nxt = _next_info(lim, grid, j, bound, boundary_width, label_noise, chatter_cost, cuts, min_step, miss_rate,
                          offset, skip_repeats)
@@ -697,6 +737,11 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         rec = _recommended_own(prior, z[hold if held else pick, :P], f, grid, lim, rec, lobe_samples=not held)
         if not cuts:  # measured calibrated with the lobe samples (docs/design/shop.md): kept on them
             nxt = _first_cut_own(prior, z[pick, :P], f, grid, lim, nxt, bound)
+    k_next = int(np.argmin(np.abs(grid - nxt["rpm"])))
+    t_cut, k25 = duration([k_next])
+    nxt = dict(nxt, duration_s=float(t_cut[0]), revolutions=int(math.ceil(float(t_cut[0]) * nxt["rpm"] / 60.0)),
+               growth_rate_p25_per_s=float(k25[0]) if np.isfinite(k25[0]) else None,
+               duration_by_growth=bool(t_cut[0] > t_next * (1 + 1e-9)))
     return Posterior(prior, cuts, method, z, tuple(ess_hist), float(np.mean(acc)) if acc else float("nan"), grid, q,
                      depths, p_st, qp, rec, nxt, time.process_time() - c0, (off_mu, off_sd), (g_med, g_sd), forward)
 
