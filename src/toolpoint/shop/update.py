@@ -373,7 +373,9 @@ class Posterior:
     recommended : dict
         ``rpm``, ``depth_m`` (the 5 % limit), ``p_stable``.
     next_cut : dict
-        ``rule``, ``risk``, ``rpm``, ``depth_m``, ``p_chatter``.
+        ``rule``, ``risk``, ``rpm``, ``depth_m``, ``p_chatter``, ``duration_s`` and ``revolutions`` (how long it
+        should last: :func:`update`'s ``audible_margin``), ``duration_by_growth`` (lengthened where chatter grows
+        slowly), ``growth_rate_p25_per_s`` (κ₂₅ there, 1/s; None without the margin).
     cpu_s : float
         CPU time of the update.
     label_offset : (float, float)
@@ -523,8 +525,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         truths 40–49: its cuts at the 750 Hz mode, κ ≈ 25–40 /s, were heard as chatter only 7–12 % above the SDM limit,
         those at its 2000 Hz mode, κ ≈ 900 /s, at 1–3 %; ``docs/design/shop.md``). (0, 0): off.
     cut_duration_s : float, default 1.0
-        Duration (s) of the cuts whose :class:`TestCut` does not state it, and the shortest next cut. Shorter is
-        the safer guess (chatter had less time to grow, so a stable label says less).
+        Duration (s) of the cuts whose :class:`TestCut` does not state it, and of the next cut while no cut
+        states one. Shorter is the safer guess (chatter had less time to grow, so a stable label says less).
     audible_margin : float, default 0
         The next cut's duration (``next_cut["duration_s"]``, what the rule's expected outcomes assume) is that of
         the cuts so far (their median, else ``cut_duration_s``). With ``audible_margin`` > 0 it is lengthened
