@@ -207,8 +207,8 @@ def _html(post, doc, rows, png) -> str:
         f"median limit {rc['limit_p50_mm']:.3f} mm).<br><b>Next test cut</b> ({e(nc['rule'])}: "
         f"{e(nc['description'])}): {nc['rpm']:.0f} rpm at {nc['depth_mm']:.3f} mm"
         + (f" for at least {nc['duration_s']:.1f} s ({nc['revolutions']} revolutions"
-           + (": chatter a few % past the limit grows slowly at this speed (κ "
-              f"{nc['growth_rate_p25_per_s']:.0f} /s in a quarter of the samples), and a shorter cut would sound "
+           + (": chatter a few % past the limit grows slowly at this speed (κ ≤ "
+              f"{nc['growth_rate_p25_per_s']:.0f} /s for a quarter of the samples), and a shorter cut would sound "
               "stable" if nc.get("duration_by_growth") else "")
            + ")" if nc.get("duration_s") is not None else "")
         + f", P(chatter) {nc['p_chatter']:.2f}.</p>{caveat}"
