@@ -1,0 +1,229 @@
+"""A chattering cut's growth rate: can a record tell how far past the limit a cut was, and what would it be worth?
+
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_growth.py [--only estimator|real|oracle] [--truths 3]
+        [--seed-start 20] [--seeds 20]
+
+An experiment, not a feature: toolpoint does not measure the growth rate yet (docs/design/shop.md, *A chattering
+cut's growth rate*). Just past the limit, chatter grows as e^{σ t} with σ = κ ln(a / a_lim) (κ:
+:func:`toolpoint.shop.model.growth_rate`), so a chattering cut whose record shows σ also says ln(a / a_lim) = σ / κ:
+a two-sided measurement where the label gives a one-sided bound.
+
+1. ``estimator``: cuts of random Cornelius-case truths (σ 0.1) simulated in the time domain at 3 random speeds and
+   at a = a_SDM e^x, x = 0.03, 0.1, 0.3, 0.6, heard by the campaign's microphone (white noise) and by the tests'
+   shop microphone (fans, spindle lines, pink room noise); σ read from the record (:func:`growth_from_record`: what
+   does not repeat every revolution, its power in windows of two tooth periods fitted by a floor plus a growing
+   exponential up to e⁻¹ below its top) against the SDM's ln ρ / T, and κ x (the zero-order model the update
+   would use) against it too.
+2. ``real``: the real shop recording (examples/cuts): the same difference, band-passed ±60 Hz about its chatter
+   line, in 20 ms windows: the rate of the entry transient's decay and of the chatter's rise.
+3. ``oracle``: the whole loop (Cornelius, 6 cuts without a stop, ``update``'s defaults), once as it is and once
+   with each chattering cut's true growth rate (the SDM's, times e^{0.25 N(0,1)}: a measurement good to 25 %) in
+   the likelihood: ln N(σ_m; κ(θ) ln(a / a_lim(θ)), (0.3 σ_m)²), 5 % outliers uniform on [0, 3 σ_m]. The upper
+   bound of what measuring it would give; the update is patched in this script only.
+
+Prints the machine and date first; CPU time where timed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from milling_sim import microphone  # noqa: E402
+
+from toolpoint.io.records import read_cut_record  # noqa: E402
+from toolpoint.shop import update as U  # noqa: E402
+from toolpoint.shop.campaign import microphone_record, sdm_limit, simulated_shop, virtual_campaign  # noqa: E402
+from toolpoint.shop.model import cornelius_2024, growth_rate, limit_at_speeds, sdm_limits  # noqa: E402
+from toolpoint.simulation import sensor_signal, simulate_milling  # noqa: E402
+from toolpoint.stability.sdm import sdm_spectral_radius  # noqa: E402
+
+REAL = Path(__file__).resolve().parents[1] / "examples" / "cuts" / "combined_chatter6567.mp3"
+
+
+def _period_difference(y, rate, period_s):
+    """y(t) − y(t − P): what repeats every P seconds removed (P one revolution: the tooth passing and the runout's
+    spindle lines), chatter kept with its growth (|1 − e^{−(σ + iω) P}| is constant in time)."""
+    t = np.arange(y.size) / rate
+    return y - np.interp(t - period_s, t, y, left=np.nan)
+
+
+def growth_from_record(y, rate, rpm, teeth, t0, t1):
+    """σ (1/s) of the chatter's rise in a record whose cut runs from t0 to t1 s; nan where it shows none.
+
+    The revolution difference's power in windows of two tooth periods, from the cut's start to the first window
+    within e⁻¹ (amplitude) of its top, fitted by ln(F + A e^{2σt}) (least squares in ln power; F: what the cut
+    holds besides chatter — its noise, the fans —, A: the kick's chatter at the start). Refused (nan): fewer than 5
+    windows before the top, or a top less than 3 × (amplitude) the cut's first windows.
+    """
+    from scipy.optimize import least_squares
+
+    T = 60.0 / (teeth * rpm)
+    d = _period_difference(y, rate, 60.0 / rpm)
+    w = max(int(round(2 * T * rate)), 32)
+    i0 = int((t0 + 60.0 / rpm) * rate)
+    seg = d[i0:int(t1 * rate)]
+    n = seg.size // w
+    if n < 6:
+        return float("nan")
+    lp = np.log(np.nanmean(seg[:n * w].reshape(n, w) ** 2, axis=1))
+    tt = (np.arange(n) + 0.5) * w / rate
+    top = lp.max()
+    if top - np.median(lp[:3]) < 2 * math.log(3.0):
+        return float("nan")
+    i1 = int(np.argmax(lp > top - 2.0))
+    if i1 < 4:
+        return float("nan")
+    tt, lp = tt[:i1 + 1], lp[:i1 + 1]
+    fit = least_squares(lambda q: np.logaddexp(q[0], q[1] + 2 * q[2] * tt) - lp,
+                        (np.median(lp[:3]), lp[-1] - 100.0 * tt[-1], 50.0),
+                        bounds=([-np.inf, -np.inf, 0.0], [np.inf, np.inf, 5000.0]))
+    return float(fit.x[2])
+
+
+def bench_estimator(truths, seed):
+    print(f"\n## estimator: Cornelius σ 0.1, {truths} truths × 3 speeds × x ∈ (0.03, 0.1, 0.3, 0.6), seed {seed}")
+    pr = cornelius_2024(0.1)
+    rng = np.random.default_rng(seed)
+    rate = 44100.0
+    rows = []
+    for k in range(truths):
+        theta = pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None])[0]
+        mm, cut = pr.tool(theta)
+        for rpm in rng.uniform(5500.0, 24000.0, 3):
+            a_sdm = sdm_limits(pr, theta, [rpm], chatter=False)[0][0]
+            _, f_z = limit_at_speeds(pr, theta[None], [rpm])
+            kap = growth_rate(pr, theta[None], [rpm], f_z)[0, 0]
+            for x in (0.03, 0.1, 0.3, 0.6):
+                a = a_sdm * math.exp(x)
+                sig = math.log(float(sdm_spectral_radius(mm, mm, cut, rpm=rpm, depth=a))) * cut.teeth * rpm / 60.0
+                res = simulate_milling(mm, mm, cut, rpm=[rpm], depth_m=[a], revolutions=250,
+                                       seed=int(rng.integers(1 << 30)), seed_level=0.01)
+                _, v = sensor_signal(res, 0, kind="microphone", rate=rate, noise=0.0)
+                white = growth_from_record(microphone_record(v, rate, rng), rate, rpm, cut.teeth, 1.0,
+                                           1.0 + v.size / rate)
+                t = res.time_s[0] - res.time_s[0][0]
+                dd, ff = res.displacement_m[0], res.force_n[0]
+                y, r2, t0, t1 = microphone((t, dd[:, 0], dd[:, 1], ff[:, 0], ff[:, 1]), rpm=rpm, teeth=cut.teeth,
+                                           seed=int(rng.integers(1 << 30)))
+                shop = growth_from_record(y, r2, rpm, cut.teeth, t0, t1)
+                rows.append((x, sig, white / sig, shop / sig, kap * x / sig))
+                print(f"  truth {k} {rpm:6.0f} rpm x {x:.2f}: SDM σ {sig:6.1f} /s; measured/SDM white "
+                      f"{white / sig:5.2f}, shop {shop / sig:5.2f}; κx/SDM {kap * x / sig:4.2f}", flush=True)
+    r = np.array(rows)
+    for j, name in ((2, "white-noise microphone"), (3, "shop microphone"), (4, "zero-order κ x")):
+        q = r[:, j]
+        ok = np.isfinite(q) & (q > 0.2) & (q < 5)
+        print(f"{name:24s}: /SDM median {np.median(q[ok]):.2f}, ln sd {np.std(np.log(q[ok])):.2f}; "
+              f"no rise read {np.sum(~np.isfinite(q))}/{q.size}, off by > ×5: {np.sum(np.isfinite(q) & ~ok)}")
+
+
+def bench_real():
+    from scipy.signal import butter, sosfiltfilt
+
+    rec = read_cut_record(REAL)
+    rate, rpm, fc = rec.rate_hz, 6460.0, 1067.3
+    print(f"\n## real recording ({REAL.name}: {rpm:.0f} rpm, 2 teeth, chatter at {fc} Hz)")
+    d = _period_difference(rec.samples, rate, 60.0 / rpm)
+    b = sosfiltfilt(butter(4, [fc - 60, fc + 60], btype="band", fs=rate, output="sos"), np.nan_to_num(d))
+    w = int(0.02 * rate)
+    n = b.size // w
+    le = 0.5 * np.log((b[:n * w].reshape(n, w) ** 2).mean(axis=1))
+    tw = (np.arange(n) + 0.5) * w / rate
+    for what, a, z in (("entry transient's decay", 7.10, 7.45), ("chatter's rise", 9.95, 10.85)):
+        s = (tw > a) & (tw < z)
+        sl, c = np.polyfit(tw[s], le[s], 1)
+        res = le[s] - (sl * tw[s] + c)
+        print(f"  {what} ({a}–{z} s): {sl:+.1f} /s (residual sd {np.std(res):.2f} ln), level "
+              f"{20 / math.log(10) * le[s][0]:.0f} → {20 / math.log(10) * le[s][-1]:.0f} dB FS")
+
+
+def bench_oracle(seeds, seed_start):
+    pr = cornelius_2024(0.1)
+    measured = {}
+    original = U.log_likelihood
+
+    def with_growth(prior, theta, cuts, **kw):
+        out = original(prior, theta, cuts, **kw)
+        idx = [r for r, c in enumerate(cuts) if not c.stable and (c.rpm, c.depth_m) in measured]
+        if not idx:
+            return out
+        rpm = np.array([cuts[r].rpm for r in idx])
+        depth = np.array([cuts[r].depth_m for r in idx])
+        a_lim, f_c = limit_at_speeds(prior, theta, rpm, kw.get("freq_hz"))
+        lr = 0.0 if kw.get("log_ratio") is None else np.asarray(kw["log_ratio"], float)[idx][None, :]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sp = growth_rate(prior, theta, rpm, f_c) * (np.log(depth)[None, :] - np.log(a_lim) - lr)
+        sp = np.where(np.isfinite(sp), sp, -1e3)
+        sm = np.array([measured[(cuts[r].rpm, cuts[r].depth_m)] for r in idx])[None, :]
+        g = -0.5 * ((sp - sm) / (0.3 * sm)) ** 2 - np.log(0.3 * sm * math.sqrt(2 * math.pi))
+        return out + np.logaddexp(math.log(0.95) + g, np.log(0.05 / (3 * sm))).sum(axis=1)
+
+    from bench_shop import SENSORS
+
+    for label, patch in (("as it is", False), ("with the growth rate (oracle, 25 %)", True)):
+        U.log_likelihood = with_growth if patch else original
+        print(f"\n## oracle: Cornelius σ 0.1, whole loop, 6 cuts without a stop, truths {seed_start}…"
+              f"{seed_start + seeds - 1}: {label}")
+        within, chat, cpu = [], [], []
+        for seed in range(seed_start, seed_start + seeds):
+            base = simulated_shop(pr, record=SENSORS["microphone"])
+            noise = np.random.default_rng(10_000 + seed)  # not the campaign's: both runs make the same first cuts
+
+            def shop(theta, rpm, depth_m, rng, duration_s=None, base=base, noise=noise):
+                c = base(theta, rpm, depth_m, rng, duration_s)
+                if not c.stable:
+                    mm, cut = pr.tool(theta)
+                    rho = float(sdm_spectral_radius(mm, mm, cut, rpm=rpm, depth=depth_m))
+                    sig = math.log(rho) * cut.teeth * rpm / 60.0
+                    if sig > 0:
+                        measured[(c.rpm, c.depth_m)] = sig * math.exp(0.25 * noise.standard_normal())
+                return c
+
+            r = virtual_campaign(pr, rng=np.random.default_rng(seed), shop=shop, max_cuts=6,
+                                 true_limit=sdm_limit(pr), stop=False)
+            made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
+            within.append(r.converged_after is not None)
+            chat.append(sum(not c.stable for c in made))
+            cpu.extend(r.update_cpu_s)
+            print(f"  truth {seed}: converged after {r.converged_after}, {chat[-1]} chattering; cuts "
+                  + " ".join(f"{c.rpm:.0f}/{1e3 * c.depth_m:.3f}{'s' if c.stable else 'C'}"
+                             + (f"[σ {measured[(c.rpm, c.depth_m)]:.0f}]" if (c.rpm, c.depth_m) in measured else "")
+                             for c in r.cuts)
+                  + f"; width {np.round(r.width, 2).tolist()}; coverage {np.round(r.coverage, 2).tolist()}"
+                  + ("; truth below the recommended depth after " + ",".join(
+                      str(n) for n, b in enumerate(r.below_recommended) if b) if any(r.below_recommended) else ""),
+                  flush=True)
+        print(f"  {label}: within 6 cuts {sum(within)}/{seeds}; chattering median {np.median(chat):.1f} "
+              f"({sum(c <= 1 for c in chat)}/{seeds} ≤ 1); CPU per update median {np.median(cpu):.1f} s, max "
+              f"{max(cpu):.1f} s")
+    U.log_likelihood = original
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", choices=("estimator", "real", "oracle"))
+    ap.add_argument("--truths", type=int, default=3)
+    ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--seed-start", type=int, default=20)
+    args = ap.parse_args()
+    print(f"# bench_growth — {platform.node()} {platform.machine()} {platform.processor() or ''}, "
+          f"{time.strftime('%Y-%m-%d %H:%M:%S %Z')}, NumPy {np.__version__}")
+    if args.only in (None, "real"):
+        bench_real()
+    if args.only in (None, "estimator"):
+        bench_estimator(args.truths, 6)
+    if args.only == "oracle":  # the whole loop twice: hours, only when asked
+        bench_oracle(args.seeds, args.seed_start)
+
+
+if __name__ == "__main__":
+    main()
