@@ -15,7 +15,8 @@ a two-sided measurement where the label gives a one-sided bound.
    exponential up to e⁻¹ below its top) against the SDM's ln ρ / T, and κ x (the zero-order model the update
    would use) against it too.
 2. ``real``: the real shop recording (examples/cuts): the same difference, band-passed ±60 Hz about its chatter
-   line, in 20 ms windows: the rate of the entry transient's decay and of the chatter's rise.
+   line, in 20 ms windows: the rate of the entry transient's decay and of the chatter's rise, fitted over stretches
+   read off that envelope by eye (printed with each rate).
 3. ``oracle``: the whole loop (Cornelius, 6 cuts without a stop, ``update``'s defaults), once as it is and once
    with each chattering cut's true growth rate (the SDM's, times e^{0.25 N(0,1)}: a measurement good to 25 %) in
    the likelihood: ln N(σ_m; κ(θ) ln(a / a_lim(θ)), (0.3 σ_m)²), 5 % outliers uniform on [0, 3 σ_m]. The upper
@@ -171,6 +172,7 @@ def bench_oracle(seeds, seed_start):
 
     for label, patch in (("as it is", False), ("with the growth rate (oracle, 25 %)", True)):
         U.log_likelihood = with_growth if patch else original
+        measured.clear()
         print(f"\n## oracle: Cornelius σ 0.1, whole loop, 6 cuts without a stop, truths {seed_start}…"
               f"{seed_start + seeds - 1}: {label}")
         within, chat, cpu = [], [], []

@@ -47,8 +47,8 @@ def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_a
     else:
         spin = None
     # the harmonics' sum is a Fourier series in the spindle's phase θ: tabulated once over a revolution by an inverse
-    # FFT (2^20 points: linear interpolation is off by (2π kmax / M)² / 8 < 3e-6 of a line) and read at each sample's
-    # θ, instead of kmax sines over every sample (800 of them at 600 rpm: seconds per record)
+    # FFT (M = 2^20 points: linear interpolation is off by (2π k / M)² / 8 of harmonic k's line, 3e-6 for k = 800)
+    # and read at each sample's θ, instead of kmax sines over every sample (800 of them at 600 rpm: seconds per record)
     k = np.arange(1, kmax + 1)
     a_air = air_lines / k
     a_cut = np.where(k % teeth == 0, 1.0, 0.1) / (k / teeth) ** 1.2
