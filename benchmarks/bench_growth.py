@@ -3,24 +3,25 @@
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_growth.py [--only estimator|real|oracle] [--truths 3]
         [--seed-start 20] [--seeds 20]
 
-An experiment, not a feature: toolpoint does not measure the growth rate yet (docs/design/shop.md, *A chattering
-cut's growth rate*). Just past the limit, chatter grows as e^{σ t} with σ = κ ln(a / a_lim) (κ:
-:func:`toolpoint.shop.model.growth_rate`), so a chattering cut whose record shows σ also says ln(a / a_lim) = σ / κ:
-a two-sided measurement where the label gives a one-sided bound.
+Just past the limit, chatter grows as e^{σ t} with σ = κ ln(a / a_lim) (κ: :func:`toolpoint.shop.model.growth_rate`),
+so a chattering cut whose record shows σ also says ln(a / a_lim) = σ / κ: a two-sided measurement where the label gives
+a one-sided bound. ``cut`` reads it (:mod:`toolpoint.shop.growth`) and ``update`` uses it (``growth_error``); the
+whole loop with and without it is ``bench_shop.py --only update --shops sim`` with ``--update '{"growth_error":
+null}'`` (docs/design/shop.md, *A chattering cut's growth rate*).
 
 1. ``estimator``: cuts of random Cornelius-case truths (σ 0.1) simulated in the time domain at 3 random speeds and
    at a = a_SDM e^x, x = 0.03, 0.1, 0.3, 0.6, heard by the campaign's microphone (white noise) and by the tests'
-   shop microphone (fans, spindle lines, pink room noise); σ read from the record (:func:`growth_from_record`: what
-   does not repeat every revolution, its power in windows of two tooth periods fitted by a floor plus a growing
-   exponential up to e⁻¹ below its top) against the SDM's ln ρ / T, and κ x (the zero-order model the update
-   would use) against it too.
-2. ``real``: the real shop recording (examples/cuts): the same difference, band-passed ±60 Hz about its chatter
-   line, in 20 ms windows: the rate of the entry transient's decay and of the chatter's rise, fitted over stretches
-   read off that envelope by eye (printed with each rate).
-3. ``oracle``: the whole loop (Cornelius, 6 cuts without a stop, ``update``'s defaults), once as it is and once
-   with each chattering cut's true growth rate (the SDM's, times e^{0.25 N(0,1)}: a measurement good to 25 %) in
-   the likelihood: ln N(σ_m; κ(θ) ln(a / a_lim(θ)), (0.3 σ_m)²), 5 % outliers uniform on [0, 3 σ_m]. The upper
-   bound of what measuring it would give; the update is patched in this script only.
+   shop microphone (fans, spindle lines, pink room noise) and its accelerometer on the spindle housing (a housing
+   mode, bearing and imbalance lines, mains hum, offset, drift); σ as ``cut`` reads it
+   (:func:`toolpoint.shop.growth.chatter_growth`) against the SDM's ln ρ / T, and κ x (the zero-order model the
+   update uses) against it too; why the records not read were not.
+2. ``real``: the real shop recording (examples/cuts): what ``cut`` reads; then the revolution difference,
+   band-passed ±60 Hz about its chatter line, in 20 ms windows: the rate of the entry transient's decay and of the
+   chatter's rise, fitted over stretches read off that envelope by eye (printed with each rate).
+3. ``oracle``: the whole loop (Cornelius, 6 cuts without a stop, ``update``'s defaults but ``growth_error=None``),
+   once as it is and once with each chattering cut's true growth rate (the SDM's, times e^{0.25 N(0,1)}: a
+   measurement good to 25 %) in the likelihood: ln N(σ_m; κ(θ) ln(a / a_lim(θ)), (0.3 σ_m)²), 5 % outliers uniform
+   on [0, 3 σ_m]. The upper bound of what a reading would give; the update is patched in this script only.
 
 Prints the machine and date first; CPU time where timed.
 """
@@ -38,11 +39,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from milling_sim import microphone  # noqa: E402
+from milling_sim import accelerometer, microphone  # noqa: E402
 
 from toolpoint.io.records import read_cut_record  # noqa: E402
 from toolpoint.shop import update as U  # noqa: E402
 from toolpoint.shop.campaign import microphone_record, sdm_limit, simulated_shop, virtual_campaign  # noqa: E402
+from toolpoint.shop.detect import analyse_cut  # noqa: E402
 from toolpoint.shop.model import cornelius_2024, growth_rate, limit_at_speeds, sdm_limits  # noqa: E402
 from toolpoint.simulation import sensor_signal, simulate_milling  # noqa: E402
 from toolpoint.stability.sdm import sdm_spectral_radius  # noqa: E402
@@ -50,44 +52,14 @@ from toolpoint.stability.sdm import sdm_spectral_radius  # noqa: E402
 REAL = Path(__file__).resolve().parents[1] / "examples" / "cuts" / "combined_chatter6567.mp3"
 
 
-def _period_difference(y, rate, period_s):
-    """y(t) − y(t − P): what repeats every P seconds removed (P one revolution: the tooth passing and the runout's
-    spindle lines), chatter kept with its growth (|1 − e^{−(σ + iω) P}| is constant in time)."""
-    t = np.arange(y.size) / rate
-    return y - np.interp(t - period_s, t, y, left=np.nan)
-
-
-def growth_from_record(y, rate, rpm, teeth, t0, t1):
-    """σ (1/s) of the chatter's rise in a record whose cut runs from t0 to t1 s; nan where it shows none.
-
-    The revolution difference's power in windows of two tooth periods, from the cut's start to the first window
-    within e⁻¹ (amplitude) of its top, fitted by ln(F + A e^{2σt}) (least squares in ln power; F: what the cut
-    holds besides chatter — its noise, the fans —, A: the kick's chatter at the start). Refused (nan): fewer than 5
-    windows before the top, or a top less than 3 × (amplitude) the cut's first windows.
-    """
-    from scipy.optimize import least_squares
-
-    T = 60.0 / (teeth * rpm)
-    d = _period_difference(y, rate, 60.0 / rpm)
-    w = max(int(round(2 * T * rate)), 32)
-    i0 = int((t0 + 60.0 / rpm) * rate)
-    seg = d[i0:int(t1 * rate)]
-    n = seg.size // w
-    if n < 6:
-        return float("nan")
-    lp = np.log(np.nanmean(seg[:n * w].reshape(n, w) ** 2, axis=1))
-    tt = (np.arange(n) + 0.5) * w / rate
-    top = lp.max()
-    if top - np.median(lp[:3]) < 2 * math.log(3.0):
-        return float("nan")
-    i1 = int(np.argmax(lp > top - 2.0))
-    if i1 < 4:
-        return float("nan")
-    tt, lp = tt[:i1 + 1], lp[:i1 + 1]
-    fit = least_squares(lambda q: np.logaddexp(q[0], q[1] + 2 * q[2] * tt) - lp,
-                        (np.median(lp[:3]), lp[-1] - 100.0 * tt[-1], 50.0),
-                        bounds=([-np.inf, -np.inf, 0.0], [np.inf, np.inf, 5000.0]))
-    return float(fit.x[2])
+def _read(y, rate, rpm, teeth, full_scale=1.0):
+    """σ (1/s) as ``cut`` reads it (the longest chattering cut's :class:`~toolpoint.shop.growth.ChatterGrowth`), or
+    the reason it was not read."""
+    an = analyse_cut(y, rate, rpm=rpm, teeth=teeth, full_scale=full_scale)
+    if an.growth is None:
+        return float("nan"), "judged stable"
+    g = an.growth
+    return (float("nan"), g.reason.split(" (")[0].split(":")[0]) if g.rate_per_s is None else (g.rate_per_s, None)
 
 
 def bench_estimator(truths, seed):
@@ -95,7 +67,7 @@ def bench_estimator(truths, seed):
     pr = cornelius_2024(0.1)
     rng = np.random.default_rng(seed)
     rate = 44100.0
-    rows = []
+    rows, why = [], []
     for k in range(truths):
         theta = pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None])[0]
         mm, cut = pr.tool(theta)
@@ -109,22 +81,34 @@ def bench_estimator(truths, seed):
                 res = simulate_milling(mm, mm, cut, rpm=[rpm], depth_m=[a], revolutions=250,
                                        seed=int(rng.integers(1 << 30)), seed_level=0.01)
                 _, v = sensor_signal(res, 0, kind="microphone", rate=rate, noise=0.0)
-                white = growth_from_record(microphone_record(v, rate, rng), rate, rpm, cut.teeth, 1.0,
-                                           1.0 + v.size / rate)
+                white, why_w = _read(microphone_record(v, rate, rng), rate, rpm, cut.teeth)
                 t = res.time_s[0] - res.time_s[0][0]
                 dd, ff = res.displacement_m[0], res.force_n[0]
                 y, r2, t0, t1 = microphone((t, dd[:, 0], dd[:, 1], ff[:, 0], ff[:, 1]), rpm=rpm, teeth=cut.teeth,
                                            seed=int(rng.integers(1 << 30)))
-                shop = growth_from_record(y, r2, rpm, cut.teeth, t0, t1)
-                rows.append((x, sig, white / sig, shop / sig, kap * x / sig))
-                print(f"  truth {k} {rpm:6.0f} rpm x {x:.2f}: SDM σ {sig:6.1f} /s; measured/SDM white "
-                      f"{white / sig:5.2f}, shop {shop / sig:5.2f}; κx/SDM {kap * x / sig:4.2f}", flush=True)
+                shop, why_s = _read(y, r2, rpm, cut.teeth)
+                y3, r3, *_ = accelerometer((t, dd[:, 0], dd[:, 1], ff[:, 0], ff[:, 1]), rpm=rpm, teeth=cut.teeth,
+                                           seed=int(rng.integers(1 << 30)))
+                acc, why_a = _read(y3, r3, rpm, cut.teeth, full_scale=None)
+                rows.append((x, sig, white / sig, shop / sig, acc / sig, kap * x / sig))
+                why.extend(w for w in (why_w, why_s, why_a) if w)
+                print(f"  truth {k} {rpm:6.0f} rpm x {x:.2f}: SDM σ {sig:6.1f} /s; read/SDM white "
+                      f"{white / sig:5.2f}{' (' + why_w + ')' if why_w else ''}, shop {shop / sig:5.2f}"
+                      f"{' (' + why_s + ')' if why_s else ''}, accelerometer {acc / sig:5.2f}"
+                      f"{' (' + why_a + ')' if why_a else ''}; κx/SDM {kap * x / sig:4.2f}", flush=True)
     r = np.array(rows)
-    for j, name in ((2, "white-noise microphone"), (3, "shop microphone"), (4, "zero-order κ x")):
+    for j, name in ((2, "white-noise microphone"), (3, "shop microphone"), (4, "housing accelerometer"),
+                    (5, "zero-order κ x")):
         q = r[:, j]
-        ok = np.isfinite(q) & (q > 0.2) & (q < 5)
-        print(f"{name:24s}: /SDM median {np.median(q[ok]):.2f}, ln sd {np.std(np.log(q[ok])):.2f}; "
-              f"no rise read {np.sum(~np.isfinite(q))}/{q.size}, off by > ×5: {np.sum(np.isfinite(q) & ~ok)}")
+        ok = np.isfinite(q)
+        print(f"{name:24s}: /SDM median {np.median(q[ok]):.2f}, ln sd {np.std(np.log(q[ok])):.2f}, 5–95 % "
+              f"{np.quantile(q[ok], 0.05):.2f}–{np.quantile(q[ok], 0.95):.2f}; not read {np.sum(~ok)}/{q.size}")
+        for xv in (0.03, 0.1, 0.3, 0.6):
+            s = ok & (r[:, 0] == xv)
+            if s.any():
+                print(f"    x {xv:.2f}: median {np.median(q[s]):.2f}, read {s.sum()}/{np.sum(r[:, 0] == xv)}")
+    from collections import Counter
+    print("  not read, why:", dict(Counter(why)))
 
 
 def bench_real():
@@ -133,7 +117,11 @@ def bench_real():
     rec = read_cut_record(REAL)
     rate, rpm, fc = rec.rate_hz, 6460.0, 1067.3
     print(f"\n## real recording ({REAL.name}: {rpm:.0f} rpm, 2 teeth, chatter at {fc} Hz)")
-    d = _period_difference(rec.samples, rate, 60.0 / rpm)
+    c0 = time.process_time()
+    an = analyse_cut(rec.samples, rate, rpm=rpm, teeth=2, full_scale=rec.full_scale)
+    print(f"  cut reads: {an.growth} ({time.process_time() - c0:.1f} s CPU with the analysis)")
+    t = np.arange(rec.samples.size) / rate
+    d = rec.samples - np.interp(t - 60.0 / rpm, t, rec.samples, left=np.nan)
     b = sosfiltfilt(butter(4, [fc - 60, fc + 60], btype="band", fs=rate, output="sos"), np.nan_to_num(d))
     w = int(0.02 * rate)
     n = b.size // w
@@ -191,7 +179,7 @@ def bench_oracle(seeds, seed_start):
                 return c
 
             r = virtual_campaign(pr, rng=np.random.default_rng(seed), shop=shop, max_cuts=6,
-                                 true_limit=sdm_limit(pr), stop=False)
+                                 true_limit=sdm_limit(pr), stop=False, growth_error=None)  # the oracle's term only
             made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
             within.append(r.converged_after is not None)
             chat.append(sum(not c.stable for c in made))

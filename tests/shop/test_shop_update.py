@@ -416,6 +416,20 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
         f"for at least 1.0 s ({nc['revolutions']} rev)" in printed
     assert f"for at least 1.0 s ({nc['revolutions']} revolutions)" in (out / "report.html").read_text()
     assert 5000 <= doc["recommended"]["rpm"] <= 25000 and len(doc["cuts"]) == 3
+    # a chattering cut's growth rate goes with it to update.json and the report, and moves the band; --no-growth
+    # leaves it out of the likelihood: the same posterior as the table without it
+    grown = tmp_path / "grown.csv"
+    grown.write_text("rpm,depth_mm,result,chatter_hz,growth_per_s\n20000,0.5,stable,,\n20000,0.9,chatter,1290,60\n"
+                     "12000,0.3,stable,,\n")
+    for o, extra in (("grown", []), ("ungrown", ["--no-growth"])):
+        assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(grown), "--out", str(tmp_path / o),
+                     "--samples", "300", *extra]) == 0
+    capsys.readouterr()
+    g = json.loads((tmp_path / "grown" / "update.json").read_text())
+    assert [c["growth_per_s"] for c in g["cuts"]] == [None, 60.0, None] and doc["cuts"][1]["growth_per_s"] is None
+    assert "<th>growth 1/s</th>" in (tmp_path / "grown" / "report.html").read_text()
+    assert (tmp_path / "ungrown" / "lobes.csv").read_text() == (out / "lobes.csv").read_text()
+    assert (tmp_path / "grown" / "lobes.csv").read_text() != (out / "lobes.csv").read_text()
     # the zero-order forward model has no SDM check: the recommended depth is the band's 5 % limit
     assert doc["recommended"]["depth_mm"] == doc["recommended"]["limit_p05_mm"]
     assert doc["recommended"]["own_sdm_p05_mm"] is None and doc["recommended"]["own_sdm_held_out"] is None

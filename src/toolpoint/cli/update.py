@@ -2,8 +2,9 @@
 
 Bayesian update of the stability lobes from test cuts (:func:`toolpoint.shop.update`): the prior is a modal-prior
 TOML file (:mod:`toolpoint.shop.prior`) or a tool of a ``library`` output; the test cuts a CSV ``rpm, depth_mm,
-result`` (stable|chatter), optional ``chatter_hz``, ``duration_s`` (how long the tool cut) and ``record`` (a record
-of the cut, analysed as ``toolpoint cut`` does; it also gives the duration), with ``start_s``/``end_s`` where the
+result`` (stable|chatter), optional ``chatter_hz``, ``duration_s`` (how long the tool cut), ``growth_per_s`` (how fast a
+chattering cut's chatter grew, 1/s) and ``record`` (a record of the cut, analysed as ``toolpoint cut`` does; it also
+gives the duration and the growth rate), with ``start_s``/``end_s`` where the
 record holds several cuts (the row's part of it, as ``cut --start --end``). Writes ``lobes.csv``, ``p_stable.csv``,
 ``parameters.csv``, ``update.json`` (recommended point, the next test cut and its rule), ``lobes.png`` and
 ``report.html`` in ``--out``; prints the recommendation and the next cut. Contradictory labels are refused (exit 2),
@@ -33,8 +34,11 @@ def register(sub) -> None:
                    "CSV/UFF/CutPro) whose modes the prior takes, in place of the file's [[mode]] tables")
     p.add_argument("--sigma-freq", help="with --library: log standard deviation of the natural frequencies "
                    "(default 0.01: the running spindle's shift, which the library does not model)")
-    p.add_argument("--cuts", help="test-cut table CSV (rpm, depth_mm, result[, chatter_hz][, duration_s][, record"
-                   "[, start_s, end_s]]); without it: the prior's lobes and the first cut")
+    p.add_argument("--cuts", help="test-cut table CSV (rpm, depth_mm, result[, chatter_hz][, duration_s]"
+                   "[, growth_per_s][, record[, start_s, end_s]]); without it: the prior's lobes and the first cut")
+    p.add_argument("--no-growth", action="store_true",
+                   help="leave the chattering cuts' growth rates out of the update (their labels and chatter "
+                   "frequencies stay): docs/design/shop.md, *A chattering cut's growth rate*")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--seed", default="0", help="random seed (default 0)")
     p.add_argument("--samples", default="1000", help="posterior samples (default 1000)")
@@ -105,6 +109,8 @@ def run(args) -> int:
     if args.max_cut_duration is not None:
         offset["max_cut_duration_s"] = check_number(args.max_cut_duration, "--max-cut-duration", above=0,
                                                     maximum=3600, unit="s")
+    if args.no_growth:
+        offset["growth_error"] = None
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")
     if args.sigma_freq is not None and not args.library:

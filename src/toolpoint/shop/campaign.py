@@ -131,8 +131,9 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
     Returns
     -------
     callable
-        ``shop(theta, rpm, depth_m, rng, duration_s=None) -> TestCut`` with the detector's verdict and chatter
-        frequency; a cut lasts ``revolutions``, or ``duration_s`` (s) when that is longer.
+        ``shop(theta, rpm, depth_m, rng, duration_s=None) -> TestCut`` with the detector's verdict, chatter
+        frequency and growth rate (:mod:`toolpoint.shop.growth`); a cut lasts ``revolutions``, or ``duration_s``
+        (s) when that is longer.
     """
     from ..simulation import sensor_signal, simulate_milling
     from .detect import analyse_cut
@@ -153,7 +154,8 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
         x, fs = make(res, float(rpm), cut.teeth, rng)
         r = analyse_cut(x, fs, rpm=float(rpm), teeth=cut.teeth, **{"full_scale": 1.0, **opts})
         return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz,
-                       duration_s=revs * 60.0 / float(rpm), warnings=tuple(r.criterion.get("warnings", ())))
+                       duration_s=revs * 60.0 / float(rpm), warnings=tuple(r.criterion.get("warnings", ())),
+                       growth_per_s=None if r.growth is None else r.growth.rate_per_s)
     return shop
 
 

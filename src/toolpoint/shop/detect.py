@@ -315,6 +315,9 @@ class CutAnalysis:
         from a ground loop is a steady tone there, and without the air cut only its strength is judged).
     time_s, freq_hz, power : ndarray
         The spectrogram (frame centres s, frequencies Hz, power per bin) for the figure.
+    growth : ChatterGrowth or None
+        How fast the chatter of the longest chattering cut grew (:func:`toolpoint.shop.growth.chatter_growth`: its
+        rate σ, 1/s, or why it was not read); None when stable.
     """
 
     verdict: str
@@ -329,6 +332,7 @@ class CutAnalysis:
     time_s: np.ndarray = field(repr=False)
     freq_hz: np.ndarray = field(repr=False)
     power: np.ndarray = field(repr=False)
+    growth: object = None
 
     @property
     def cuts(self) -> tuple:
@@ -377,6 +381,7 @@ class CutAnalysis:
                 "tooth_passing_hz": round(float(self.rpm) * self.teeth / 60, 4),
                 "recommended_rpm": None if self.recommended_rpm is None else round(float(self.recommended_rpm), 1),
                 "alternatives_rpm": [round(float(a), 1) for a in self.alternatives_rpm],
+                "growth": None if self.growth is None else self.growth.to_dict(),
                 "criterion": self.criterion}
 
 
@@ -1092,8 +1097,16 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                  "speed_wander": round(wander, 6), "speed_tracked": track is not None,
                  "speed_elsewhere_rpm": None if elsewhere is None else round(60 * elsewhere[0], 1),
                  "analysed_rate_hz": rate, "warnings": warns}
-    return CutAnalysis(verdict, chatter_hz, tuple(segments), float(rpm), 60 * f_s, int(teeth), rec,
-                       alts, criterion, frame_t, freq, P)
+    res = CutAnalysis(verdict, chatter_hz, tuple(segments), float(rpm), 60 * f_s, int(teeth), rec,
+                      alts, criterion, frame_t, freq, P)
+    chatty = [c for c in res.cuts if c[2] == "chatter"]
+    if chatty:  # how fast its chatter grew (shop.growth): the longest chattering cut's, as chatter_hz is its
+        from .growth import chatter_growth
+
+        ta, tb, _, hz = max(chatty, key=lambda c: c[1] - c[0])
+        res = replace(res, growth=chatter_growth(x, rate, rpm=60 * f_s, teeth=teeth, chatter_hz=hz, start_s=ta,
+                                                 end_s=tb))
+    return res
 
 
 def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, activity_db):
@@ -1280,7 +1293,10 @@ def _harmonic_mask(freq, inband, f_lo, f_hi, df):
 def _shifted(res: CutAnalysis, t0: float, criterion: dict) -> CutAnalysis:
     """``res`` of a part of a record that starts at ``t0`` s, its times the record's again (segments, frames)."""
     segs = tuple(replace(g, start_s=g.start_s + t0, end_s=g.end_s + t0) for g in res.segments)
-    return replace(res, segments=segs, criterion=criterion, time_s=res.time_s + t0)
+    gr = res.growth
+    if gr is not None and gr.start_s is not None:
+        gr = replace(gr, start_s=gr.start_s + t0, end_s=gr.end_s + t0)
+    return replace(res, segments=segs, criterion=criterion, time_s=res.time_s + t0, growth=gr)
 
 
 def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, inband, df, source) -> None:

@@ -37,6 +37,10 @@ chatter frequency f adds
     p(f | θ) = (1 − ε_f) N(d; 0, (σ_f f)²) + ε_f / f,   d = min_j |f − (f_c(θ, n) + j N n/60)|, j = −2…2,
 
 f_c the frequency of the limiting lobe at n (a detector may report an alias f_c + j f_t), σ_f = 2 %.
+A chattering cut whose record shows how fast its chatter grew, σ_m (1/s, :mod:`toolpoint.shop.growth`), also says
+how far past the limit it was: just past it σ = κ ln(a/a_lim), so x_m = σ_m / (b κ(θ)) is read against the sample's
+x = ln(a/a_lim) (``growth_error``; :data:`GROWTH_ERROR`). Its error grows with x_m and adds to the boundary width w:
+the label bounds the limit from above, the rate from below too.
 
 The posterior is sampled by sequential Monte Carlo (Chopin 2002; Del Moral, Doucet & Jasra 2006): prior
 samples are tempered, L^β with β from 0 to 1 in steps that keep the effective sample size at half the
@@ -103,11 +107,19 @@ from ..errors import InputError
 from ..stability.zoa_batch import zoa_limits
 from .model import ModalPrior, growth_rate, limit_at_speeds, receptance, sdm_limits
 
-__all__ = ["DEFAULT_RISK", "TestCut", "Posterior", "read_test_cuts", "check_consistent", "log_likelihood", "update"]
+__all__ = ["DEFAULT_RISK", "GROWTH_ERROR", "TestCut", "Posterior", "read_test_cuts", "check_consistent",
+           "log_likelihood", "update"]
 
 
 DEFAULT_RISK = {"info": 0.3, "risk": 0.1}
 """The default bound on the next cut's P(chatter) of each next-cut rule (module docstring)."""
+
+GROWTH_ERROR = (1.0, 0.35, 0.7, 0.05)
+"""A measured chatter growth against the zero-order κ ln(a / a_lim): (bias b, relative sd above, below, outlier share).
+On simulated Cornelius-case cuts the readings were 0.89–0.91× the SDM's rate at the median (microphones and a
+housing accelerometer; ln sd 0.2–0.3) and κ x 0.90× (ln sd 0.18): b = 1, s₊ ≈ √(0.25² + 0.18²). Fast rises read low
+(0.75× at 60 % past the limit), so a reading below the prediction has the wider error (``docs/design/shop.md``, *A
+chattering cut's growth rate*)."""
 
 
 @dataclass(frozen=True)
@@ -115,7 +127,9 @@ class TestCut:
     """One test cut: speed (rpm), depth (m), stable or not, measured chatter frequency (Hz) if any, how long
     the tool cut (s; None: not known, :func:`update`'s ``cut_duration_s``), what the analysis of its record
     could not rule out (``warnings``: :func:`toolpoint.shop.analyse_cut`'s, e.g. chatter on a mains harmonic) and
-    the record (``record``: the table's file name, with its part ``(start–end s)`` where the row names one)."""
+    the record (``record``: the table's file name, with its part ``(start–end s)`` where the row names one), and
+    how fast a chattering cut's chatter grew (``growth_per_s``, σ in 1/s: :mod:`toolpoint.shop.growth`; None: not
+    read)."""
 
     __test__ = False  # a shop's test cut, not a pytest test class
 
@@ -128,16 +142,19 @@ class TestCut:
     duration_s: float | None = None
     warnings: tuple = ()
     record: str | None = None
+    growth_per_s: float | None = None
 
 
 def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
     """Read a test-cut table: CSV ``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz``,
-    ``duration_s`` (how long the tool cut, s), ``record``, ``start_s`` and ``end_s``; column names in any case,
+    ``duration_s`` (how long the tool cut, s), ``growth_per_s`` (how fast a chattering cut's chatter grew, 1/s:
+    :mod:`toolpoint.shop.growth`), ``record``, ``start_s`` and ``end_s``; column names in any case,
     cells split at commas or (a spreadsheet's export with the decimal comma) semicolons
     (:func:`toolpoint.io.table.read_rows`).
 
     A ``record`` (path relative to the table) is analysed by :func:`toolpoint.shop.analyse_cut` (needs
-    ``teeth``): it gives ``result`` and ``chatter_hz`` where the table leaves them empty, and ``duration_s``
+    ``teeth``): it gives ``result``, ``chatter_hz`` and ``growth_per_s`` where the table leaves them empty, and
+    ``duration_s``
     (its longest run of entry, cut and exit); where both are given and disagree the table is refused (a
     contradiction is reported, not averaged). ``start_s`` and ``end_s`` (s from the record's start; either may be
     empty: its start, its end) name the part of the record that holds the row's cut, as ``toolpoint cut --start
@@ -185,6 +202,10 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             raise InputError(f"line {line}: {depth:g} mm is not a depth of cut", file=p, field="depth_mm")
         fc = num("chatter_hz", required=False)
         dur = num("duration_s", required=False)
+        grow = num("growth_per_s", required=False)
+        if grow is not None and grow > 1e4:
+            raise InputError(f"line {line}: {grow:g} /s is not a chatter's growth rate (e^σt: σ ≲ 1000 /s)", file=p,
+                             field="growth_per_s")
         if dur is not None and dur > 3600:
             raise InputError(f"line {line}: {dur:g} s is not a test cut's duration", file=p, field="duration_s")
         res = (row.get("result") or "").strip().lower()
@@ -238,6 +259,8 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             res = a.verdict
             if fc is None and a.chatter_hz is not None:
                 fc = a.chatter_hz
+            if grow is None and a.growth is not None and a.growth.rate_per_s is not None:
+                grow = a.growth.rate_per_s
             if dur is None:
                 dur = _cutting_s(a)
             warns = tuple(f"{what}: {w}" for w in a.criterion.get("warnings", ()))
@@ -250,7 +273,10 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             raise InputError(f"line {line}: empty (and no record)", file=p, field="result")
         if res == "stable" and fc is not None:
             raise InputError(f"line {line}: a stable cut has no chatter frequency", file=p, field="chatter_hz")
-        cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p), dur, warns, what if rec else None))
+        if res == "stable" and grow is not None:
+            raise InputError(f"line {line}: a stable cut has no chatter growth", file=p, field="growth_per_s")
+        cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p), dur, warns, what if rec else None,
+                            grow))
     if not cuts:
         raise InputError("no test cuts", file=p, field="rpm")
     check_consistent(cuts, source=str(p))
@@ -285,7 +311,7 @@ def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, s
 def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.05, label_noise: float = 0.002,
                    freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None,
                    miss_rate: float = 0.0, label_offset=0.0, label_growth=0.0,
-                   cut_duration_s: float = 1.0) -> np.ndarray:
+                   cut_duration_s: float = 1.0, growth_error=None) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
     ``log_ratio`` (per cut, optional): ln of a factor on the zero-order limit at the cut's speed (the SDM
@@ -295,7 +321,12 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     sample, (S,)): the labels' boundary is a_lim e^δ — chatter is heard only δ (ln) above the limit.
     ``label_growth`` G (scalar or (S,)): the boundary moves up by a further min(G / (κ t), 0.5) per cut, κ the
     sample's chatter growth rate at the cut (:func:`~toolpoint.shop.model.growth_rate`), t the cut's
-    ``duration_s`` (else ``cut_duration_s``): chatter is heard once it has grown by e^G."""
+    ``duration_s`` (else ``cut_duration_s``): chatter is heard once it has grown by e^G. ``growth_error`` (b, s₊,
+    s₋, o), None to leave it out: each chattering cut's measured growth σ_m (``TestCut.growth_per_s``) as a distance
+    past the limit, x_m = σ_m / (b κ) (κ the sample's :func:`~toolpoint.shop.model.growth_rate`), against the
+    sample's x = ln(a / a_lim) (a_lim with ``log_ratio``'s correction): x_m − x split-normal with sd
+    √((s₊ x_m)² + w²) above and √((s₋ x_m)² + w²) below (w the boundary width), a share o of readings anywhere in
+    a 100× range of σ (:func:`update`'s ``growth_error``)."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
@@ -328,6 +359,24 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         sd = freq_sigma * c.chatter_hz
         gauss = -0.5 * (d / sd) ** 2 - math.log(sd * math.sqrt(2 * math.pi))
         ll = ll + np.logaddexp(math.log(1 - freq_outlier) + gauss, math.log(freq_outlier / c.chatter_hz))
+    idx = [r for r, c in enumerate(cuts) if not c.stable and c.growth_per_s] if growth_error is not None else []
+    if idx:
+        # the reading as a distance past the limit, x_m = σ_m / (b κ), against the sample's x = ln(a / a_lim):
+        # its error grows with x_m (the reading's, s₊ / s₋) on top of the boundary width w (the limit's own model
+        # error: a reading cannot place the limit closer than the model knows where it is); b κ the Jacobian
+        b, s_hi, s_lo, out = (float(v) for v in growth_error)
+        sig = np.array([cuts[k].growth_per_s for k in idx], float)[None, :]
+        kap = growth_rate(prior, theta, rpm[idx], f_c[:, idx])
+        w = np.broadcast_to(np.asarray(boundary_width, float), (len(cuts),))[idx][None, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xm = sig / (b * kap)
+            r = xm - (np.log(depth[idx])[None, :] - np.log(a_lim[:, idx]) - lr[None, idx])
+            sd_hi, sd_lo = np.hypot(s_hi * xm, w), np.hypot(s_lo * xm, w)
+            sd = np.where(r > 0, sd_hi, sd_lo)
+            g = -0.5 * (r / sd) ** 2 + np.log(2.0 / (math.sqrt(2 * math.pi) * (sd_hi + sd_lo) * b * kap))
+        # no growth at the sample's lobe (κ ≤ 0, no lobe reaching the speed): the outliers' share alone
+        g = np.where((kap > 0) & np.isfinite(g), g, -np.inf)
+        ll = ll + np.logaddexp(math.log1p(-out) + g, np.log(out / (math.log(100.0) * sig))).sum(axis=1)
     return ll
 
 
@@ -441,7 +490,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            min_step: float | None = None, sdm_train: int = 0, miss_rate: float = 0.0,
            label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
            cut_duration_s: float = 1.0, risk_after_chatter: float | None = None,
-           skip_repeats: bool = True, audible_margin: float = 0.0, max_cut_duration_s: float = 5.0) -> Posterior:
+           skip_repeats: bool = True, audible_margin: float = 0.0, max_cut_duration_s: float = 5.0,
+           growth_error: tuple | None = GROWTH_ERROR) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -542,6 +592,13 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     max_cut_duration_s : float, default 5.0
         The longest next cut ``audible_margin`` proposes (s); it bounds the lengthening, not the length of the
         cuts already made.
+    growth_error : (float, float, float, float) or None, default :data:`GROWTH_ERROR`
+        How a chattering cut's measured growth rate σ_m (``TestCut.growth_per_s``, read from its record by
+        :mod:`toolpoint.shop.growth`) enters: as a distance past the limit x_m = σ_m / (b κ) (κ the sample's
+        :func:`~toolpoint.shop.model.growth_rate`) against the sample's ln(a / a_lim), split-normal with sd s₊ x_m
+        above and s₋ x_m below, each with the boundary width added in quadrature (the limit's own model error), a
+        share o of readings anywhere (:func:`log_likelihood`). The label bounds the limit from one side; the rate
+        says how far past it the cut was. None: the rates are not used.
     skip_repeats : bool, default True
         ``"info"`` rule: no candidate at the speed of an earlier cut (±0.5 %) that is no deeper than a stable cut there,
         or no shallower than a chattering one — the shop already knows how it ends. The likelihood takes each cut's
@@ -621,6 +678,16 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         raise InputError(f"must be in [0, 0.5] (ln), got {audible_margin}", field="audible_margin")
     if not (math.isfinite(max_cut_duration_s) and 0 < max_cut_duration_s <= 3600):
         raise InputError(f"must be in (0, 3600] s, got {max_cut_duration_s}", field="max_cut_duration_s")
+    if growth_error is not None:
+        try:
+            ge = tuple(float(v) for v in growth_error)
+        except (TypeError, ValueError):
+            raise InputError(f"must be (bias, sd above, sd below, outliers) or None, got {growth_error!r}",
+                             field="growth_error") from None
+        if not (len(ge) == 4 and 0.2 <= ge[0] <= 5 and 0.05 <= ge[1] <= 2 and 0.05 <= ge[2] <= 2
+                and 0 < ge[3] < 1):
+            raise InputError(f"needs bias in [0.2, 5], sds in [0.05, 2] (ln), outliers in (0, 1); got {growth_error!r}",
+                             field="growth_error")
     if min_step > 0 and rule != "info":
         raise InputError("the step above stable cuts belongs to the info rule; the risk rule has none",
                          field="min_step")
@@ -632,7 +699,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     free = np.r_[prior.sigma > 0, off_sd > 0, g_med > 0 and g_sd > 0]
     kw = dict(boundary_width=boundary_width, label_noise=label_noise, freq_sigma=freq_sigma, freq_hz=f,
               miss_rate=miss_rate, label_offset=(off_mu, off_sd), label_growth=(g_med, g_sd),
-              cut_duration_s=cut_duration_s)
+              cut_duration_s=cut_duration_s, growth_error=growth_error)
     z = _draw_z(rng, n_samples, free)
     ess_hist, acc = [], []
     log_ratio_grid = None

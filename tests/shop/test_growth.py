@@ -1,0 +1,125 @@
+"""A chattering cut's growth rate: read from records against the semi-discretisation (a second method), refused
+where a record has no single rate, carried by the test-cut table, and what the update makes of it."""
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from toolpoint.errors import InputError
+from toolpoint.shop.campaign import microphone_record
+from toolpoint.shop.detect import analyse_cut
+from toolpoint.shop.growth import chatter_growth
+from toolpoint.shop.model import cornelius_2024, growth_rate, limit_at_speeds, sdm_limits
+from toolpoint.shop.update import GROWTH_ERROR, TestCut, log_likelihood, read_test_cuts, update
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from milling_sim import microphone  # noqa: E402
+
+
+def _tone(rate, dur, sigma, f0=1030.0, spindle_hz=100.0, noise=0.01, seed=0, accel=0.0, t0=0.0):
+    """A chatter tone growing as e^{σ t + q t²} from 1e-3 at t0 s to a saturation at 1, over a spindle comb and white
+    noise."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(dur * rate)) / rate
+    u = np.maximum(t - t0, 0.0)
+    amp = 1e-3 * np.exp(np.minimum(sigma * u + accel * u * u, math.log(1e3)))
+    comb = sum(np.sin(2 * np.pi * k * spindle_hz * t + k) / k for k in range(1, 20))
+    return amp * np.sin(2 * np.pi * f0 * t) + comb + noise * rng.standard_normal(t.size), t
+
+
+@pytest.mark.parametrize("sigma", [5.0, 30.0, 80.0])
+def test_a_clean_exponential_rise_is_read(sigma):
+    """From 1e-3 to 1 after 0.3 s of a quiet cut; at 6000 rpm and 2 teeth the windows are 12.5 ms (1/B, B = 80 Hz),
+    so e^{6.9} at 80 /s takes 7 of them (at 150 /s, 3.7: refused as too fast)."""
+    rate = 20000.0
+    y, _ = _tone(rate, 1.5 + 8.0 / sigma, sigma, t0=0.3)
+    g = chatter_growth(y, rate, rpm=6000.0, teeth=2, chatter_hz=1030.0, start_s=0.0, end_s=y.size / rate)
+    assert g.rate_per_s == pytest.approx(sigma, rel=0.1), g
+    assert g.rise_ln > math.log(3.0)
+
+
+def test_records_without_one_rate_are_refused():
+    rate = 20000.0
+    # a rise that accelerates, as a cut whose depth ramps up: e^{q t²}, its rate from 1 /s to 30 /s
+    y, _ = _tone(rate, 2.0, 1.0, accel=7.25)
+    g = chatter_growth(y, rate, rpm=6000.0, teeth=2, chatter_hz=1030.0, start_s=0.0, end_s=2.0)
+    assert g.rate_per_s is None and "accelerates" in g.reason
+    # chatter there from the start: nothing quiet before it
+    y, _ = _tone(rate, 2.0, 1000.0)
+    g = chatter_growth(y, rate, rpm=6000.0, teeth=2, chatter_hz=1030.0, start_s=0.0, end_s=2.0)
+    assert g.rate_per_s is None and "already there" in g.reason
+    # a step (a change of engagement): no growth to read
+    y, t = _tone(rate, 2.0, 0.0)
+    y = y + np.where(t > 1.0, 1.0, 0.0) * np.sin(2 * np.pi * 1030.0 * t)
+    g = chatter_growth(y, rate, rpm=6000.0, teeth=2, chatter_hz=1030.0, start_s=0.0, end_s=2.0)
+    assert g.rate_per_s is None and "at once" in g.reason
+
+
+@pytest.mark.parametrize("rpm, x", [(11000.0, 0.05), (19000.0, 0.15)])
+def test_simulated_cuts_give_the_semi_discretisation_s_rate(rpm, x):
+    """Second method: a cut simulated in the time domain (Cornelius case) at a = a_SDM e^x, heard by the campaign's
+    microphone and by the tests' shop microphone (fans, spindle lines, pink noise), read by `cut` — against the SDM's
+    ln ρ / T. Over 60 such cuts (benchmarks/bench_growth.py --only estimator) the readings were 0.88× the SDM's at the
+    median; these two within 0.7–1.1×."""
+    from toolpoint.simulation import sensor_signal, simulate_milling
+    from toolpoint.stability.sdm import sdm_spectral_radius
+
+    pr = cornelius_2024(0.1)
+    th = pr.theta(np.zeros((1, pr.sigma.size)))[0]
+    mm, cut = pr.tool(th)
+    a = sdm_limits(pr, th, [rpm], chatter=False)[0][0] * math.exp(x)
+    ref = math.log(float(sdm_spectral_radius(mm, mm, cut, rpm=rpm, depth=a))) * cut.teeth * rpm / 60.0
+    res = simulate_milling(mm, mm, cut, rpm=[rpm], depth_m=[a], revolutions=250, seed=3, seed_level=0.01)
+    rng = np.random.default_rng(1)
+    _, v = sensor_signal(res, 0, kind="microphone", rate=44100.0, noise=0.0)
+    t = res.time_s[0] - res.time_s[0][0]
+    d, f = res.displacement_m[0], res.force_n[0]
+    shop, rate, *_ = microphone((t, d[:, 0], d[:, 1], f[:, 0], f[:, 1]), rpm=rpm, teeth=cut.teeth, seed=2)
+    for y in (microphone_record(v, 44100.0, rng), shop):
+        r = analyse_cut(y, 44100.0, rpm=rpm, teeth=cut.teeth, full_scale=1.0)
+        assert r.verdict == "chatter" and r.growth is not None
+        assert 0.7 < r.growth.rate_per_s / ref < 1.1, (r.growth, ref)
+        assert r.to_dict()["growth"]["rate_per_s"] == pytest.approx(r.growth.rate_per_s, abs=1e-3)
+
+
+def test_the_table_carries_the_growth_rate(tmp_path):
+    p = tmp_path / "cuts.csv"
+    p.write_text("rpm,depth_mm,result,chatter_hz,growth_per_s\n12000,0.4,chatter,1280,35\n10000,0.2,stable,,\n")
+    cuts = read_test_cuts(p)
+    assert cuts[0].growth_per_s == 35.0 and cuts[1].growth_per_s is None
+    for bad, what in (("10000,0.2,stable,,5", "a stable cut has no chatter growth"), ("12000,0.4,chatter,,1e6",
+                                                                                         "not a chatter's growth")):
+        p.write_text("rpm,depth_mm,result,chatter_hz,growth_per_s\n" + bad + "\n")
+        with pytest.raises(InputError, match=what) as e:
+            read_test_cuts(p)
+        assert e.value.field == "growth_per_s"
+
+
+def test_the_rate_says_how_far_past_the_limit_the_cut_was():
+    """A chattering cut at a known distance past the truth's limit, with the rate the truth predicts: the posterior
+    puts the limit at that speed within the band about the truth, and a cut read as growing 5× faster moves it down
+    (further past); a rate the samples cannot explain (a cut below their limit) counts as an outlier, not as −∞."""
+    pr = cornelius_2024(0.1)
+    z = np.random.default_rng(4).standard_normal((1, pr.sigma.size))
+    th = pr.theta(z)
+    rpm = 12000.0
+    a_lim, fc = limit_at_speeds(pr, th, [rpm])
+    kap = growth_rate(pr, th, [rpm], fc)[0, 0]
+    depth = float(a_lim[0, 0]) * math.exp(0.15)
+    quant = {}
+    b = GROWTH_ERROR[0]
+    for name, sig in (("none", None), ("right", b * kap * 0.15), ("fast", 5 * b * kap * 0.15)):
+        post = update(pr, [TestCut(rpm, depth, False, float(fc[0, 0]), growth_per_s=sig)], rng=np.random.default_rng(0),
+                      n_samples=600, lobe_samples=150, forward="zoa")
+        lim = limit_at_speeds(pr, post.theta, [rpm])[0][:, 0]
+        quant[name] = np.quantile(np.log(depth / lim), [0.05, 0.5, 0.95])
+    lo, med, hi = quant["right"]
+    assert lo < 0.15 < hi and abs(med - 0.15) < 0.1, quant
+    assert hi - lo < 0.7 * (quant["none"][2] - quant["none"][0]), quant  # the rate narrows it
+    # 5× the rate says 0.75 past, in the prior's tail (its 95 % is 0.53): the median moves past the right one's 95 %
+    assert quant["fast"][1] > hi and quant["fast"][2] > quant["none"][2], quant
+    ll = log_likelihood(pr, th, [TestCut(rpm, 0.5 * depth, False, None, growth_per_s=50.0)], growth_error=GROWTH_ERROR)
+    assert np.isfinite(ll).all()
