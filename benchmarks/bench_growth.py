@@ -1,7 +1,7 @@
 """A chattering cut's growth rate: can a record tell how far past the limit a cut was, and what would it be worth?
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_growth.py [--only estimator|real|oracle] [--truths 3]
-        [--seed-start 20] [--seeds 20]
+        [--library-prior OUT:TOOL] [--seed-start 20] [--seeds 20]
 
 Just past the limit, chatter grows as e^{σ t} with σ = κ ln(a / a_lim) (κ: :func:`toolpoint.shop.model.growth_rate`),
 so a chattering cut whose record shows σ also says ln(a / a_lim) = σ / κ: a two-sided measurement where the label gives
@@ -62,16 +62,24 @@ def _read(y, rate, rpm, teeth, full_scale=1.0):
     return (float("nan"), g.reason.split(" (")[0].split(":")[0]) if g.rate_per_s is None else (g.rate_per_s, None)
 
 
-def bench_estimator(truths, seed):
-    print(f"\n## estimator: Cornelius σ 0.1, {truths} truths × 3 speeds × x ∈ (0.03, 0.1, 0.3, 0.6), seed {seed}")
-    pr = cornelius_2024(0.1)
+def bench_estimator(truths, seed, library_prior=None):
+    if library_prior:  # OUT:TOOL — a campaign tool as `update --library` sees it (EM12-60: a slow 750 Hz mode)
+        from toolpoint.shop.prior import prior_from_library
+
+        out, tool = library_prior.rsplit(":", 1)
+        pr, name = prior_from_library(out, tool), tool
+    else:
+        pr, name = cornelius_2024(0.1), "Cornelius σ 0.1"
+    lo, hi = pr.rpm_range if pr.rpm_range is not None else (5500.0, 24000.0)
+    print(f"\n## estimator: {name}, {truths} truths × 3 speeds in {lo:.0f}–{hi:.0f} rpm × x ∈ (0.03, 0.1, 0.3, 0.6), "
+          f"seed {seed}")
     rng = np.random.default_rng(seed)
     rate = 44100.0
     rows, why = [], []
     for k in range(truths):
         theta = pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None])[0]
         mm, cut = pr.tool(theta)
-        for rpm in rng.uniform(5500.0, 24000.0, 3):
+        for rpm in rng.uniform(max(lo, 5500.0), min(hi, 24000.0), 3):
             a_sdm = sdm_limits(pr, theta, [rpm], chatter=False)[0][0]
             _, f_z = limit_at_speeds(pr, theta[None], [rpm])
             kap = growth_rate(pr, theta[None], [rpm], f_z)[0, 0]
@@ -204,13 +212,14 @@ def main():
     ap.add_argument("--truths", type=int, default=3)
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=20)
+    ap.add_argument("--library-prior", help="OUT:TOOL — the estimator on a tool of a `toolpoint library` output")
     args = ap.parse_args()
     print(f"# bench_growth — {platform.node()} {platform.machine()} {platform.processor() or ''}, "
           f"{time.strftime('%Y-%m-%d %H:%M:%S %Z')}, NumPy {np.__version__}")
     if args.only in (None, "real"):
         bench_real()
     if args.only in (None, "estimator"):
-        bench_estimator(args.truths, 6)
+        bench_estimator(args.truths, 6, args.library_prior)
     if args.only == "oracle":  # the whole loop twice: hours, only when asked
         bench_oracle(args.seeds, args.seed_start)
 

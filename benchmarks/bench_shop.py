@@ -510,7 +510,9 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                 if verbose:
                     print(f"   seed {seed}: converged after {r.converged_after}, {chat[-1]} chattering; cuts "
                           + " ".join(f"{c.rpm:.0f}/{1e3 * c.depth_m:.2f}{'s' if c.stable else 'C'}"
-                                     + ("" if c.duration_s is None else f"({c.duration_s:.1f}s)") for c in r.cuts)
+                                     + ("" if c.duration_s is None else f"({c.duration_s:.1f}s)")
+                                     + ("" if c.growth_per_s is None else f"[σ {c.growth_per_s:.3g}/s]")
+                                     for c in r.cuts)
                           + f"; width {np.round(r.width, 2).tolist()}; coverage {np.round(r.coverage, 2).tolist()}"
                           + ("; truth below the recommended depth after "
                              + ",".join(str(n) for n, b in enumerate(r.below_recommended) if b)

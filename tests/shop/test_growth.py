@@ -123,3 +123,16 @@ def test_the_rate_says_how_far_past_the_limit_the_cut_was():
     assert quant["fast"][1] > hi and quant["fast"][2] > quant["none"][2], quant
     ll = log_likelihood(pr, th, [TestCut(rpm, 0.5 * depth, False, None, growth_per_s=50.0)], growth_error=GROWTH_ERROR)
     assert np.isfinite(ll).all()
+
+
+def test_a_rate_where_the_sdm_limit_is_another_lobe_is_left_out():
+    """Where the SDM correction at a cut exceeds 10 % its limiting lobe may be another than the zero-order's, whose κ
+    the term uses (EM12-60: κ x against the SDM's rate 0.07–1.6 there): the rate leaves the likelihood as it was."""
+    pr = cornelius_2024(0.1)
+    th = pr.sample(50, np.random.default_rng(2)).theta
+    with_rate = [TestCut(12000.0, 0.5e-3, False, 1280.0, growth_per_s=40.0)]
+    without = [TestCut(12000.0, 0.5e-3, False, 1280.0)]
+    for lr, same in ((0.05, False), (-0.05, False), (0.15, True), (-0.3, True)):
+        a = log_likelihood(pr, th, with_rate, log_ratio=[lr], growth_error=GROWTH_ERROR)
+        b = log_likelihood(pr, th, without, log_ratio=[lr], growth_error=GROWTH_ERROR)
+        assert np.array_equal(a, b) == same, lr

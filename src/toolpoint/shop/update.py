@@ -326,7 +326,8 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     past the limit, x_m = σ_m / (b κ) (κ the sample's :func:`~toolpoint.shop.model.growth_rate`), against the
     sample's x = ln(a / a_lim) (a_lim with ``log_ratio``'s correction): x_m − x split-normal with sd
     √((s₊ x_m)² + w²) above and √((s₋ x_m)² + w²) below (w the boundary width), a share o of readings anywhere in
-    a 100× range of σ (:func:`update`'s ``growth_error``)."""
+    a 100× range of σ (:func:`update`'s ``growth_error``); not at a cut whose ``log_ratio`` exceeds 0.1 in size
+    (the SDM's limiting lobe may be another than the zero-order's, whose κ this is)."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
@@ -359,7 +360,11 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         sd = freq_sigma * c.chatter_hz
         gauss = -0.5 * (d / sd) ** 2 - math.log(sd * math.sqrt(2 * math.pi))
         ll = ll + np.logaddexp(math.log(1 - freq_outlier) + gauss, math.log(freq_outlier / c.chatter_hz))
-    idx = [r for r, c in enumerate(cuts) if not c.stable and c.growth_per_s] if growth_error is not None else []
+    # where the SDM's limit lies more than 10 % from the zero-order's, its limiting lobe may be another (a flip lobe, a
+    # pocket): the zero-order lobe's κ does not describe the chatter heard, and the rate is left out (EM12-60: κ x
+    # against the SDM's rate 0.07–1.6 there, 0.89–1.07 within it but for one 1.96; docs/design/shop.md)
+    idx = [r for r, c in enumerate(cuts) if not c.stable and c.growth_per_s and abs(lr[r]) <= _GROWTH_LR_MAX] \
+        if growth_error is not None else []
     if idx:
         # the reading as a distance past the limit, x_m = σ_m / (b κ), against the sample's x = ln(a / a_lim):
         # its error grows with x_m (the reading's, s₊ / s₋) on top of the boundary width w (the limit's own model
@@ -380,6 +385,7 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     return ll
 
 
+_GROWTH_LR_MAX = 0.1  # |ln(a_SDM / a_ZOA)| at a cut beyond which its growth rate is not read (log_likelihood)
 _GROWTH_CAP = 0.5  # ln: a chatter that cannot grow audibly within the cut leaves the label uninformative, not wild
 
 
@@ -598,7 +604,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         :func:`~toolpoint.shop.model.growth_rate`) against the sample's ln(a / a_lim), split-normal with sd s₊ x_m
         above and s₋ x_m below, each with the boundary width added in quadrature (the limit's own model error), a
         share o of readings anywhere (:func:`log_likelihood`). The label bounds the limit from one side; the rate
-        says how far past it the cut was. None: the rates are not used.
+        says how far past it the cut was. With ``forward="sdm"`` the rates enter once the SDM correction is known,
+        and not at a cut where it exceeds 10 % (another lobe may limit there). None: the rates are not used.
     skip_repeats : bool, default True
         ``"info"`` rule: no candidate at the speed of an earlier cut (±0.5 %) that is no deeper than a stable cut there,
         or no shallower than a chattering one — the shop already knows how it ends. The likelihood takes each cut's
@@ -697,9 +704,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     # z: the prior's standard-normal coordinates; column P the label offset's (δ = μ + s z), P + 1 the label
     # growth's (G = G̃ e^{s_G z})
     free = np.r_[prior.sigma > 0, off_sd > 0, g_med > 0 and g_sd > 0]
+    # forward="sdm": the growth rates wait for the SDM correction (the zero-order pass only picks its references)
     kw = dict(boundary_width=boundary_width, label_noise=label_noise, freq_sigma=freq_sigma, freq_hz=f,
               miss_rate=miss_rate, label_offset=(off_mu, off_sd), label_growth=(g_med, g_sd),
-              cut_duration_s=cut_duration_s, growth_error=growth_error)
+              cut_duration_s=cut_duration_s, growth_error=growth_error if forward == "zoa" else None)
     z = _draw_z(rng, n_samples, free)
     ess_hist, acc = [], []
     log_ratio_grid = None
@@ -714,7 +722,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
             lr_c, lr_g = _sdm_log_ratio(prior, prior.theta(ref), rpm_c, grid, f)
             spread = lr_c.std(axis=0) if sdm_refs > 1 else np.zeros(rpm_c.size)
             kw2 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + spread ** 2),
-                       log_ratio=lr_c.mean(axis=0))
+                       log_ratio=lr_c.mean(axis=0), growth_error=growth_error)
             z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw2, method, n_moves, rng,
                         ess_hist, acc)
             log_ratio_grid = lr_g
@@ -732,7 +740,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 mean_u = lr_tr.mean(axis=0)
                 sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
                 kw3 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + sd_u[inv] ** 2),
-                           log_ratio=mean_u[inv])
+                           log_ratio=mean_u[inv], growth_error=growth_error)
                 z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw3, method, n_moves,
                             rng, ess_hist, acc)
                 log_ratio_grid = lr_g + _carry(mean_u[None, :] - lr_ref_u, grid, u)
