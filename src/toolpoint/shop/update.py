@@ -154,8 +154,7 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
 
     A ``record`` (path relative to the table) is analysed by :func:`toolpoint.shop.analyse_cut` (needs
     ``teeth``): it gives ``result``, ``chatter_hz`` and ``growth_per_s`` where the table leaves them empty, and
-    ``duration_s``
-    (its longest run of entry, cut and exit); where both are given and disagree the table is refused (a
+    ``duration_s`` (its longest run of entry, cut and exit); where both are given and disagree the table is refused (a
     contradiction is reported, not averaged). ``start_s`` and ``end_s`` (s from the record's start; either may be
     empty: its start, its end) name the part of the record that holds the row's cut, as ``toolpoint cut --start
     --end`` does: a shop that records a session of cuts in one file gives each cut its own row and part. What the
