@@ -41,6 +41,17 @@ def test_a_clean_exponential_rise_is_read(sigma):
     assert g.rise_ln > math.log(3.0)
 
 
+def test_a_chatter_that_falls_as_the_tool_leaves_is_read():
+    """The cut's span ends with its exit, where the chatter drops: that dip is no foot of a rise (it once made every
+    such record "rose within 0 windows")."""
+    rate = 20000.0
+    y, t = _tone(rate, 2.0, 30.0, t0=0.3)
+    y = y - np.where(t > 1.9, 0.999, 0.0) * 1e-3 * np.exp(np.minimum(30.0 * np.maximum(t - 0.3, 0), math.log(1e3))) \
+        * np.sin(2 * np.pi * 1030.0 * t)
+    g = chatter_growth(y, rate, rpm=6000.0, teeth=2, chatter_hz=1030.0, start_s=0.0, end_s=2.0)
+    assert g.rate_per_s == pytest.approx(30.0, rel=0.1), g
+
+
 def test_records_without_one_rate_are_refused():
     rate = 20000.0
     # a rise that accelerates, as a cut whose depth ramps up: e^{q t²}, its rate from 1 /s to 30 /s

@@ -93,7 +93,9 @@ def _rise(lp):
     k = 5  # smoothed over 5 windows to find it; fitted on the windows themselves
     sm = np.convolve(np.r_[np.full(k // 2, lp[0]), lp, np.full(k // 2, lp[-1])], np.ones(k) / k, mode="valid")
     top = min(float(np.median(sm[int(0.7 * sm.size):])), float(sm.max()))
-    below = np.flatnonzero(sm < top - 4.0)
+    # the last window near the top bounds the search: a dip after it (the exit, the tool leaving the cut) is no foot
+    last_up = int(np.flatnonzero(sm >= top - 2.0)[-1])
+    below = np.flatnonzero(sm[:last_up] < top - 4.0)
     if below.size == 0:
         return None, "the chatter is already there at the cut's start: its rise is not in the record"
     kb = int(below[-1])
