@@ -118,7 +118,7 @@ GROWTH_ERROR = (1.0, 0.35, 0.7, 0.05)
 """A measured chatter growth against the zero-order κ ln(a / a_lim): (bias b, relative sd above, below, outlier share).
 On simulated Cornelius-case cuts the readings were 0.89–0.91× the SDM's rate at the median (microphones and a
 housing accelerometer; ln sd 0.2–0.3) and κ x 0.90× (ln sd 0.18): b = 1, s₊ ≈ √(0.25² + 0.18²). Fast rises read low
-(0.75× at 60 % past the limit), so a reading below the prediction has the wider error (``docs/design/shop.md``, *A
+(0.52–0.80× at 60 % past the limit), so a reading below the prediction has the wider error (``docs/design/shop.md``, *A
 chattering cut's growth rate*)."""
 
 
