@@ -1,7 +1,7 @@
 """A chattering cut's growth rate: can a record tell how far past the limit a cut was, and what would it be worth?
 
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_growth.py [--only estimator|real|oracle] [--truths 3]
-        [--library-prior OUT:TOOL] [--seed-start 20] [--seeds 20]
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_growth.py [--only estimator|real|oracle|kappa] [--truths 3]
+        [--library-prior OUT:TOOL] [--agc] [--seed-start 20] [--seeds 20]
 
 Just past the limit, chatter grows as e^{σ t} with σ = κ ln(a / a_lim) (κ: :func:`toolpoint.shop.model.growth_rate`),
 so a chattering cut whose record shows σ also says ln(a / a_lim) = σ / κ: a two-sided measurement where the label gives
@@ -14,7 +14,9 @@ null}'`` (docs/design/shop.md, *A chattering cut's growth rate*).
    shop microphone (fans, spindle lines, pink room noise) and its accelerometer on the spindle housing (a housing
    mode, bearing and imbalance lines, mains hum, offset, drift); σ as ``cut`` reads it
    (:func:`toolpoint.shop.growth.chatter_growth`) against the SDM's ln ρ / T, and κ x (the zero-order model the
-   update uses) against it too; why the records not read were not.
+   update uses) against it too; why the records not read were not. With ``--agc`` the shop microphone's record is
+   also read through a phone's automatic gain control (``tests/shop_synth.phone_agc``: attack 0.05 s, release 2 s,
+   and 0.5 s both), which levels the record as the chatter grows.
 2. ``real``: the real shop recording (examples/cuts): what ``cut`` reads; then the revolution difference,
    band-passed ±60 Hz about its chatter line, in 20 ms windows: the rate of the entry transient's decay and of the
    chatter's rise, fitted over stretches read off that envelope by eye (printed with each rate).
@@ -22,6 +24,10 @@ null}'`` (docs/design/shop.md, *A chattering cut's growth rate*).
    once as it is and once with each chattering cut's true growth rate (the SDM's, times e^{0.25 N(0,1)}: a
    measurement good to 25 %) in the likelihood: ln N(σ_m; κ(θ) ln(a / a_lim(θ)), (0.3 σ_m)²), 5 % outliers uniform
    on [0, 3 σ_m]. The upper bound of what a reading would give; the update is patched in this script only.
+
+4. ``kappa``: no simulation — at random truths × 10 speeds the SDM's own σ at a = a_SDM e^x against κ x, with the
+   zero-order κ and with the SDM's slope at its limit: why ``update`` reads x_m from the SDM's growth curve
+   (``shop.update._sdm_growth_x``) rather than from a slope, where the SDM's limit lies > 10 % from the zero-order one.
 
 Prints the machine and date first; CPU time where timed.
 """
@@ -40,6 +46,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from milling_sim import accelerometer, microphone  # noqa: E402
+from shop_synth import phone_agc  # noqa: E402
 
 from toolpoint.io.records import read_cut_record  # noqa: E402
 from toolpoint.shop import update as U  # noqa: E402
@@ -62,7 +69,10 @@ def _read(y, rate, rpm, teeth, full_scale=1.0):
     return (float("nan"), g.reason.split(" (")[0].split(":")[0]) if g.rate_per_s is None else (g.rate_per_s, None)
 
 
-def bench_estimator(truths, seed, library_prior=None):
+AGC = ((0.05, 2.0), (0.5, 0.5))  # a phone's gain control: attack, release, s (the `cut` tests' two)
+
+
+def bench_estimator(truths, seed, library_prior=None, agc=False):
     if library_prior:  # OUT:TOOL — a campaign tool as `update --library` sees it (EM12-60: a slow 750 Hz mode)
         from toolpoint.shop.prior import prior_from_library
 
@@ -75,7 +85,7 @@ def bench_estimator(truths, seed, library_prior=None):
           f"seed {seed}")
     rng = np.random.default_rng(seed)
     rate = 44100.0
-    rows, why = [], []
+    rows, why, why_agc = [], [], []
     for k in range(truths):
         theta = pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None])[0]
         mm, cut = pr.tool(theta)
@@ -98,15 +108,21 @@ def bench_estimator(truths, seed, library_prior=None):
                 y3, r3, *_ = accelerometer((t, dd[:, 0], dd[:, 1], ff[:, 0], ff[:, 1]), rpm=rpm, teeth=cut.teeth,
                                            seed=int(rng.integers(1 << 30)))
                 acc, why_a = _read(y3, r3, rpm, cut.teeth, full_scale=None)
-                rows.append((x, sig, white / sig, shop / sig, acc / sig, kap * x / sig))
+                through = [_read(phone_agc(y, r2, *ar), r2, rpm, cut.teeth) for ar in (AGC if agc else ())]
+                rows.append((x, sig, white / sig, shop / sig, acc / sig, kap * x / sig, *(v / sig for v, _ in through)))
                 why.extend(w for w in (why_w, why_s, why_a) if w)
+                why_agc.extend(w for _, w in through if w)
                 print(f"  truth {k} {rpm:6.0f} rpm x {x:.2f}: SDM σ {sig:6.1f} /s; read/SDM white "
                       f"{white / sig:5.2f}{' (' + why_w + ')' if why_w else ''}, shop {shop / sig:5.2f}"
                       f"{' (' + why_s + ')' if why_s else ''}, accelerometer {acc / sig:5.2f}"
-                      f"{' (' + why_a + ')' if why_a else ''}; κx/SDM {kap * x / sig:4.2f}", flush=True)
+                      f"{' (' + why_a + ')' if why_a else ''}; κx/SDM {kap * x / sig:4.2f}"
+                      + "".join(f"; through gain control {ar[0]:g}/{ar[1]:g} s {v / sig:5.2f}"
+                                + (f" ({w})" if w else "") for ar, (v, w) in zip(AGC, through)), flush=True)
     r = np.array(rows)
-    for j, name in ((2, "white-noise microphone"), (3, "shop microphone"), (4, "housing accelerometer"),
-                    (5, "zero-order κ x")):
+    names = [(2, "white-noise microphone"), (3, "shop microphone"), (4, "housing accelerometer"),
+             (5, "zero-order κ x")]
+    names += [(6 + j, f"shop mic, gain control {a:g}/{b:g} s") for j, (a, b) in enumerate(AGC if agc else ())]
+    for j, name in names:
         q = r[:, j]
         ok = np.isfinite(q)
         print(f"{name:24s}: /SDM median {np.median(q[ok]):.2f}, ln sd {np.std(np.log(q[ok])):.2f}, 5–95 % "
@@ -117,6 +133,51 @@ def bench_estimator(truths, seed, library_prior=None):
                 print(f"    x {xv:.2f}: median {np.median(q[s]):.2f}, read {s.sum()}/{np.sum(r[:, 0] == xv)}")
     from collections import Counter
     print("  not read, why:", dict(Counter(why)))
+    if agc:
+        print("  through gain control, not read, why:", dict(Counter(why_agc)))
+
+
+def bench_kappa(truths, library_prior=None, seed=3):
+    """Why update reads x_m from the SDM's growth curve: at truths × 10 speeds, the SDM's σ at a = a_SDM e^x (x = 0.03,
+    0.1, 0.3) against κ x with the zero-order κ, and with the SDM's own slope at its limit (one-sided over 5 %)."""
+    if library_prior:
+        from toolpoint.shop.prior import prior_from_library
+
+        out, tool = library_prior.rsplit(":", 1)
+        pr, name = prior_from_library(out, tool), tool
+    else:
+        pr, name = cornelius_2024(0.1), "Cornelius σ 0.1"
+    lo, hi = pr.rpm_range if pr.rpm_range is not None else (5500.0, 24000.0)
+    print(f"\n## kappa: {name}, {truths} truths × 10 speeds in {lo:.0f}–{hi:.0f} rpm, seed {seed}: κ x / σ_SDM")
+    rng = np.random.default_rng(seed)
+    rows = []
+    for k in range(truths):
+        th = pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None])[0]
+        mm, cut = pr.tool(th)
+        rpms = np.sort(rng.uniform(lo, hi, 10))
+        a_s = sdm_limits(pr, th, rpms, chatter=False)[0]
+        a_z, fz = limit_at_speeds(pr, th[None], rpms)
+        kz = growth_rate(pr, th[None], rpms, fz)[0]
+        for j, rpm in enumerate(rpms):
+            if not np.isfinite(a_s[j]):
+                continue
+            ft = cut.teeth * rpm / 60.0
+            lr = math.log(a_s[j] / a_z[0, j])
+            rho = sdm_spectral_radius(mm, mm, cut, rpm=rpm, depth=a_s[j] * np.exp([0.05, 0.03, 0.1, 0.3]))
+            ks = math.log(rho[0]) / 0.05 * ft
+            sig = np.log(rho[1:]) * ft
+            for x, sg in zip((0.03, 0.1, 0.3), sig):
+                rows.append((abs(lr) > 0.1, x, kz[j] * x / sg, ks * x / sg))
+            print(f"  truth {k} {rpm:6.0f} rpm: ln(a_SDM/a_ZOA) {lr:+.2f}, κ zero-order {kz[j]:6.1f} /s, SDM slope "
+                  f"{ks:6.1f} /s; σ_SDM at x = 0.03 / 0.1 / 0.3: " + " / ".join(f"{v:.1f}" for v in sig), flush=True)
+    r = np.array(rows, float)
+    for far in (0.0, 1.0):
+        for x in (0.03, 0.1, 0.3):
+            s = (r[:, 0] == far) & (r[:, 1] == x)
+            if s.any():
+                print(f"  |ln ratio| {'> 0.1' if far else '≤ 0.1'}, x {x}: {s.sum()} speeds; zero-order κ x / σ median "
+                      f"{np.median(r[s, 2]):.2f} ({r[s, 2].min():.2f}–{r[s, 2].max():.2f}), SDM slope × x / σ "
+                      f"{np.median(r[s, 3]):.2f} ({r[s, 3].min():.2f}–{r[s, 3].max():.2f})")
 
 
 def bench_real():
@@ -208,18 +269,22 @@ def bench_oracle(seeds, seed_start):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--only", choices=("estimator", "real", "oracle"))
+    ap.add_argument("--only", choices=("estimator", "real", "oracle", "kappa"))
     ap.add_argument("--truths", type=int, default=3)
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=20)
     ap.add_argument("--library-prior", help="OUT:TOOL — the estimator on a tool of a `toolpoint library` output")
+    ap.add_argument("--agc", action="store_true",
+                    help="the estimator also reads the shop microphone through a phone's gain control (two settings)")
     args = ap.parse_args()
     print(f"# bench_growth — {platform.node()} {platform.machine()} {platform.processor() or ''}, "
           f"{time.strftime('%Y-%m-%d %H:%M:%S %Z')}, NumPy {np.__version__}")
     if args.only in (None, "real"):
         bench_real()
     if args.only in (None, "estimator"):
-        bench_estimator(args.truths, 6, args.library_prior)
+        bench_estimator(args.truths, 6, args.library_prior, args.agc)
+    if args.only == "kappa":
+        bench_kappa(args.truths, args.library_prior)
     if args.only == "oracle":  # the whole loop twice: hours, only when asked
         bench_oracle(args.seeds, args.seed_start)
 

@@ -82,3 +82,17 @@ def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_a
         for j, a in ((-1, 0.3), (1, 0.2)):
             x += chatter_amp * a * grow * np.sin(phase + 2 * np.pi * j * f_t * t)
     return x / (1.5 * np.abs(x).max()), rate, t0, t1
+
+
+def phone_agc(x, rate, attack_s, release_s, block=64):
+    """A phone recorder's automatic gain control: the record divided by its RMS envelope, which follows a rise within
+    ``attack_s`` and a fall within ``release_s`` (block by block; the envelope starts at the first 0.3 s's level)."""
+    p = np.add.reduceat(x ** 2, np.arange(0, x.size, block)) / block
+    env, e = np.empty_like(p), p[: int(0.3 * rate / block)].mean()
+    a_up, a_down = np.exp(-block / (attack_s * rate)), np.exp(-block / (release_s * rate))
+    for i, v in enumerate(p):  # a loop over blocks: the envelope is recursive
+        a = a_up if v > e else a_down
+        e = a * e + (1 - a) * v
+        env[i] = e
+    y = x * np.repeat(env ** -0.5, block)[: x.size]
+    return 0.9 * y / np.abs(y).max()

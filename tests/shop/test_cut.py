@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from shop_synth import shop_record
+from shop_synth import phone_agc, shop_record
 from toolpoint.cli.main import main
 from toolpoint.errors import InputError
 from toolpoint.io.records import read_cut_record
@@ -464,20 +464,6 @@ def test_a_drooping_or_wandering_spindle_is_not_chatter():
     assert not res.criterion["speed_tracked"] and res.criterion["speed_wander"] < 5e-4
 
 
-def _phone_agc(x, rate, attack_s, release_s, block=64):
-    """A phone recorder's automatic gain control: the record divided by its RMS envelope, which follows a rise within
-    ``attack_s`` and a fall within ``release_s`` (block by block; the envelope starts at the first 0.3 s's level)."""
-    p = np.add.reduceat(x ** 2, np.arange(0, x.size, block)) / block
-    env, e = np.empty_like(p), p[: int(0.3 * rate / block)].mean()
-    a_up, a_down = np.exp(-block / (attack_s * rate)), np.exp(-block / (release_s * rate))
-    for i, v in enumerate(p):  # a loop over blocks: the envelope is recursive
-        a = a_up if v > e else a_down
-        e = a * e + (1 - a) * v
-        env[i] = e
-    y = x * np.repeat(env ** -0.5, block)[: x.size]
-    return 0.9 * y / np.abs(y).max()
-
-
 @pytest.mark.parametrize("attack_s,release_s", [(0.05, 2.0), (0.5, 0.5)])
 def test_a_record_levelled_by_automatic_gain_control_is_split_and_judged_right(attack_s, release_s):
     # A phone levels the cut to the air cut's loudness within its attack time and lifts the air after the cut back
@@ -489,7 +475,7 @@ def test_a_record_levelled_by_automatic_gain_control_is_split_and_judged_right(a
         for chatter in (None, fc):
             x, rate, t0, t1 = shop_record(rpm=rpm, teeth=teeth, chatter_hz=chatter, chatter_amp=0.5, mode_hz=fc,
                                           cut_s=4.0, seed=seed)
-            res = analyse_cut(_phone_agc(x, rate, attack_s, release_s), rate, rpm=rpm, teeth=teeth, full_scale=1.0)
+            res = analyse_cut(phone_agc(x, rate, attack_s, release_s), rate, rpm=rpm, teeth=teeth, full_scale=1.0)
             assert res.verdict == ("stable" if chatter is None else "chatter"), (rpm, chatter)
             if chatter is not None:
                 assert abs(res.chatter_hz / fc - 1) < 0.01
@@ -986,7 +972,7 @@ def test_the_real_recording_through_a_phone_s_gain_control_keeps_its_air_cut(att
     air it leaves does not hold the cut's chatter: the level is upside down."""
     rec = read_cut_record(REAL)
     n = int(20 * rec.rate_hz)
-    x = _phone_agc(rec.samples[:n], rec.rate_hz, attack_s, release_s)
+    x = phone_agc(rec.samples[:n], rec.rate_hz, attack_s, release_s)
     res = analyse_cut(x, rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=1.0)
     assert res.segments[0].kind == "air" and res.segments[0].end_s > 5.0
     entry = next(s for s in res.segments if s.kind == "entry")

@@ -145,3 +145,56 @@ def test_a_rate_where_the_sdm_limit_is_another_lobe_is_left_out():
         a = log_likelihood(pr, th, with_rate, log_ratio=[lr], growth_error=GROWTH_ERROR)
         b = log_likelihood(pr, th, without, log_ratio=[lr], growth_error=GROWTH_ERROR)
         assert np.array_equal(a, b) == same, lr
+
+
+def test_the_sdm_s_own_growth_reads_the_distance_past_a_pocket_s_limit():
+    """Where the SDM's limit lies far from the zero-order one (8500 rpm on the Cornelius tool: ln ratio 0.56), the
+    rate is read by the SDM's own growth curve at reference samples near the truth: a cut 12 % past the truth's SDM
+    limit, with the SDM's own σ there (ln ρ / T, at a depth off the curve's grid), reads x within 0.02, where the
+    zero-order κ would say 0.09 (27 % short), measured from the curve's own zero crossing; a rate past the curve's
+    reach, or a curve already unstable at its start, is no reading; and in the likelihood the term favours the
+    samples that put the cut x_m past their limit."""
+    from toolpoint.shop.update import _sdm_growth_x
+    from toolpoint.stability.sdm import sdm_spectral_radius
+
+    pr = cornelius_2024(0.1)
+    z0 = np.zeros((1, pr.sigma.size))
+    th = pr.theta(z0)
+    rpm, x = 8500.0, 0.12
+    a_s = sdm_limits(pr, th[0], [rpm], chatter=False)[0][0]
+    a_z, fz = limit_at_speeds(pr, th, [rpm])
+    mm, cut = pr.tool(th[0])
+    ft = cut.teeth * rpm / 60.0
+    sig = math.log(float(sdm_spectral_radius(mm, mm, cut, rpm=rpm, depth=a_s * math.exp(x)))) * ft
+    kz = growth_rate(pr, th, [rpm], fz)[0, 0]
+    assert abs(sig / kz - x) > 0.025  # the zero-order κ misreads it here (0.088)
+    # references as a posterior pinned near the truth would give: close to it, each with its own SDM limit
+    ref_z = z0 + 0.03 * np.random.default_rng(5).standard_normal((4, pr.sigma.size))
+    ref = pr.theta(ref_z)
+    lr = np.log(np.array([[sdm_limits(pr, t, [rpm], chatter=False)[0][0]] for t in ref])
+                / limit_at_speeds(pr, ref, [rpm])[0])
+    cuts = [TestCut(rpm, a_s * math.exp(x), False, None, growth_per_s=sig),
+            TestCut(rpm, a_s * math.exp(x), False, None, growth_per_s=100 * sig),  # past x = 1
+            TestCut(rpm, 0.9 * a_s, True, None)]
+    xm, sd = _sdm_growth_x(pr, ref, cuts, np.repeat(lr, 3, axis=1), pr.freq_grid())
+    assert abs(xm[0] - x) < 0.02 and sd[0] < 0.02, (xm, sd)
+    assert np.isnan(xm[1]) and np.isnan(xm[2])
+    # x is read from the curve's own zero crossing, not from where the references' search put the limit: from the
+    # zero-order limit (lr 0, the SDM's 0.56 above it, within the curve's reach) the same x; from a limit put 1.5
+    # above the zero-order one (past the SDM's: unstable already at the curve's start) no reading
+    xm0, _ = _sdm_growth_x(pr, ref, cuts[:1], np.zeros((4, 1)), pr.freq_grid())
+    assert abs(xm0[0] - x) < 0.02, xm0
+    xm1, _ = _sdm_growth_x(pr, ref, cuts[:1], np.full((4, 1), 1.5), pr.freq_grid())
+    assert np.isnan(xm1[0])
+    # in the likelihood: the term (with the rate − without) is largest for the samples that put the cut x_m past
+    # their (corrected) limit, and falls off on either side
+    ths = pr.sample(200, np.random.default_rng(6)).theta
+    lr3 = [math.log(a_s / a_z[0, 0])]
+    kw = dict(log_ratio=lr3, growth_error=GROWTH_ERROR, growth_x=(xm[:1], sd[:1]))
+    term = log_likelihood(pr, ths, cuts[:1], **kw) - log_likelihood(
+        pr, ths, [TestCut(rpm, a_s * math.exp(x), False, None)], **kw)
+    xs = np.log(a_s * math.exp(x)) - np.log(limit_at_speeds(pr, ths, [rpm])[0][:, 0]) - lr3[0]
+    near = np.abs(xs - xm[0]) < 0.03
+    far = np.abs(xs - xm[0]) > 0.2
+    assert near.any() and far.any()
+    assert term[near].min() > term[far].max()

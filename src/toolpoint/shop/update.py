@@ -119,7 +119,8 @@ GROWTH_ERROR = (1.0, 0.35, 0.7, 0.05)
 On simulated Cornelius-case cuts the readings were 0.89–0.91× the SDM's rate at the median (microphones and a
 housing accelerometer; ln sd 0.2–0.3) and κ x 0.90× (ln sd 0.18): b = 1, s₊ ≈ √(0.25² + 0.18²). Fast rises read low
 (0.52–0.80× at 60 % past the limit), so a reading below the prediction has the wider error (``docs/design/shop.md``, *A
-chattering cut's growth rate*)."""
+chattering cut's growth rate*). With ``forward="sdm"`` the model's part of s₊ (κ x's 0.18) is the SDM growth curves'
+instead, whose references' spread is added on top; s₊ is kept, on the side of a wider band."""
 
 
 @dataclass(frozen=True)
@@ -310,7 +311,7 @@ def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, s
 def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.05, label_noise: float = 0.002,
                    freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None,
                    miss_rate: float = 0.0, label_offset=0.0, label_growth=0.0,
-                   cut_duration_s: float = 1.0, growth_error=None) -> np.ndarray:
+                   cut_duration_s: float = 1.0, growth_error=None, growth_x=None) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
     ``log_ratio`` (per cut, optional): ln of a factor on the zero-order limit at the cut's speed (the SDM
@@ -326,7 +327,10 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     sample's x = ln(a / a_lim) (a_lim with ``log_ratio``'s correction): x_m − x split-normal with sd
     √((s₊ x_m)² + w²) above and √((s₋ x_m)² + w²) below (w the boundary width), a share o of readings anywhere in
     a 100× range of σ (:func:`update`'s ``growth_error``); not at a cut whose ``log_ratio`` exceeds 0.1 in size
-    (the SDM's limiting lobe may be another than the zero-order's, whose κ this is)."""
+    (the SDM's limiting lobe may be another than the zero-order's, whose κ this is). ``growth_x`` (x_m, sd), each
+    (C,), nan where a cut's reading is not used: the distances past the limit the readings say by the SDM's own
+    growth (``_sdm_growth_x``), used instead of σ_m / (b κ) and the 10 % rule; its sd (the references' spread)
+    is added to the error in quadrature, and the outliers are uniform over x_m ∈ [0, 1.5]."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
@@ -359,9 +363,29 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         sd = freq_sigma * c.chatter_hz
         gauss = -0.5 * (d / sd) ** 2 - math.log(sd * math.sqrt(2 * math.pi))
         ll = ll + np.logaddexp(math.log(1 - freq_outlier) + gauss, math.log(freq_outlier / c.chatter_hz))
-    # where the SDM's limit lies more than 10 % from the zero-order's, its limiting lobe may be another (a flip lobe, a
-    # pocket): the zero-order lobe's κ does not describe the chatter heard, and the rate is left out (EM12-60: κ x
-    # against the SDM's rate 0.07–1.6 there, 0.89–1.07 within it but for one 1.96; docs/design/shop.md)
+    # without the SDM's growth curves (forward="zoa", or a caller's log_ratio): where the SDM's limit lies more than
+    # 10 % from the zero-order's, its limiting lobe may be another (a flip lobe, a pocket): the zero-order lobe's κ
+    # does not describe the chatter heard, and the rate is left out (EM12-60: κ x against the SDM's rate 0.07–1.6
+    # there, 0.89–1.07 within it but for one 1.96; docs/design/shop.md)
+    if growth_error is not None and growth_x is not None:
+        # the readings as distances past the limit by the SDM's own growth curves (the references'): x_m the same for
+        # every sample, so no Jacobian; the references' spread joins the reading's error
+        xg, xsd = (np.asarray(v, float) for v in growth_x)
+        idx = [r for r, c in enumerate(cuts) if not c.stable and c.growth_per_s and np.isfinite(xg[r])]
+        if idx:
+            _, s_hi, s_lo, out = (float(v) for v in growth_error)
+            xm, ref_sd = xg[idx][None, :], xsd[idx][None, :]
+            w = np.broadcast_to(np.asarray(boundary_width, float), (len(cuts),))[idx][None, :]
+            r = xm - (np.log(depth[idx])[None, :] - np.log(a_lim[:, idx]) - lr[None, idx])
+            sd_hi = np.sqrt((s_hi * xm) ** 2 + w ** 2 + ref_sd ** 2)
+            sd_lo = np.sqrt((s_lo * xm) ** 2 + w ** 2 + ref_sd ** 2)
+            with np.errstate(invalid="ignore"):
+                sd = np.where(r > 0, sd_hi, sd_lo)
+                g = -0.5 * (r / sd) ** 2 + np.log(2.0 / (math.sqrt(2 * math.pi) * (sd_hi + sd_lo)))
+            g = np.where(np.isfinite(g), g, -np.inf)  # no lobe reaches the speed: the outliers' share alone
+            # outliers: uniform over the x a 100× range of σ spans on the curve, taken as [0, 1.5] (ln)
+            ll = ll + np.logaddexp(math.log1p(-out) + g, math.log(out / 1.5)).sum(axis=1)
+        return ll
     idx = [r for r, c in enumerate(cuts) if not c.stable and c.growth_per_s and abs(lr[r]) <= _GROWTH_LR_MAX] \
         if growth_error is not None else []
     if idx:
@@ -604,7 +628,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         above and s₋ x_m below, each with the boundary width added in quadrature (the limit's own model error), a
         share o of readings anywhere (:func:`log_likelihood`). The label bounds the limit from one side; the rate
         says how far past it the cut was. With ``forward="sdm"`` the rates enter once the SDM correction is known,
-        and not at a cut where it exceeds 10 % (another lobe may limit there). None: the rates are not used.
+        and x_m is read from the SDM's own growth curves σ(x) = ln ρ(a_SDM e^x) / T at the references, not from
+        the zero-order κ (``_sdm_growth_x``: at a pocket or a flip lobe another lobe limits and grows, and κ x
+        was 0.04–2.2× the SDM's rate there); the references' spread joins the error. None: the rates are not
+        used.
     skip_repeats : bool, default True
         ``"info"`` rule: no candidate at the speed of an earlier cut (±0.5 %) that is no deeper than a stable cut there,
         or no shallower than a chattering one — the shop already knows how it ends. The likelihood takes each cut's
@@ -720,8 +747,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
             ref = z[rng.choice(n_samples, sdm_refs, replace=False), :P]
             lr_c, lr_g = _sdm_log_ratio(prior, prior.theta(ref), rpm_c, grid, f)
             spread = lr_c.std(axis=0) if sdm_refs > 1 else np.zeros(rpm_c.size)
+            gx = None if growth_error is None else _sdm_growth_x(prior, prior.theta(ref), cuts, lr_c, f,
+                                                                  float(growth_error[0]))
             kw2 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + spread ** 2),
-                       log_ratio=lr_c.mean(axis=0), growth_error=growth_error)
+                       log_ratio=lr_c.mean(axis=0), growth_error=growth_error, growth_x=gx)
             z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw2, method, n_moves, rng,
                         ess_hist, acc)
             log_ratio_grid = lr_g
@@ -739,7 +768,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 mean_u = lr_tr.mean(axis=0)
                 sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
                 kw3 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + sd_u[inv] ** 2),
-                           log_ratio=mean_u[inv], growth_error=growth_error)
+                           log_ratio=mean_u[inv], growth_error=growth_error, growth_x=gx)
                 z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw3, method, n_moves,
                             rng, ess_hist, acc)
                 log_ratio_grid = lr_g + _carry(mean_u[None, :] - lr_ref_u, grid, u)
@@ -925,6 +954,65 @@ def _sdm_log_ratio(prior, theta, rpm_cuts, grid, f):
         out_g[i] = log_ratio(s[inv_g], zg[i])
         out_c[i] = log_ratio(s[inv_c], zc[i])
     return out_c, out_g
+
+
+_GROWTH_X = np.array([-0.06, -0.04, -0.02, -0.01, 0.0, 0.01, 0.02, 0.035, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.6,
+                      0.8, 1.0])  # ln(a / a_SDM) of the growth curves (_sdm_growth_x)
+
+
+def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
+    """The distance past the limit, x_m (ln), that each chattering cut's measured growth σ_m says by the SDM's own
+    growth: at each reference sample (rows of ``theta``) its σ(x) = ln ρ(a_SDM e^x) / T at the cut's speed (ρ the
+    spectral radius per tooth period, a_SDM ≈ a_ZOA e^``lr_c`` the reference's limit there, as its search found it
+    to ~0.5 %), made monotone (its running maximum), over x ∈ [−0.06, 1]; x_m = x(σ_m / ``bias``) − x(0), from the
+    curve's own zero crossing (the limit exactly; the search's 0.5 % would be worth κ · 0.005 ≈ 2.5 /s on the
+    Cornelius tool, a quarter of a reading 2 % past). (mean, sd) over the references, each (C,); nan where a cut has
+    no reading, or fewer than two references bracket it (the reading past x = 1, or the curve not crossing zero
+    within the grid: no SDM limit near the search's).
+
+    Why not κ x: the zero-order κ (:func:`~toolpoint.shop.model.growth_rate`) is the zero-order lobe's slope at its
+    limit, and where the SDM's limit lies more than 10 % from it (a pocket, a flip lobe) another lobe limits and
+    grows: there κ x was 0.04–2.2× the SDM's σ on four EM12-60 truths, and a cut 10 % past a pocket's limit can grow
+    16× faster than the pocket's slope says, as the next lobe takes over (``docs/design/shop.md``)."""
+    from ..stability.sdm import sdm_spectral_radius
+
+    C = len(cuts)
+    xm, xsd = np.full(C, np.nan), np.full(C, np.nan)
+    use = [r for r, c in enumerate(cuts) if not c.stable and c.growth_per_s]
+    if not use:
+        return xm, xsd
+    rpm = np.array([cuts[r].rpm for r in use])
+    sig_m = np.array([cuts[r].growth_per_s for r in use], float) / bias
+    a_z = limit_at_speeds(prior, theta, rpm, f)[0]  # (R, U)
+    a_s = a_z * np.exp(np.asarray(lr_c, float)[:, use])
+    ft = prior.cutting.teeth * rpm / 60.0
+    got = np.full((theta.shape[0], len(use)), np.nan)
+    for i, t in enumerate(theta):
+        mm, cut = prior.tool(t)
+        ok = np.isfinite(a_s[i]) & (a_s[i] > 0)
+        if not ok.any():
+            continue
+        rho = sdm_spectral_radius(mm, mm, cut, rpm=rpm[ok][None, :],
+                                  depth=a_s[i, ok][None, :] * np.exp(_GROWTH_X)[:, None])  # (X, U')
+        sig = np.maximum.accumulate(np.log(np.maximum(rho, 1e-300)) * ft[ok][None, :], axis=0)
+        for j, q in zip(np.flatnonzero(ok), sig.T):
+            if q[0] >= 0 or q[-1] < sig_m[j]:
+                continue
+            got[i, j] = _cross(q, sig_m[j]) - _cross(q, 0.0)
+    n = np.sum(np.isfinite(got), axis=0)
+    for j, r in enumerate(use):
+        if n[j] >= 2:
+            v = got[np.isfinite(got[:, j]), j]
+            xm[r], xsd[r] = float(v.mean()), float(v.std(ddof=1))
+    return xm, xsd
+
+
+def _cross(q, level):
+    """x where the non-decreasing curve q over :data:`_GROWTH_X` first reaches ``level`` (q[0] < level ≤ q[-1]);
+    linear between the grid's points."""
+    k = int(np.argmax(q >= level))
+    u = (level - q[k - 1]) / (q[k] - q[k - 1])
+    return float(_GROWTH_X[k - 1] + u * (_GROWTH_X[k] - _GROWTH_X[k - 1]))
 
 
 def _sdm_own_log_ratio(prior, z, u, f, lr_guess, zoa=None):
