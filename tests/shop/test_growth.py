@@ -198,3 +198,33 @@ def test_the_sdm_s_own_growth_reads_the_distance_past_a_pocket_s_limit():
     far = np.abs(xs - xm[0]) > 0.2
     assert near.any() and far.any()
     assert term[near].min() > term[far].max()
+
+
+def test_the_update_says_how_far_past_the_limit_each_rate_read(tmp_path):
+    """``forward="sdm"``: the posterior and update.json carry, per cut, the distance past the limit the SDM's growth
+    curves read from its rate — for the chattering cut with a rate only, near where the truth's own curve puts it (a
+    cut 8 % past the truth's SDM limit with the truth's σ, 38.7 /s at 20000 rpm: 0.073–0.085 over update seeds 0–2,
+    from posterior references) — and nothing without the rates (``growth_error`` None) or under the zero-order
+    model, whose κ x is per sample."""
+    import json
+
+    from toolpoint.shop.report import write_update
+
+    pr = cornelius_2024(0.1)
+    th = pr.theta(np.zeros((1, pr.sigma.size)))
+    rpm = 20000.0
+    mm, cut = pr.tool(th[0])
+    a_s = sdm_limits(pr, th[0], [rpm], chatter=False)[0][0]
+    from toolpoint.stability.sdm import sdm_spectral_radius
+
+    sig = math.log(float(sdm_spectral_radius(mm, mm, cut, rpm=rpm, depth=a_s * math.exp(0.08)))) * cut.teeth * rpm / 60
+    cuts = [TestCut(rpm, 0.9 * a_s, True), TestCut(rpm, a_s * math.exp(0.08), False, None, growth_per_s=sig)]
+    kw = dict(n_samples=300, lobe_samples=100)
+    post = update(pr, cuts, rng=np.random.default_rng(0), forward="sdm", **kw)
+    assert post.growth_past_limit[0] is None and 0.05 < post.growth_past_limit[1] < 0.11, post.growth_past_limit
+    write_update(post, tmp_path)
+    doc = json.loads((tmp_path / "update.json").read_text())
+    assert doc["cuts"][1]["growth_past_limit_ln"] == pytest.approx(post.growth_past_limit[1], abs=1e-4)
+    assert "(x 0.0" in (tmp_path / "report.html").read_text()
+    for other in (dict(forward="sdm", growth_error=None), dict(forward="zoa")):
+        assert update(pr, cuts, rng=np.random.default_rng(0), **kw, **other).growth_past_limit == (None, None)

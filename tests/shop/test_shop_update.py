@@ -427,7 +427,7 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     capsys.readouterr()
     g = json.loads((tmp_path / "grown" / "update.json").read_text())
     assert [c["growth_per_s"] for c in g["cuts"]] == [None, 60.0, None] and doc["cuts"][1]["growth_per_s"] is None
-    assert "<th>growth 1/s</th>" in (tmp_path / "grown" / "report.html").read_text()
+    assert "<th>growth 1/s (x: ln past the limit)</th>" in (tmp_path / "grown" / "report.html").read_text()
     assert (tmp_path / "ungrown" / "lobes.csv").read_text() == (out / "lobes.csv").read_text()
     assert (tmp_path / "grown" / "lobes.csv").read_text() != (out / "lobes.csv").read_text()
     # the zero-order forward model has no SDM check: the recommended depth is the band's 5 % limit

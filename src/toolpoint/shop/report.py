@@ -103,8 +103,10 @@ def _doc(post: Posterior) -> dict:
         "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},
         "cuts": [{"rpm": c.rpm, "depth_mm": round(1e3 * c.depth_m, 6), "result": "stable" if c.stable else "chatter",
                   "chatter_hz": c.chatter_hz, "duration_s": c.duration_s, "growth_per_s": c.growth_per_s,
+                  "growth_past_limit_ln": None if x is None else round(x, 4),
                   "record": c.record,
-                  "warnings": [f"line {c.line}: {w}" if c.line else w for w in c.warnings]} for c in post.cuts],
+                  "warnings": [f"line {c.line}: {w}" if c.line else w for w in c.warnings]}
+                 for c, x in zip(post.cuts, post.growth_past_limit or (None,) * len(post.cuts))],
         "sampler": {"method": post.method, "forward": post.forward, "samples": int(post.z.shape[0]),
                     "ess": [round(e, 1) for e in post.ess],
                     "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
@@ -183,12 +185,20 @@ def away_note(cuts) -> str:
             "a test cut at a speed before trusting the band there")
 
 
+def _growth_cell(c) -> str:
+    """A cut's growth rate, 1/s, with how far past the limit (ln) the SDM's growth curves read it, where they did."""
+    if c["growth_per_s"] is None:
+        return ""
+    x = c.get("growth_past_limit_ln")
+    return format(c["growth_per_s"], ".3g") + ("" if x is None else f" (x {x:.3f})")
+
+
 def _html(post, doc, rows, png) -> str:
     e = html.escape
     rc, nc = doc["recommended"], doc["next_cut"]
     cut_rows = "".join(f"<tr><td>{c['rpm']:.0f}</td><td>{c['depth_mm']:.3f}</td><td>{c['result']}</td>"
                        f"<td>{'' if c['chatter_hz'] is None else format(c['chatter_hz'], '.1f')}</td>"
-                       f"<td>{'' if c['growth_per_s'] is None else format(c['growth_per_s'], '.3g')}</td>"
+                       f"<td>{_growth_cell(c)}</td>"
                        f"<td>{e(c['record'] or '')}</td></tr>" for c in doc["cuts"])
     par_rows = "".join("<tr>" + "".join(f"<td>{e(str(v))}</td>" for v in r) + "</tr>" for r in rows)
     s = doc["sampler"]
@@ -216,7 +226,7 @@ def _html(post, doc, rows, png) -> str:
         + f", P(chatter) {nc['p_chatter']:.2f}.</p>{caveat}"
         f"<img alt='lobes' style='max-width:100%' src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
         "<h2>Test cuts</h2><table><tr><th>rpm</th><th>depth mm</th><th>result</th><th>chatter Hz</th>"
-        "<th>growth 1/s</th><th>record</th></tr>"
+        "<th>growth 1/s (x: ln past the limit)</th><th>record</th></tr>"
         f"{cut_rows}</table>"
         "<h2>Parameters (5 / 50 / 95 %)</h2><table><tr><th>name</th><th>unit</th><th>prior 5</th><th>prior 50</th>"
         f"<th>prior 95</th><th>post 5</th><th>post 50</th><th>post 95</th></tr>{par_rows}</table>"

@@ -460,6 +460,12 @@ class Posterior:
         Prior mean and standard deviation of the label offset δ (ln; :func:`update`).
     label_growth : (float, float)
         Prior median and log standard deviation of the label growth G (ln of the amplitude; :func:`update`).
+    forward : str
+        The forward model, ``"sdm"`` or ``"zoa"``.
+    growth_past_limit : tuple of (float or None)
+        Per cut: how far past the limit (ln) its measured growth rate said it was, read from the SDM's growth curves
+        (``forward="sdm"``); None where no rate entered that way (a stable cut, no rate, ``growth_error`` None,
+        ``forward="zoa"`` — where κ x is per sample —, or a rate the references' curves do not bracket).
     """
 
     prior: ModalPrior
@@ -479,6 +485,7 @@ class Posterior:
     label_offset: tuple = (0.0, 0.0)
     label_growth: tuple = (0.0, 0.0)
     forward: str = "sdm"
+    growth_past_limit: tuple = ()
 
     @property
     def theta(self) -> np.ndarray:
@@ -737,6 +744,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     z = _draw_z(rng, n_samples, free)
     ess_hist, acc = [], []
     log_ratio_grid = None
+    gx = None  # the SDM growth curves' reading of the rates (forward="sdm" with cuts)
     grid = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)  # speeds of the lobes
     if cuts:
         z = _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc)
@@ -848,7 +856,9 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                growth_rate_p25_per_s=float(k25[0]) if np.isfinite(k25[0]) else None,
                duration_by_growth=bool(t_cut[0] > t_next * (1 + 1e-9)))
     return Posterior(prior, cuts, method, z, tuple(ess_hist), float(np.mean(acc)) if acc else float("nan"), grid, q,
-                     depths, p_st, qp, rec, nxt, time.process_time() - c0, (off_mu, off_sd), (g_med, g_sd), forward)
+                     depths, p_st, qp, rec, nxt, time.process_time() - c0, (off_mu, off_sd), (g_med, g_sd), forward,
+                     tuple(float(v) if np.isfinite(v) else None for v in (gx[0] if gx is not None else
+                                                                           np.full(len(cuts), np.nan))))
 
 
 def _draw_z(rng, n, free):
@@ -967,8 +977,8 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
     to ~0.5 %), made monotone (its running maximum), over x ∈ [−0.06, 1]; x_m = x(σ_m / ``bias``) − x(0), from the
     curve's own zero crossing (the limit exactly; the search's 0.5 % would be worth κ · 0.005 ≈ 2.5 /s on the
     Cornelius tool, a quarter of a reading 2 % past). (mean, sd) over the references, each (C,); nan where a cut has
-    no reading, or fewer than two references bracket it (the reading past x = 1, or the curve not crossing zero
-    within the grid: no SDM limit near the search's).
+    no reading, or fewer than two references bracket it (one, of one reference; the reading past x = 1, or the
+    curve not crossing zero within the grid: no SDM limit near the search's).
 
     Why not κ x: the zero-order κ (:func:`~toolpoint.shop.model.growth_rate`) is the zero-order lobe's slope at its
     limit, and where the SDM's limit lies more than 10 % from it (a pocket, a flip lobe) another lobe limits and
@@ -1000,10 +1010,11 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
                 continue
             got[i, j] = _cross(q, sig_m[j]) - _cross(q, 0.0)
     n = np.sum(np.isfinite(got), axis=0)
+    need = min(2, theta.shape[0])  # one reference (update's sdm_refs=1) reads alone, with no spread
     for j, r in enumerate(use):
-        if n[j] >= 2:
+        if n[j] >= need:
             v = got[np.isfinite(got[:, j]), j]
-            xm[r], xsd[r] = float(v.mean()), float(v.std(ddof=1))
+            xm[r], xsd[r] = float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else 0.0
     return xm, xsd
 
 
