@@ -228,3 +228,16 @@ def test_the_update_says_how_far_past_the_limit_each_rate_read(tmp_path):
     assert "(x 0.0" in (tmp_path / "report.html").read_text()
     for other in (dict(forward="sdm", growth_error=None), dict(forward="zoa")):
         assert update(pr, cuts, rng=np.random.default_rng(0), **kw, **other).growth_past_limit == (None, None)
+
+
+def test_a_rate_that_is_no_growth_is_left_out():
+    """A TestCut made in code (the table's reader refuses these) with a rate ≤ 0 or not finite leaves the likelihood
+    as the label alone, in both the zero-order and the SDM-curve terms."""
+    pr = cornelius_2024(0.1)
+    th = pr.sample(50, np.random.default_rng(2)).theta
+    without = log_likelihood(pr, th, [TestCut(12000.0, 0.5e-3, False, 1280.0)], growth_error=GROWTH_ERROR)
+    for bad in (-5.0, 0.0, float("nan"), float("inf")):
+        cut = [TestCut(12000.0, 0.5e-3, False, 1280.0, growth_per_s=bad)]
+        assert np.array_equal(log_likelihood(pr, th, cut, growth_error=GROWTH_ERROR), without), bad
+        gx = (np.array([0.1]), np.array([0.01]))
+        assert np.array_equal(log_likelihood(pr, th, cut, growth_error=GROWTH_ERROR, growth_x=gx), without), bad

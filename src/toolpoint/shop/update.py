@@ -371,7 +371,7 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         # the readings as distances past the limit by the SDM's own growth curves (the references'): x_m the same for
         # every sample, so no Jacobian; the references' spread joins the reading's error
         xg, xsd = (np.asarray(v, float) for v in growth_x)
-        idx = [r for r, c in enumerate(cuts) if not c.stable and c.growth_per_s and np.isfinite(xg[r])]
+        idx = [r for r, c in enumerate(cuts) if _rate(c) and np.isfinite(xg[r])]
         if idx:
             _, s_hi, s_lo, out = (float(v) for v in growth_error)
             xm, ref_sd = xg[idx][None, :], xsd[idx][None, :]
@@ -386,7 +386,7 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
             # outliers: uniform over the x a 100× range of σ spans on the curve, taken as [0, 1.5] (ln)
             ll = ll + np.logaddexp(math.log1p(-out) + g, math.log(out / 1.5)).sum(axis=1)
         return ll
-    idx = [r for r, c in enumerate(cuts) if not c.stable and c.growth_per_s and abs(lr[r]) <= _GROWTH_LR_MAX] \
+    idx = [r for r, c in enumerate(cuts) if _rate(c) and abs(lr[r]) <= _GROWTH_LR_MAX] \
         if growth_error is not None else []
     if idx:
         # the reading as a distance past the limit, x_m = σ_m / (b κ), against the sample's x = ln(a / a_lim):
@@ -406,6 +406,13 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         g = np.where((kap > 0) & np.isfinite(g), g, -np.inf)
         ll = ll + np.logaddexp(math.log1p(-out) + g, np.log(out / (math.log(100.0) * sig))).sum(axis=1)
     return ll
+
+
+def _rate(cut) -> float | None:
+    """A chattering cut's measured growth rate σ_m (1/s) where it can enter the likelihood: finite and > 0 (the
+    table's reader refuses others; a :class:`TestCut` made in code is not checked)."""
+    g = cut.growth_per_s
+    return float(g) if not cut.stable and g is not None and math.isfinite(g) and g > 0 else None
 
 
 _GROWTH_LR_MAX = 0.1  # |ln(a_SDM / a_ZOA)| at a cut beyond which its growth rate is not read (log_likelihood)
@@ -988,7 +995,7 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
 
     C = len(cuts)
     xm, xsd = np.full(C, np.nan), np.full(C, np.nan)
-    use = [r for r, c in enumerate(cuts) if not c.stable and c.growth_per_s]
+    use = [r for r, c in enumerate(cuts) if _rate(c)]
     if not use:
         return xm, xsd
     rpm = np.array([cuts[r].rpm for r in use])
