@@ -135,8 +135,10 @@ def test_the_rate_says_how_far_past_the_limit_the_cut_was():
 
 
 def test_a_rate_where_the_sdm_limit_is_another_lobe_is_left_out():
-    """Where the SDM correction at a cut exceeds 10 % its limiting lobe may be another than the zero-order's, whose κ
-    the term uses (EM12-60: κ x against the SDM's rate 0.07–1.6 there): the rate leaves the likelihood as it was."""
+    """Without the SDM's growth curves (``forward="zoa"``, or a caller's ``log_ratio`` alone): where the SDM correction
+    at a cut exceeds 10 % its limiting lobe may be another than the zero-order's, whose κ the term uses (EM12-60: κ x
+    against the SDM's rate 0.07–1.6 there): the rate leaves the likelihood as it was. (``update``'s SDM path reads
+    it through the curves instead: the next test.)"""
     pr = cornelius_2024(0.1)
     th = pr.sample(50, np.random.default_rng(2)).theta
     with_rate = [TestCut(12000.0, 0.5e-3, False, 1280.0, growth_per_s=40.0)]

@@ -363,10 +363,6 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         sd = freq_sigma * c.chatter_hz
         gauss = -0.5 * (d / sd) ** 2 - math.log(sd * math.sqrt(2 * math.pi))
         ll = ll + np.logaddexp(math.log(1 - freq_outlier) + gauss, math.log(freq_outlier / c.chatter_hz))
-    # without the SDM's growth curves (forward="zoa", or a caller's log_ratio): where the SDM's limit lies more than
-    # 10 % from the zero-order's, its limiting lobe may be another (a flip lobe, a pocket): the zero-order lobe's κ
-    # does not describe the chatter heard, and the rate is left out (EM12-60: κ x against the SDM's rate 0.07–1.6
-    # there, 0.89–1.07 within it but for one 1.96; docs/design/shop.md)
     if growth_error is not None and growth_x is not None:
         # the readings as distances past the limit by the SDM's own growth curves (the references'): x_m the same for
         # every sample, so no Jacobian; the references' spread joins the reading's error
@@ -386,6 +382,10 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
             # outliers: uniform over the x a 100× range of σ spans on the curve, taken as [0, 1.5] (ln)
             ll = ll + np.logaddexp(math.log1p(-out) + g, math.log(out / 1.5)).sum(axis=1)
         return ll
+    # without the SDM's growth curves (forward="zoa", or a caller's log_ratio): where the SDM's limit lies more than
+    # 10 % from the zero-order's, its limiting lobe may be another (a flip lobe, a pocket): the zero-order lobe's κ
+    # does not describe the chatter heard, and the rate is left out (EM12-60: κ x against the SDM's rate 0.07–1.6
+    # there, 0.89–1.07 within it but for one 1.96; docs/design/shop.md)
     idx = [r for r, c in enumerate(cuts) if _rate(c) and abs(lr[r]) <= _GROWTH_LR_MAX] \
         if growth_error is not None else []
     if idx:
