@@ -62,7 +62,12 @@ REAL = Path(__file__).resolve().parents[1] / "examples" / "cuts" / "combined_cha
 def _read(y, rate, rpm, teeth, full_scale=1.0):
     """σ (1/s) as ``cut`` reads it (the longest chattering cut's :class:`~toolpoint.shop.growth.ChatterGrowth`), or
     the reason it was not read."""
-    an = analyse_cut(y, rate, rpm=rpm, teeth=teeth, full_scale=full_scale)
+    from toolpoint.errors import InputError
+
+    try:
+        an = analyse_cut(y, rate, rpm=rpm, teeth=teeth, full_scale=full_scale)
+    except InputError as e:  # `cut` refuses the record (exit 2): no rate, as in the shop
+        return float("nan"), "record refused: " + str(e).split(":")[0]
     if an.growth is None:
         return float("nan"), "judged stable"
     g = an.growth

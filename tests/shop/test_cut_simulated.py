@@ -147,3 +147,31 @@ def test_a_table_the_record_contradicts_through_a_wrong_tooth_count_says_why(tmp
     assert "line 2: the table says stable, its record c1.wav says chatter at" in msg and "\n" not in msg
     assert "c1.wav: the spindle harmonics that stand out in the chatter on a spindle harmonic are the multiples of 4" \
         in msg, msg
+
+
+def test_chatter_a_few_hz_beside_the_tooth_passing_at_a_pocket_s_top_is_heard():
+    """At the top of a pocket the tooth passing sits on the mode and the chatter grows a few Hz beside it, inside the
+    harmonic's mask at the frames' resolution: a one-mode tool like EM28-80's (a `library` tool of the campaign:
+    660.9 Hz, ζ 0.27 %, k 1.85e7 N/m; 4 teeth, 25 % immersion, up milling) at 9919.46 rpm, f_t 661.3 Hz. Cuts 10 %
+    and 35 % past the SDM limit (σ 4.4 and 125 /s) were judged stable before the long-frame test; now chatter, within
+    1 % of the simulation's own chatter frequency (658.1, 658.9 Hz). 10 % under the limit: stable. The package's
+    simulation (toolpoint.simulation, the virtual campaigns'), heard by the tests' shop microphone."""
+    from toolpoint.simulation import simulate_milling
+    from toolpoint.stability import CuttingConditions, sdm_lobes
+
+    mm = ModalModel(np.array([660.9237707]), np.array([0.00266763]), np.array([1.0756753]))
+    c = CuttingConditions(teeth=4, tangential_coeff=7.85093390665303e8, radial_ratio=0.2468162631747136,
+                          radial_immersion=0.25, milling="up")
+    rpm = 9919.46
+    a_lim = float(sdm_lobes(mm, mm, c, rpm=np.array([rpm])).depth_m[0])
+    for x, want in ((-0.1, "stable"), (0.1, "chatter"), (0.3, "chatter")):
+        res = simulate_milling(mm, mm, c, rpm=[rpm], depth_m=[a_lim * np.exp(x)], revolutions=250, seed=5,
+                               seed_level=0.01)
+        t = res.time_s[0] - res.time_s[0][0]
+        d, f = res.displacement_m[0], res.force_n[0]
+        y, rate, *_ = microphone((t, d[:, 0], d[:, 1], f[:, 0], f[:, 1]), rpm=rpm, teeth=4, seed=7)
+        r = analyse_cut(y, rate, rpm=rpm, teeth=4, full_scale=1.0)
+        assert r.verdict == want, (x, r.chatter_hz)
+        if want == "chatter":
+            assert res.stable[0] is not True and abs(r.chatter_hz / float(res.chatter_hz[0]) - 1) < 0.01
+            assert abs(r.chatter_hz - 4 * r.rpm / 60) < 8  # beside the tooth passing, inside its mask

@@ -228,6 +228,10 @@ def test_the_update_says_how_far_past_the_limit_each_rate_read(tmp_path):
     doc = json.loads((tmp_path / "update.json").read_text())
     assert doc["cuts"][1]["growth_past_limit_ln"] == pytest.approx(post.growth_past_limit[1], abs=1e-4)
     assert "(x 0.0" in (tmp_path / "report.html").read_text()
+    from toolpoint.cli.update import _growth_read  # the CLI's line, as the report's cell says it
+
+    assert _growth_read(post, False) == f"cut 2: {sig:.3g} /s = {100 * math.expm1(post.growth_past_limit[1]):.1f} % " \
+        "past the limit by the SDM's growth"
     for other in (dict(forward="sdm", growth_error=None), dict(forward="zoa")):
         assert update(pr, cuts, rng=np.random.default_rng(0), **kw, **other).growth_past_limit == (None, None)
 

@@ -424,7 +424,9 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     for o, extra in (("grown", []), ("ungrown", ["--no-growth"])):
         assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(grown), "--out", str(tmp_path / o),
                      "--samples", "300", *extra]) == 0
-    capsys.readouterr()
+    said = capsys.readouterr().out  # what each rate was read as, on the screen too
+    assert "growth rates: line 3: 60 /s (per sample, the zero-order growth)" in said
+    assert "growth rates: line 3: 60 /s (left out: --no-growth)" in said
     g = json.loads((tmp_path / "grown" / "update.json").read_text())
     assert [c["growth_per_s"] for c in g["cuts"]] == [None, 60.0, None] and doc["cuts"][1]["growth_per_s"] is None
     assert "<th>growth 1/s (x: ln past the limit)</th>" in (tmp_path / "grown" / "report.html").read_text()

@@ -13,6 +13,7 @@ not averaged.
 
 from __future__ import annotations
 
+import math
 import sys
 import warnings
 
@@ -164,6 +165,9 @@ def run(args) -> int:
               "samples leave fewer than 100 beyond them); --samples 1000 checks it by held-out samples")
     if cuts:
         print("note: " + away_note([{"rpm": c.rpm} for c in cuts]))
+    rates = _growth_read(post, args.no_growth)
+    if rates:
+        print("growth rates: " + rates)
     pocket = pocket_note({"rpm": rc["rpm"], "limit_p05_mm": 1e3 * rc["limit_p05_m"],
                           "own_sdm_p05_mm": None if rc["own_sdm_p05_m"] is None else 1e3 * rc["own_sdm_p05_m"]})
     if pocket is not None:
@@ -197,6 +201,22 @@ def _outside(post, far: float = 0.5):
                 yield c, (f"chatter at {c.chatter_hz:.1f} Hz lies far from every mode of the prior "
                           f"({', '.join(f'{f:.0f}' for f in f_modes)} Hz) and their tooth-passing aliases: is the "
                           "chatter_hz column in Hz, and the line the cut's?")
+
+
+def _growth_read(post, left_out: bool) -> str:
+    """What each chattering cut's measured growth rate was read as (the report's table says the same), or ''."""
+    parts = []
+    for i, (c, x) in enumerate(zip(post.cuts, post.growth_past_limit or (None,) * len(post.cuts))):
+        if c.stable or c.growth_per_s is None:
+            continue
+        where = f"cut {i + 1}" if c.line is None else f"line {c.line}"  # a cut made in code has no line
+        said = (f"{where}: {c.growth_per_s:.3g} /s"
+                + (" (left out: --no-growth)" if left_out else
+                   f" = {100 * (math.exp(x) - 1):.1f} % past the limit by the SDM's growth" if x is not None else
+                   " (per sample, the zero-order growth)" if post.forward == "zoa" else
+                   " (not read: the references' growth curves do not reach it)"))
+        parts.append(said)
+    return "; ".join(parts)
 
 
 def _depth_units(post, factor: float = 30.0):

@@ -119,6 +119,25 @@ The detector (:func:`analyse_cut`):
    one residue) and strong and sustained as above (its aliases: the candidates k ± N, k ± 2N). With two teeth
    every non-tooth harmonic has the same residue and such chatter cannot be told from runout on a spectrum.
 
+   *Chatter beside a harmonic.* At the top of a pocket a tooth-passing harmonic sits on the mode, and the chatter
+   that grows there lies a few Hz from it (f_c = j f_t + δ, |δ| ≪ f_t), inside the harmonic's mask (±2 bins of a
+   0.1–0.4 s frame, 5–10 Hz): the frames cannot tell it from the harmonic, and a cut 35–80 % past the limit was
+   judged stable (EM28-80 at 9919 rpm, f_t 661.3 Hz on its 660.9 Hz mode: chatter at 658–659 Hz, growing at
+   125–480 /s). It is also where a Harmonizer speed lands: a tooth harmonic put on the chatter frequency. When the
+   frames find no chatter in a cutting run of ≥ 0.5 s, the run is read as **one Hann frame** of T s (bins 1/T,
+   zero-padded ×4), where the speed held within two bins at the harmonic (k × the tracked speed range ≤ 2/T; chatter
+   beside a harmonic pulls the frames' tracked speed by ~0.07 %, which this allows): beside each of the lowest
+   8 N spindle harmonics k f_s, beyond the harmonic's main lobe (2/T) and within its mask, the strongest peak on
+   each side. The strongest such peak is chatter when it is a tone by the test of one frame (a periodogram's bins
+   are exponential about their mean, the median / ln 2 of the bins within ±max(2 mask, 20 Hz) off the harmonic's and
+   the peak's main lobes; the largest of the M bins searched exceeds ln(M/α) × that with probability α), a line
+   (``line_db`` over the bins 3–4 out), new (``rise_db`` over the air cut's own long frame), ≥ 10 dB over its mirror
+   image across the harmonic (a speed's wander and an amplitude modulation make symmetric sidebands), strong
+   (``alias_dominance`` of the strongest harmonic with an air cut, else ``dominance``), and **its family** stands too:
+   a line at the same offset (to 1.5/T) beside a harmonic k ± N or k ± 2 N, ≥ 6 dB over its own mirror and over
+   ln(24/α) × its local noise (a wander's smear grows with k; chatter's aliases f_c + j f_t keep δ). Chatter closer to
+   the harmonic than its main lobe, 2/T, is not resolved at this length: a longer cut resolves it.
+
    *Automatic gain control.* A phone or a recorder with gain control levels the record: within its attack time the
    cut is brought down to the air cut's loudness, and the air after the cut comes back up within its release time.
    Two things go wrong without care. (a) The segments: the air before the cut is as loud as the cut, and a split by
@@ -996,6 +1015,12 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     # 4. judge the cutting runs window by window
     segments = []
     edge_s = max(0.2, 10 / f_s)
+    # the air cut's samples for the long-frame test beside the harmonics: its longest run, 0.1 s in from each end
+    air_runs = [(ta + 0.1, tb - 0.1) for ta, tb, v in runs if not v and tb - ta > 0.3]
+    air_x = None
+    if ref is not None and air_runs:
+        ta_, tb_ = max(air_runs, key=lambda r: r[1] - r[0])
+        air_x = x[int(ta_ * rate):int(tb_ * rate)]
     has_air = ref is not None  # entry and exit exist when the record shows the tool going in and out
     for ta, tb, v in runs:
         if not v:
@@ -1010,7 +1035,20 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         nwin = max(1, int((mb - ma) / window_s))
         bounds = np.linspace(ma, mb, nwin + 1)
         windows = [judge(wa, wb) for wa, wb in zip(bounds[:-1], bounds[1:])]
-        segments.extend(_merge(windows, judge))
+        merged = _merge(windows, judge)
+        if all(sg.verdict != "chatter" for sg in merged) and mb - ma >= _NEAR_MIN_S:
+            # chatter a few Hz from a spindle harmonic lies inside its mask at the frames' resolution: the run read
+            # as one long frame (module docstring, *Chatter beside a harmonic*), where the speed held within a bin
+            spread = 0.0
+            if track is not None:
+                fr = np.interp(frame_t[frames_in(ma, mb)], *track)
+                spread = float(fr.max() - fr.min())
+            near = _near_harmonic(x[int(ma * rate):int(mb * rate)], rate, air_x, f_s, teeth, lo, hi, df,
+                                  alias_dominance if air_x is not None else dominance, rise_db, spread)
+            if near is not None:
+                opr = _once_per_rev(x[int(ma * rate):int(mb * rate)], rate, f_s)
+                merged = [CutSegment("cut", ma, mb, **near, once_per_rev=opr)]
+        segments.extend(merged)
         if e_out:
             segments.append(CutSegment("exit", tb - e_out, tb, "transient"))
     judged = [sg for sg in segments if sg.kind == "cut"]
@@ -1843,6 +1881,92 @@ def _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominan
     f_c = float(freq[j] + _parabola(p, j) * df)
     return dict(verdict="chatter", chatter_hz=f_c, peak_hz=f_c, significance=sig, rise_db=float(rise),
                 dominance=float(min(dom, 1e6)), n_alias=n_alias, growth_db=_growth(Pseg, win[m])[0])
+
+
+_NEAR_MIN_S = 0.5  # s: a cutting run this long at least is read as one frame beside the harmonics (1/T ≤ 2 Hz)
+_NEAR_ASYM_DB = 10.0  # the strongest line beside a harmonic stands this far over its mirror image across it …
+_NEAR_FAMILY_DB = 6.0  # … and its family's lines at the same offset from other harmonics this far over theirs
+_NEAR_HARMONICS = 8  # the lowest spindle harmonics searched
+
+
+def _long_psd(seg, rate, n):
+    """One Hann frame of ``n`` samples (zero-padded ×4): (frequencies Hz, power spectral density)."""
+    w = np.hanning(seg.size)
+    z = np.fft.rfft((seg - seg.mean()) * w, 4 * n)
+    return np.fft.rfftfreq(4 * n, 1.0 / rate), np.abs(z) ** 2 / (rate * float(np.sum(w * w)))
+
+
+def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, spread=0.0) -> dict | None:
+    """Chatter a few Hz beside a spindle harmonic (module docstring, *Chatter beside a harmonic*): the cutting run
+    ``seg`` read as one Hann frame of T s; ``air`` the air cut's samples (None: no air cut, and ``dominance`` is the
+    plain one); ``spread`` the range of spindle frequencies (Hz) the run's frames ran at (0 when not tracked): a
+    harmonic k is searched only where k × spread stays within two bins (2/T, the Hann main lobe). A
+    :func:`_judge`-style dict of the chatter, or None."""
+    n = seg.size
+    T = n / rate
+    freq, p = _long_psd(seg, rate, n)
+    fa, pa = _long_psd(air, rate, min(n, air.size)) if air is not None else (None, None)
+    step = freq[1] - freq[0]
+    cands, h_pows, searched = [], [], 0
+    for k in range(1, _NEAR_HARMONICS * teeth + 1):
+        f_k = k * f_s
+        mask = 2 * df + _MASK_REL * f_k  # where the frames' test does not look
+        if f_k - mask < lo or f_k + mask > hi or k * spread > 2.0 / T:
+            continue
+        near = np.flatnonzero(np.abs(freq - f_k) <= _MASK_REL * f_k + 1.0 / T)
+        if near.size == 0:
+            continue
+        i_h = int(near[np.argmax(p[near])])
+        f_h = float(freq[i_h])
+        h_pows.append(float(p[i_h]))
+        for side in (1.0, -1.0):
+            off = side * (freq - f_h)
+            # beyond the harmonic's Hann main lobe (2 bins of the unpadded frame), a peak of its own
+            reg = np.flatnonzero((off >= 2.0 / T) & (off <= mask))
+            reg = reg[(reg > 0) & (reg < p.size - 1)]
+            reg = reg[(p[reg] > p[reg - 1]) & (p[reg] > p[reg + 1])]
+            if reg.size == 0:
+                continue
+            i = int(reg[np.argmax(p[reg])])
+            mirror = np.abs(freq - (2 * f_h - freq[i])) <= 1.0 / T
+            outer = (side * (freq - freq[i]) >= 3.0 / T) & (side * (freq - freq[i]) <= 4.0 / T)
+            if not (mirror.any() and outer.any()):
+                continue
+            asym = 10 * math.log10(p[i] / max(float(p[mirror].max()), 1e-300))
+            line = 10 * math.log10(p[i] / max(float(p[outer].mean()), 1e-300))
+            rise = None if fa is None else 10 * math.log10(p[i] / max(float(np.interp(freq[i], fa, pa)), 1e-300))
+            # the local noise: a periodogram's bins near the harmonic, off its main lobe and the peak's, are
+            # exponential about their mean (median / ln 2) — a resonance the cutting noise excites raises it too
+            loc = (np.abs(freq - f_h) <= max(2 * mask, 20.0)) & (np.abs(freq - f_h) >= 2.0 / T) & \
+                (np.abs(freq - freq[i]) >= 2.0 / T)
+            mean = float(np.median(p[loc])) / math.log(2.0) if loc.any() else float("inf")
+            searched += reg.size
+            cands.append(dict(k=k, i=i, off=float(freq[i] - f_h), pow=float(p[i]), asym=asym, line=line, rise=rise,
+                              z=float(p[i] / mean)))
+    if not cands or not h_pows:
+        return None
+    ok = [c for c in cands if c["line"] >= _LINE_DB and (c["rise"] is None or c["rise"] >= rise_db)]
+    if not ok:
+        return None
+    c0 = max(ok, key=lambda c: c["pow"])
+    if c0["asym"] < _NEAR_ASYM_DB:
+        return None
+    # the regenerative family f_c + j f_t: the same offset (to 1.5 bins of the unpadded frame) beside the harmonics
+    # k ± N, k ± 2N, each over its own mirror — a speed's wander or an amplitude modulation gives neither
+    # a tone, by the test of one frame: the largest of M exponential bins exceeds ln(M / α) times their mean with
+    # probability α — M every (padded, so more than independent: the safe side) bin searched for the strongest line,
+    # and for each line of its family the few bins within 1.5 bins of the same offset
+    sig = c0["z"] / math.log(max(searched, 1) / _ALPHA)
+    fam_t = math.log(4 * 3 * 2 / _ALPHA)
+    fam = [c for c in ok if c is not c0 and (c["k"] - c0["k"]) % teeth == 0 and abs(c["k"] - c0["k"]) <= 2 * teeth
+           and abs(c["off"] - c0["off"]) <= 1.5 / T and c["asym"] >= _NEAR_FAMILY_DB and c["z"] >= fam_t]
+    dom = c0["pow"] / max(h_pows)
+    if not fam or dom < dominance or sig <= 1.0:
+        return None
+    i = c0["i"]
+    f_c = float(freq[i] + _parabola(p, i) * step)
+    return dict(verdict="chatter", chatter_hz=f_c, peak_hz=f_c, significance=float(sig), rise_db=c0["rise"],
+                dominance=float(dom), n_alias=min(len(fam), 4), growth_db=None, line_db=c0["line"])
 
 
 def _merge(windows, judge):
