@@ -122,21 +122,21 @@ The detector (:func:`analyse_cut`):
    *Chatter beside a harmonic.* At the top of a pocket a tooth-passing harmonic sits on the mode, and the chatter
    that grows there lies a few Hz from it (f_c = j f_t + δ, |δ| ≪ f_t), inside the harmonic's mask (±2 bins of a
    0.1–0.4 s frame, 5–10 Hz): the frames cannot tell it from the harmonic, and a cut 35–80 % past the limit was
-   judged stable (EM28-80 at 9919 rpm, f_t 661.3 Hz on its 660.9 Hz mode: chatter at 658–659 Hz, growing at
-   125–480 /s). It is also where a Harmonizer speed lands: a tooth harmonic put on the chatter frequency. When the
-   frames find no chatter in a cutting run of ≥ 0.5 s, the run is read as **one Hann frame** of T s (bins 1/T,
-   zero-padded ×4), where the speed held within two bins at the harmonic (k × the tracked speed range ≤ 2/T; chatter
-   beside a harmonic pulls the frames' tracked speed by ~0.07 %, which this allows): beside each of the lowest
-   8 N spindle harmonics k f_s, beyond the harmonic's main lobe (2/T) and within its mask, the strongest peak on
-   each side. The strongest such peak is chatter when it is a tone by the test of one frame (a periodogram's bins
+   judged stable (EM28-80 at 9919 rpm, f_t 661.3 Hz on its 660.9 Hz mode: chatter at 658–659 Hz, growing at 125–480
+   /s). It is also where a Harmonizer speed lands: a tooth harmonic put on the chatter frequency. When the frames
+   find no chatter in a cutting run of ≥ 0.5 s, the run (its middle 8 s at most) is read as **one Hann frame** of T s
+   (bins 1/T, zero-padded ×4), where the speed held within two bins at the harmonic (k × the tracked speed range ≤
+   2/T; chatter beside a harmonic pulls the frames' tracked speed by ~0.07 %, which this allows): beside each of the
+   lowest 8 N spindle harmonics k f_s, beyond the harmonic's main lobe (2/T) and within its mask, the strongest peak
+   on each side. The strongest such peak is chatter when it is a tone by the test of one frame (a periodogram's bins
    are exponential about their mean, the median / ln 2 of the bins within ±max(2 mask, 20 Hz) off the harmonic's and
    the peak's main lobes; the largest of the M bins searched exceeds ln(M/α) × that with probability α), a line
    (``line_db`` over the bins 3–4 out), new (``rise_db`` over the air cut's own long frame), ≥ 10 dB over its mirror
    image across the harmonic (a speed's wander and an amplitude modulation make symmetric sidebands), strong
-   (``alias_dominance`` of the strongest harmonic with an air cut, else ``dominance``), and **its family** stands too:
-   a line at the same offset (to 1.5/T) beside a harmonic k ± N or k ± 2 N, ≥ 6 dB over its own mirror and over
-   ln(24/α) × its local noise (a wander's smear grows with k; chatter's aliases f_c + j f_t keep δ). Chatter closer to
-   the harmonic than its main lobe, 2/T, is not resolved at this length: a longer cut resolves it.
+   (``alias_dominance`` of the strongest harmonic with an air cut, else ``dominance``), and **its family** stands
+   too: a line at the same offset (to 1.5/T) beside a harmonic k ± N or k ± 2 N, ≥ 6 dB over its own mirror and over
+   ln(24/α) × its local noise (a wander's smear grows with k; chatter's aliases f_c + j f_t keep δ). Chatter closer
+   to the harmonic than its main lobe, 2/T, is not resolved at this length: a longer cut resolves it.
 
    *Automatic gain control.* A phone or a recorder with gain control levels the record: within its attack time the
    cut is brought down to the air cut's loudness, and the air after the cut comes back up within its release time.
@@ -1020,7 +1020,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     air_x = None
     if ref is not None and air_runs:
         ta_, tb_ = max(air_runs, key=lambda r: r[1] - r[0])
-        air_x = x[int(ta_ * rate):int(tb_ * rate)]
+        air_x = x[int(ta_ * rate):int(min(tb_, ta_ + _NEAR_MAX_S) * rate)]
     has_air = ref is not None  # entry and exit exist when the record shows the tool going in and out
     for ta, tb, v in runs:
         if not v:
@@ -1043,8 +1043,10 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             if track is not None:
                 fr = np.interp(frame_t[frames_in(ma, mb)], *track)
                 spread = float(fr.max() - fr.min())
-            near = _near_harmonic(x[int(ma * rate):int(mb * rate)], rate, air_x, f_s, teeth, lo, hi, df,
-                                  alias_dominance if air_x is not None else dominance, rise_db, spread)
+            # at most _NEAR_MAX_S of it, the middle (bins of 1/8 Hz are plenty; a 10 min run padded ×4 would not fit)
+            mid, half = 0.5 * (ma + mb), 0.5 * min(mb - ma, _NEAR_MAX_S)
+            near = _near_harmonic(x[int((mid - half) * rate):int((mid + half) * rate)], rate, air_x, f_s, teeth, lo,
+                                  hi, df, alias_dominance if air_x is not None else dominance, rise_db, spread)
             if near is not None:
                 opr = _once_per_rev(x[int(ma * rate):int(mb * rate)], rate, f_s)
                 merged = [CutSegment("cut", ma, mb, **near, once_per_rev=opr)]
@@ -1883,7 +1885,8 @@ def _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominan
                 dominance=float(min(dom, 1e6)), n_alias=n_alias, growth_db=_growth(Pseg, win[m])[0])
 
 
-_NEAR_MIN_S = 0.5  # s: a cutting run this long at least is read as one frame beside the harmonics (1/T ≤ 2 Hz)
+_NEAR_MIN_S = 0.5  # s: a cutting run this long at least is read as one frame beside the harmonics (1/T ≤ 2 Hz) …
+_NEAR_MAX_S = 8.0  # … its middle 8 s at most
 _NEAR_ASYM_DB = 10.0  # the strongest line beside a harmonic stands this far over its mirror image across it …
 _NEAR_FAMILY_DB = 6.0  # … and its family's lines at the same offset from other harmonics this far over theirs
 _NEAR_HARMONICS = 8  # the lowest spindle harmonics searched
