@@ -1038,7 +1038,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         merged = _merge(windows, judge)
         if all(sg.verdict != "chatter" for sg in merged) and mb - ma >= _NEAR_MIN_S:
             # chatter a few Hz from a spindle harmonic lies inside its mask at the frames' resolution: the run read
-            # as one long frame (module docstring, *Chatter beside a harmonic*), where the speed held within a bin
+            # as one long frame (module docstring, *Chatter beside a harmonic*) at the harmonics where the speed held
+            # within two bins; the air cut is not lowered for a gain control here, as it is in _judge (a recorder
+            # whose gain fell with the cut makes the line rise less over it: on the side of "stable")
             spread = 0.0
             if track is not None:
                 fr = np.interp(frame_t[frames_in(ma, mb)], *track)
@@ -1954,13 +1956,14 @@ def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, s
     c0 = max(ok, key=lambda c: c["pow"])
     if c0["asym"] < _NEAR_ASYM_DB:
         return None
-    # the regenerative family f_c + j f_t: the same offset (to 1.5 bins of the unpadded frame) beside the harmonics
-    # k ± N, k ± 2N, each over its own mirror — a speed's wander or an amplitude modulation gives neither
     # a tone, by the test of one frame: the largest of M exponential bins exceeds ln(M / α) times their mean with
-    # probability α — M every (padded, so more than independent: the safe side) bin searched for the strongest line,
-    # and for each line of its family the few bins within 1.5 bins of the same offset
+    # probability α — M the local peaks searched for the strongest line (of the ×4 padded spectrum: about one per
+    # one to two bins of the unpadded frame), and for each line of its family the 12 padded bins within ±1.5 bins of
+    # the same offset, counted twice (the safe side)
     sig = c0["z"] / math.log(max(searched, 1) / _ALPHA)
     fam_t = math.log(4 * 3 * 2 / _ALPHA)
+    # the regenerative family f_c + j f_t: the same offset (to 1.5 bins of the unpadded frame) beside the harmonics
+    # k ± N, k ± 2N, each over its own mirror — a speed's wander or an amplitude modulation gives neither
     fam = [c for c in ok if c is not c0 and (c["k"] - c0["k"]) % teeth == 0 and abs(c["k"] - c0["k"]) <= 2 * teeth
            and abs(c["off"] - c0["off"]) <= 1.5 / T and c["asym"] >= _NEAR_FAMILY_DB and c["z"] >= fam_t]
     dom = c0["pow"] / max(h_pows)
