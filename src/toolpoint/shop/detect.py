@@ -1918,33 +1918,39 @@ def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, s
         mask = 2 * df + _MASK_REL * f_k  # where the frames' test does not look
         if f_k - mask < lo or f_k + mask > hi or k * spread > 2.0 / T:
             continue
-        near = np.flatnonzero(np.abs(freq - f_k) <= _MASK_REL * f_k + 1.0 / T)
+        # only the bins within reach of this harmonic's tests (its mask, twice over for the local noise, and the
+        # peak's outer bins), not the whole ×4 padded spectrum for each of the 8 N harmonics
+        a = int(np.searchsorted(freq, f_k - max(2 * mask, 20.0) - 8.0 / T))
+        b = int(np.searchsorted(freq, f_k + max(2 * mask, 20.0) + 8.0 / T))
+        fq = freq[a:b]
+        near = a + np.flatnonzero(np.abs(fq - f_k) <= _MASK_REL * f_k + 1.0 / T)
         if near.size == 0:
             continue
         i_h = int(near[np.argmax(p[near])])
         f_h = float(freq[i_h])
         h_pows.append(float(p[i_h]))
         for side in (1.0, -1.0):
-            off = side * (freq - f_h)
+            off = side * (fq - f_h)
             # beyond the harmonic's Hann main lobe (2 bins of the unpadded frame), a peak of its own
-            reg = np.flatnonzero((off >= 2.0 / T) & (off <= mask))
+            reg = a + np.flatnonzero((off >= 2.0 / T) & (off <= mask))
             reg = reg[(reg > 0) & (reg < p.size - 1)]
             reg = reg[(p[reg] > p[reg - 1]) & (p[reg] > p[reg + 1])]
             if reg.size == 0:
                 continue
             i = int(reg[np.argmax(p[reg])])
-            mirror = np.abs(freq - (2 * f_h - freq[i])) <= 1.0 / T
-            outer = (side * (freq - freq[i]) >= 3.0 / T) & (side * (freq - freq[i]) <= 4.0 / T)
+            pq = p[a:b]
+            mirror = np.abs(fq - (2 * f_h - freq[i])) <= 1.0 / T
+            outer = (side * (fq - freq[i]) >= 3.0 / T) & (side * (fq - freq[i]) <= 4.0 / T)
             if not (mirror.any() and outer.any()):
                 continue
-            asym = 10 * math.log10(p[i] / max(float(p[mirror].max()), 1e-300))
-            line = 10 * math.log10(p[i] / max(float(p[outer].mean()), 1e-300))
+            asym = 10 * math.log10(p[i] / max(float(pq[mirror].max()), 1e-300))
+            line = 10 * math.log10(p[i] / max(float(pq[outer].mean()), 1e-300))
             rise = None if fa is None else 10 * math.log10(p[i] / max(float(np.interp(freq[i], fa, pa)), 1e-300))
             # the local noise: a periodogram's bins near the harmonic, off its main lobe and the peak's, are
             # exponential about their mean (median / ln 2) — a resonance the cutting noise excites raises it too
-            loc = (np.abs(freq - f_h) <= max(2 * mask, 20.0)) & (np.abs(freq - f_h) >= 2.0 / T) & \
-                (np.abs(freq - freq[i]) >= 2.0 / T)
-            mean = float(np.median(p[loc])) / math.log(2.0) if loc.any() else float("inf")
+            loc = (np.abs(fq - f_h) <= max(2 * mask, 20.0)) & (np.abs(fq - f_h) >= 2.0 / T) & \
+                (np.abs(fq - freq[i]) >= 2.0 / T)
+            mean = float(np.median(pq[loc])) / math.log(2.0) if loc.any() else float("inf")
             searched += reg.size
             cands.append(dict(k=k, i=i, off=float(freq[i] - f_h), pow=float(p[i]), asym=asym, line=line, rise=rise,
                               z=float(p[i] / mean)))
