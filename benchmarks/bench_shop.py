@@ -177,8 +177,9 @@ THRESHOLDS = ((0.05, 0.002, 6.0), (0.05, 0.002, 0.0), (0.05, 0.002, 3.0), (0.05,
 class _Score:
     """Verdicts of ``cut`` on simulated records against the SDM (and the simulation's own verdict), per threshold."""
 
-    def __init__(self, record=None):
+    def __init__(self, record=None, force_noise=0.0):
         self.record = record or shop_microphone  # the sensor: (res, rpm, teeth, rng, point) -> (samples, rate)
+        self.force_noise = force_noise  # the simulation's relative cutting-force noise
         self.full_scale = 1.0 if self.record is shop_microphone else None  # a sound file's full scale; a DAQ's in m/s²
         self.right = dict.fromkeys(THRESHOLDS, 0)
         self.right_sim = dict.fromkeys(THRESHOLDS, 0)
@@ -191,7 +192,8 @@ class _Score:
         SDM limit ``lim`` heard by ``self.record`` (the others counted in ``skipped``), in the points' order."""
         from toolpoint.simulation import simulate_milling
 
-        res = simulate_milling(mm, mm, c, rpm=rpm, depth_m=depth, revolutions=250, seed=seed, seed_level=seed_level)
+        res = simulate_milling(mm, mm, c, rpm=rpm, depth_m=depth, revolutions=250, seed=seed, seed_level=seed_level,
+                               force_noise=self.force_noise)
         recs = {}
         for p in range(rpm.size):
             if abs(depth[p] / lim[p] - 1) < 0.05:
@@ -352,7 +354,7 @@ def _truth(pr, rng, random_cut=True):
                                    milling=str(rng.choice(["down", "up"])))
 
 
-def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="microphone", score=None):
+def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="microphone", score=None, force_noise=0.0):
     """Verdicts of ``cut`` on records (``sensor``) of cuts simulated by ``toolpoint.simulation``; truth: the SDM.
 
     Each simulated cut starts on the steady cut with a kick of ``seed_level`` × the forced response (a shop cut's
@@ -367,7 +369,7 @@ def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="micro
     """
     from toolpoint.stability import sdm_lobes, sdm_spectral_radius
 
-    sc = score or _Score(SENSORS[sensor])  # or another scorer of the same records (_TeethScore)
+    sc = score or _Score(SENSORS[sensor], force_noise)  # or another scorer of the same records (_TeethScore)
     for case in ("cornelius", "example"):
         for seed in range(seed_start, seed_start + (2 if quick else truths)):
             rng = np.random.default_rng(seed)
@@ -380,12 +382,14 @@ def bench_cut_sim(quick, truths=6, seed_start=10, seed_level=0.01, sensor="micro
             R, A = np.meshgrid(speeds, depths)
             sc.add(mm, c, R.ravel(), A.ravel(), np.broadcast_to(lim, R.shape).ravel(), rho.ravel(), seed, seed_level,
                    rng)
-    sc.report(f"simulated {sensor} records (toolpoint.simulation, seed level {seed_level:g}, "
+    sc.report(f"simulated {sensor} records (toolpoint.simulation, seed level {seed_level:g}, force noise "
+              f"{force_noise:g}, "
               f"{2 * (2 if quick else truths)} random truths (seeds {seed_start}…) of the Cornelius and example-tool "
               f"priors, random immersion and up/down, 7 speeds x 7 depths")
 
 
-def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01, sensor="microphone", score=None):
+def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01, sensor="microphone", score=None,
+                      force_noise=0.0):
     """``cut`` at the speeds a chatter-avoiding choice lands on: a tooth-passing harmonic j f_t on a mode.
 
     For each truth (drawn from each prior, its immersion and direction, seeds
@@ -397,7 +401,7 @@ def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01, s
     from toolpoint.shop.model import sdm_limits
     from toolpoint.stability import sdm_spectral_radius
 
-    sc = score or _Score(SENSORS[sensor])  # or another scorer of the same records (_TeethScore)
+    sc = score or _Score(SENSORS[sensor], force_noise)  # or another scorer of the same records (_TeethScore)
     for name, pr in priors.items():
         lo, hi = pr.rpm_range if pr.rpm_range is not None else (5000.0, 25000.0)
         for seed in range(seed_start, seed_start + (1 if quick else truths)):
@@ -417,7 +421,8 @@ def bench_cut_pockets(quick, priors, truths=4, seed_start=40, seed_level=0.01, s
             A = L * np.tile([0.6, 0.8, 1.15, 1.4, 2.0], sp.size)
             rho = sdm_spectral_radius(mm, mm, c, rpm=R, depth=A)
             sc.add(mm, c, R, A, L, rho, seed, seed_level, rng)
-    sc.report(f"simulated {sensor} records at pocket speeds (a tooth-passing harmonic on a mode; {', '.join(priors)}; "
+    sc.report(f"simulated {sensor} records at pocket speeds (force noise {force_noise:g}; a tooth-passing harmonic "
+              f"on a mode; {', '.join(priors)}; "
               f"{1 if quick else truths} truths each, seeds {seed_start}…; 5 depths 0.6–2 × the SDM limit")
 
 
@@ -467,7 +472,7 @@ SENSORS = {"microphone": shop_microphone, "accelerometer": shop_accelerometer}
 
 def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius", "example"), update_kw=None,
                  max_cuts=10, verbose=False, seed_start=0, library_prior=None, detector=None, stop=True,
-                 sensor="microphone"):
+                 sensor="microphone", force_noise=0.0):
     update_kw = dict(update_kw or {})
     n_s = update_kw.pop("n_samples", 600 if quick else 1000)
     n_l = update_kw.pop("lobe_samples", 300 if quick else 400)
@@ -475,6 +480,7 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
           f"{seed_start}…{seed_start + seeds - 1}, at most {max_cuts} cuts; update options {update_kw or 'default'} "
           "(forward: zoa for the zoa and noisy shops unless given)"
           + (f"; detector options {detector}" if detector else "")
+          + (f"; simulated cuts with force noise {force_noise:g}" if force_noise else "")
           + ("" if stop else "; no stop: every campaign makes all its cuts, convergence read from the same sequence")
           + ")")
     priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
@@ -494,7 +500,8 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                 # a sound file's full scale is 1; an accelerometer's record is in m/s²
                 det = detector if sensor == "microphone" else {"full_scale": None, **(detector or {})}
                 shop = {"zoa": None, "noisy": noisy_shop(prior), "sdm": sdm_shop(prior),
-                        "sim": simulated_shop(prior, record=SENSORS[sensor], detector=det)}[shop_name]
+                        "sim": simulated_shop(prior, record=SENSORS[sensor], detector=det,
+                                              force_noise=force_noise)}[shop_name]
                 truth = sdm_limit(prior) if shop_name in ("sim", "sdm") else None
                 # the forward model of the shop's physics unless --update names one: the zero-order shops label by
                 # the zero-order limit, the others by the SDM's (update's default, "sdm")
@@ -656,12 +663,15 @@ def main():
                     "band's calibration after each cut is printed over all the truths")
     ap.add_argument("--sensor", choices=("microphone", "accelerometer"), default="microphone",
                     help="the record of the simulated cuts (the cut benchmark and the update benchmark's sim shop)")
+    ap.add_argument("--force-noise", type=float, default=0.0,
+                    help="relative cutting-force noise of the simulated shop's cuts (simulate_milling force_noise)")
     ap.add_argument("--detector", default="{}", help="JSON of analyse_cut() options of the simulated shop")
     a = ap.parse_args()
     header()
     if a.only in (None, "cut"):
         bench_cut(a.quick)
-        bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level, sensor=a.sensor)
+        bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level, sensor=a.sensor,
+                      force_noise=a.force_noise)
         pockets = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
         if a.library_prior:
             from toolpoint.shop.prior import prior_from_library
@@ -669,7 +679,7 @@ def main():
             out, tool = a.library_prior.rsplit(":", 1)
             pockets[tool] = prior_from_library(out, tool)
         bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level,
-                          sensor=a.sensor)
+                          sensor=a.sensor, force_noise=a.force_noise)
     if a.only in (None, "teeth"):
         sensor = SENSORS[a.sensor]
         bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level, sensor=a.sensor,
@@ -702,7 +712,7 @@ def main():
 
         bench_update(a.seeds, a.quick, a.shops.split(","), a.cases.split(","), json.loads(a.update), a.max_cuts,
                      a.verbose, a.seed_start, a.library_prior, json.loads(a.detector), stop=not a.no_stop,
-                     sensor=a.sensor)
+                     sensor=a.sensor, force_noise=a.force_noise)
 
 
 if __name__ == "__main__":

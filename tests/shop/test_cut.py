@@ -1073,3 +1073,19 @@ def test_a_spindle_heard_by_its_own_lines_is_judged():
         assert res.verdict == "stable" and abs(res.rpm / rpm - 1) < 1e-3, (amp, res.rpm)
         with pytest.raises(InputError, match="no spindle harmonics stand out"):
             analyse_cut(noise + 2 * amp * np.sin(2 * np.pi * f_s * t), rate, rpm=rpm, teeth=4)
+
+
+def test_a_weak_steady_chatter_family_is_warned_of_and_a_strong_one_is_not():
+    """A chatter line weaker than "strong" (``dominance``) is chatter only by its tooth-passing aliases, and a stable
+    cut near its limit makes the same family under the cutting noise (docs/design/shop.md, *Cutting noise*): such a
+    verdict says so; a strong line does not."""
+    for amp, weak in ((0.1, True), (0.5, False)):
+        x, rate, _, _ = shop_record(rpm=6000.0, teeth=4, chatter_hz=1137.0, chatter_amp=amp, cut_s=3.0, seed=1)
+        r = analyse_cut(x, rate, rpm=6000.0, teeth=4, full_scale=1.0)
+        assert r.verdict == "chatter" and abs(r.chatter_hz - 1137.0) < 1.0
+        dom = max(s.dominance for s in r.segments if s.kind == "cut" and s.verdict == "chatter")
+        assert (dom < r.criterion["dominance"]) == weak
+        said = [w for w in r.criterion["warnings"] if "rests on a weak line" in w]
+        assert bool(said) == weak, (amp, r.criterion["warnings"])
+        if weak:
+            assert "1137.2 Hz" in said[0] and "-20 dB" in said[0]

@@ -38,6 +38,11 @@ relative size ``seed_level``: a stable cut decays back, an unstable one grows
 from the seed, and what is measured is the linear growth the SDM predicts.
 "rest" starts from rest on fresh material (a real entry transient, which can
 kick a cut below the linear limit into finite-amplitude chatter).
+
+Force noise. A real cutting force fluctuates about the model's (2) by a few % (chip formation, the material,
+friction); ``force_noise`` multiplies each step's force by 1 + ξ, ξ white. It makes what a sensor hears of a stable
+cut near the limit: the tool's modes driven between the harmonics, more as the closed loop's damping falls. The
+verdict is then taken from a noise-free twin of each point run in the same batch (see :func:`simulate_milling`).
 """
 
 from __future__ import annotations
@@ -65,6 +70,8 @@ SATURATED = 1e-3
 """Deviation from the periodic cut (RMS over a revolution / displacement scale) above which a cut chatters."""
 FLOOR = 1e-11
 """Deviation (relative) below which growth is round-off, not chatter."""
+NOISE_BAND_HZ = 5000.0
+"""Band B over which ``force_noise`` is the relative standard deviation of the cutting force, Hz."""
 _TABLE_BYTES = 96e6  # angle tables per revolution are precomputed below this size, else computed per step
 
 
@@ -104,7 +111,8 @@ class SimulationResult:
         (P,) growth rate of the deviation, 1/revolution (ln of the ratio of its RMS over the last quarter of the
         revolutions and the quarter before, per revolution): > 0 where the cut is unstable.
     stable : numpy.ndarray
-        (P,) bool: the deviation decays and stays below ``SATURATED`` × the displacement scale.
+        (P,) bool: the deviation decays and stays below ``SATURATED`` × the displacement scale (with
+        ``force_noise``, of the noise-free twin run; so are ``growth_per_rev`` and ``chatter_hz``).
     chatter_hz : numpy.ndarray
         (P,) peak of the spectrum of the displacement less its part periodic with T (recorded part), Hz; nan
         where stable.
@@ -311,8 +319,16 @@ class _Cut:
 
 
 def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, feed, revolutions: int, S: int,
-         start: str, seed: int, seed_level: float, record: int) -> dict:
-    """Simulate one batch with a common S; returns the raw arrays (points last)."""
+         start: str, seed: int, seed_level: float, record: int, force_noise: float = 0.0,
+         noise_band_hz: float = NOISE_BAND_HZ) -> dict:
+    """Simulate one batch with a common S; returns the raw arrays (points last).
+
+    With ``force_noise`` > 0 the batch runs twice side by side (2 P columns, the same kick): the first P columns
+    with the force noise, the last P without it (the twin that judges the linear stability; :func:`_split`)."""
+    P0 = rpm.size
+    twin = force_noise > 0
+    if twin:
+        rpm, depth = np.tile(rpm, 2), np.tile(depth, 2)
     P = rpm.size
     geo = _Cut(cut, tool, depth, feed, S)
     M, R, Pf = geo.M, geo.R, geo.period
@@ -362,8 +378,16 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
         ring = np.zeros((Pf, 2, P))
         u_prev = np.zeros((m, P), complex)
     rng = np.random.default_rng(seed)
-    kick = rng.standard_normal((m, P)) + 1j * rng.standard_normal((m, P))
+    kick = rng.standard_normal((m, P0)) + 1j * rng.standard_normal((m, P0))
+    kick = np.tile(kick, (1, P // P0))  # the twin gets the same kick
     eta = eta + seed_level * scale * kick / (np.abs(Cout).max(axis=0)[:, None] * np.sqrt(2) * max(m, 1))
+    if twin:
+        # white relative fluctuation of the cutting force, one-sided PSD force_noise² / noise_band_hz (1/Hz):
+        # per-step samples of std force_noise / sqrt(2 Δt B) have that PSD up to the step's Nyquist frequency
+        nrng = np.random.default_rng([int(seed), 0x5EED])
+        amp = np.zeros(P)
+        amp[:P0] = force_noise / np.sqrt(2.0 * dt[:P0] * noise_band_hz)
+        block = np.zeros((M, P))
 
     n = revolutions * M
     i0 = (revolutions - record) * M
@@ -380,6 +404,11 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
         dev[i // M] += (d * d).sum(axis=0)
         ring[i % Pf] = r
         fx, fy = geo.step(i, mid[0], mid[1], buf)
+        if twin:
+            if i % M == 0:
+                block[:, :P0] = nrng.standard_normal((M, P0))
+            g = 1.0 + amp * block[i % M]
+            fx, fy = fx * g, fy * g
         if i >= i0:
             rec_r[i - i0] = r
             rec_f[i - i0, 0], rec_f[i - i0, 1] = fx, fy
@@ -389,8 +418,26 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
         r = (Cout @ eta).real
     opr[-1] = r
     rec_r[-1] = r
-    return dict(dt=dt, M=M, geo=geo, rec_r=rec_r, rec_f=rec_f, opr=opr, dev=np.sqrt(dev / M), scale=scale, i0=i0,
-                period=Pf)
+    out = dict(dt=dt, M=M, geo=geo, rec_r=rec_r, rec_f=rec_f, opr=opr, dev=np.sqrt(dev / M), scale=scale, i0=i0,
+               period=Pf)
+    return _split(out, P0) if twin else out
+
+
+def _split(out: dict, P0: int) -> dict:
+    """The noisy columns of a twin batch, with the noise-free twin's raw arrays under ``"quiet"``."""
+    import copy
+
+    def cols(d, sl):
+        r = {k: (v[..., sl] if isinstance(v, np.ndarray) else v) for k, v in d.items()}
+        geo = copy.copy(d["geo"])
+        if geo.phase.shape[2] > 1:
+            geo.phase = geo.phase[..., sl]
+        r["geo"] = geo
+        return r
+
+    noisy = cols(out, slice(0, P0))
+    noisy["quiet"] = cols(out, slice(P0, None))
+    return noisy
 
 
 # ----------------------------------------------------------------- metrics
@@ -469,7 +516,7 @@ def simulate_milling(modes_x, modes_y=None, cutting: CuttingConditions | None = 
                      feed_m: float = 1e-4, tool: Tool | None = None, revolutions: int = 40,
                      steps_per_tooth: int | None = None, substeps: int | None = None, start: str = "steady",
                      seed: int = 0, seed_level: float = 1e-6, record_revolutions: int | None = None,
-                     chunk: int = 1000) -> SimulationResult:
+                     chunk: int = 1000, force_noise: float = 0.0) -> SimulationResult:
     """Time-domain simulation of regenerative milling at many (speed, depth) points at once.
 
     Parameters
@@ -502,6 +549,18 @@ def simulate_milling(modes_x, modes_y=None, cutting: CuttingConditions | None = 
         Last revolutions whose force and displacement are kept (default all; ≥ 1).
     chunk : int
         Most points simulated together (memory).
+    force_noise : float
+        Relative standard deviation s of the cutting force's random fluctuation over a band of
+        ``NOISE_BAND_HZ`` (5 kHz), ≥ 0 and ≤ 0.3 (default 0: no noise). The force of each step is multiplied by
+        1 + ξ_i, ξ white with one-sided PSD s²/B up to the step's Nyquist frequency: chip formation, the
+        material's inhomogeneity and friction make a force whose standard deviation is 4–9 % of its mean, Gaussian
+        and modelled as multiplicative noise (Fodor, Sykora & Bachrathy, Int J Adv Manuf Technol 111 (2020)
+        213–226, doi:10.1007/s00170-020-05877-8; measured in turning). It drives the tool's modes in a stable cut
+        (a real cut's vibration between the harmonics; the closed loop's least damped mode swells as the limit
+        nears) and seeds chatter. The points then run twice, with and without the noise (one batch, the same
+        kick): ``stable``, ``growth_per_rev`` and ``chatter_hz`` come from the noise-free run (the linear
+        stability; the noisy deviation never decays), every recorded signal and ``metric`` from the noisy one.
+        The band's value (5 kHz) and white shape are assumptions: a dynamometer resolves the force to a few kHz.
 
     Returns
     -------
@@ -546,22 +605,32 @@ def simulate_milling(modes_x, modes_y=None, cutting: CuttingConditions | None = 
     if not (np.isfinite(level) and 0 <= level <= 1e-2):
         raise InputError(f"must be in [0, 0.01], got {seed_level!r}", field="seed_level")
     chunk = _positive_int(chunk, "chunk", 1, 10**6)
+    try:
+        noise = float(force_noise)
+    except (TypeError, ValueError):
+        raise InputError(f"must be a number, got {force_noise!r}", field="force_noise") from None
+    if not (np.isfinite(noise) and 0 <= noise <= 0.3):
+        raise InputError(f"must be in [0, 0.3], got {force_noise!r}", field="force_noise")
     S = int(steps_per_tooth_needed(dyn.max_frequency_hz, rpm, cut.teeth, steps_per_tooth, substeps).max())
     parts = []
     with single_thread_blas():
         for a in range(0, rpm.size, chunk):
             sl = slice(a, a + chunk)
             parts.append(_run(dyn, cut, tool, rpm[sl], depth[sl], feed, revolutions, S, start, seed + a, level,
-                              record))
-    return _assemble(parts, cut, tool, rpm, depth, feed, revolutions, record, S, start, dyn)
+                              record, noise))
+    res = _assemble(parts, cut, tool, rpm, depth, feed, revolutions, record, S, start, dyn)
+    res.params["force_noise"] = noise
+    return res
 
 
 def _assemble(parts, cut, tool, rpm, depth, feed, revolutions, record, S, start, dyn) -> SimulationResult:
     cols = {k: [] for k in ("metric", "growth", "stable", "chatter", "sle", "surface", "pv")}
     for p in parts:
-        metric, growth, stable = _verdict(p["dev"], p["opr"], p["rec_r"], p["M"], p["scale"])
+        metric = _verdict(p["dev"], p["opr"], p["rec_r"], p["M"], p["scale"])[0]
+        q = p.get("quiet", p)  # with force noise, the noise-free twin says whether the cut is stable
+        _, growth, stable = _verdict(q["dev"], q["opr"], q["rec_r"], q["M"], q["scale"])
         sle, surface, pv = _surface(p["rec_r"], p["geo"], cut.milling, p["i0"], record)
-        for k, v in zip(cols, (metric, growth, stable, _chatter(p["rec_r"], p["period"], p["dt"], stable), sle,
+        for k, v in zip(cols, (metric, growth, stable, _chatter(q["rec_r"], q["period"], q["dt"], stable), sle,
                                surface, pv)):
             cols[k].append(v)
     cat = np.concatenate
