@@ -26,6 +26,21 @@ def test_simulate_writes_json_plot_audio(tmp_path, capsys):
     assert "stable at 10000 rpm" in capsys.readouterr().out
 
 
+def test_simulate_with_force_noise_keeps_the_noise_free_verdict(tmp_path, capsys):
+    # the Insperger–Stépán example at 0.2 mm (its SDM limit at 10000 rpm is 0.32 mm): stable with and without the
+    # noise; the force history differs by it
+    outs = {}
+    for fn in ("0", "0.05"):
+        out = tmp_path / f"r{fn}.csv"
+        assert main(["simulate", *BASE, "--rpm", "10000", "--depth-mm", "0.2", "--revolutions", "12",
+                     "--force-noise", fn, "--out", str(out)]) == 0
+        assert "stable at 10000 rpm" in capsys.readouterr().out
+        outs[fn] = np.genfromtxt(out, delimiter=",", names=True)
+    f0, f1 = outs["0"]["fx_n"], outs["0.05"]["fx_n"]
+    cut = np.abs(f0) > 1e-3 * np.abs(f0).max()
+    assert 0.02 < np.std(f1[cut] / f0[cut] - 1) < 0.5
+
+
 def test_simulate_csv_histories(tmp_path):
     out, audio = tmp_path / "r.csv", tmp_path / "a.csv"
     assert main(["simulate", *BASE, "--rpm", "10000", "--depth-mm", "0.2", "--revolutions", "8",
@@ -42,6 +57,8 @@ def test_simulate_bad_input_one_line_exit_2_nothing_written(tmp_path, capsys):
         (["--depth-mm", "-1"], "--depth-mm"),
         (["--steps-per-tooth", "8", "--substeps", "1"], "--substeps"),
         (["--mode-x", "922:0:0.01"], "--mode-x"),
+        (["--force-noise", "0.5"], "--force-noise"),
+        (["--force-noise", "-0.1"], "--force-noise"),
     ]
     for extra, flag in bad:
         args = ["simulate", *BASE, "--rpm", "10000", "--depth-mm", "0.2", "--out", str(out)]
