@@ -81,7 +81,9 @@ The detector (:func:`analyse_cut`):
      be told, and the on/off of the cut inside the judged part leaves sidebands k f_t ± δ that look like a
      family). Where the tool spends little of the revolution in the cut,
      chatter saturates weak (the tool leaves the cut) and spreads into its aliases; the measured effect of
-     both ratios on simulated records over a speed × depth grid is in ``docs/design/shop.md``;
+     both ratios on simulated records over a speed × depth grid is in ``docs/design/shop.md``. A chatter verdict
+     that rests on a line weaker than ``dominance``, whose growth was not read, is warned of: under the cutting
+     force's noise a stable cut near its limit makes the same family (``docs/design/shop.md``, *Cutting noise*);
    * *sustained*: over the segment's second half the line keeps ≥ ¼ of its first half's power (a free
      vibration left by the entry decays; chatter holds or grows);
    * *a line*: without a tooth-passing alias, the peak stands ≥ 5 dB over the mean power 3–4 bins either side
