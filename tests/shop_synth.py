@@ -23,12 +23,16 @@ import numpy as np
 
 def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_amp=1.0, air_s=1.0, cut_s=2.0,
                 fans=(617.0, 1813.0), fan_amp=0.3, noise=0.05, mode_hz=None, speed_droop=0.0, speed_wander=0.0,
-                wander_hz=0.5, speed_step=0.0, air_lines=0.02, chatter_swing_db=0.0, swing_hz=0.4, seed=0):
+                wander_hz=0.5, speed_step=0.0, air_lines=0.02, chatter_swing_db=0.0, swing_hz=0.4, ring_per_s=None,
+                seed=0):
     """(samples, rate, cut start s, cut end s).
 
     ``air_lines``: the spindle's k-th harmonic in air, ``air_lines``/k (0.3–1: a spindle that rings in air).
     ``chatter_swing_db``: developed chatter waxes and wanes by this much (peak to peak, dB) at ``swing_hz``, as the
-    real recording's chatter line does (±5 dB over a second or two, ``examples/cuts``)."""
+    real recording's chatter line does (±5 dB over a second or two, ``examples/cuts``). ``ring_per_s`` σ < 0: the
+    line at ``chatter_hz`` is not a chatter's steady tone but a ring the cutting noise drives — a complex AR(1)
+    process whose spectrum is a Lorentzian of half-width |σ|/2π (a stable cut's least damped mode just under its
+    limit), of the same rms as the tone, with the same tooth-passing aliases."""
     rng = np.random.default_rng(seed)
     n = int((2 * air_s + cut_s) * rate)
     t = np.arange(n) / rate
@@ -78,9 +82,17 @@ def shop_record(*, rpm=6000.0, teeth=4, rate=44100.0, chatter_hz=None, chatter_a
             grow = grow * 10 ** (chatter_swing_db / 40 * np.sin(2 * np.pi * swing_hz * t + rng.uniform(0, 2 * np.pi)))
         wander = 1 + 1e-3 * np.sin(2 * np.pi * 0.7 * t)
         phase = 2 * np.pi * np.cumsum(chatter_hz * wander) / rate
-        x += chatter_amp * grow * np.sin(phase)
+        if ring_per_s is None:
+            line = np.exp(1j * phase)
+        else:  # e^{(σ + i2πf)/rate} per sample, driven by complex white noise: unit mean power
+            from scipy.signal import lfilter
+
+            pole = np.exp((ring_per_s + 2j * np.pi * chatter_hz) / rate)
+            e = (rng.standard_normal(n) + 1j * rng.standard_normal(n)) / np.sqrt(2.0)
+            line = lfilter([np.sqrt(1 - abs(pole) ** 2)], [1.0, -pole], e)
+        x += chatter_amp * grow * line.imag
         for j, a in ((-1, 0.3), (1, 0.2)):
-            x += chatter_amp * a * grow * np.sin(phase + 2 * np.pi * j * f_t * t)
+            x += chatter_amp * a * grow * (line * np.exp(2j * np.pi * j * f_t * t)).imag
     return x / (1.5 * np.abs(x).max()), rate, t0, t1
 
 

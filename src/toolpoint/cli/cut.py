@@ -11,11 +11,12 @@ segment (air cut, entry, cut windows, exit).
 chatter_hz of each cut between air cuts, and part_s: the part that holds it with its air), ``segments`` (kind,
 start_s, end_s, verdict, chatter_hz, …), ``rpm_measured`` (from the spindle harmonics), ``recommended_rpm`` (a
 tooth-passing harmonic on the chatter frequency), ``growth`` (how fast the chatter grew: ``rate_per_s``, the rise's
-``start_s``/``end_s``, or the ``reason`` it was not read; null when stable: :mod:`toolpoint.shop.growth`) and the
-criterion used. A one-line summary goes to stdout (and a
-line of each cut's verdict where the record holds several). ``--table``: a test-cut table for ``toolpoint update``
-(``rpm, depth_mm, result, record, start_s, end_s``, one row per cut, ``depth_mm`` left for the user, ``result`` to
-the record). Bad input: one line naming file and field, exit 2.
+``start_s``/``end_s``, or the ``reason`` it was not read; null when stable: :mod:`toolpoint.shop.growth`), ``ring``
+(how fast the line a stable cut, or a weak chatter line, rings at decays: ``rate_per_s`` ≤ 0, ``ln_sd``, ``freq_hz``,
+``resolved``, or the ``reason`` it was not read; :func:`toolpoint.shop.growth.ring_decay`) and the criterion used.
+A one-line summary goes to stdout (and a line of each cut's verdict where the record holds several). ``--table``: a
+test-cut table for ``toolpoint update`` (``rpm, depth_mm, result, record, start_s, end_s``, one row per cut,
+``depth_mm`` left for the user, ``result`` to the record). Bad input: one line naming file and field, exit 2.
 """
 
 from __future__ import annotations
@@ -130,6 +131,9 @@ def run(args) -> int:
            + (f" at {res.chatter_hz:.1f} Hz; Harmonizer speed {res.recommended_rpm:.0f} rpm" if res.chatter_hz else "")
            + ("" if res.growth is None else f"; its chatter grew at {res.growth.rate_per_s:.3g} /s"
               if res.growth.rate_per_s is not None else f"; its growth rate was not read ({res.growth.reason})")
+           + (f"; its strongest line ({res.ring.freq_hz:.1f} Hz) decays at {-res.ring.rate_per_s:.3g} /s"
+              if res.verdict == "stable" and res.ring is not None and res.ring.rate_per_s is not None
+              and res.ring.resolved else "")
            + f"; spindle {res.rpm:.1f} rpm"
            + (f", its speed wandered ±{100 * res.criterion['speed_wander']:.2g} % (tracked)"
               if res.criterion.get("speed_tracked") else ""))
