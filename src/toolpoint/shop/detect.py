@@ -347,8 +347,8 @@ class CutAnalysis:
     ring : RingDecay or None
         How fast the line the longest judged cut rings at decays (:func:`toolpoint.shop.growth.ring_decay`: σ ≤ 0,
         1/s, or why it was not read): read for a stable cut's strongest non-harmonic line and for a chatter verdict
-        on a weak line whose growth was not read (the verdict it can turn: *Cutting noise* in the module docstring);
-        None where not read (a strong or a growing chatter, a chatter on a spindle harmonic, no line).
+        on a weak line whose growth was not read (the verdict it can turn: *Cutting noise* in the module docstring;
+        on a spindle harmonic not read, with the reason); None for a strong or a growing chatter, or no line.
     """
 
     verdict: str
@@ -1171,16 +1171,18 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         res = replace(res, growth=chatter_growth(x, rate, rpm=60 * f_s, teeth=teeth, chatter_hz=hz, start_s=ta,
                                                  end_s=tb))
     grew = res.growth is not None and res.growth.rate_per_s is not None and res.growth.rate_per_s > 0
-    if chat and ref is not None and longest.dominance < dominance and not grew and longest.line_db is not None \
-            and not (longest.growth_db is not None and growth_db > 0 and longest.growth_db >= growth_db):
+    if chat and ref is not None and longest.dominance < dominance and not grew and not (
+            longest.growth_db is not None and growth_db > 0 and longest.growth_db >= growth_db):
         # a line weaker than "strong" alone, kept by its tooth-passing aliases, whose growth was not read: a stable
         # cut near its limit makes such a family too — the cutting force's noise drives the closed loop's least damped
         # mode and the tooth passing modulates it (docs/design/shop.md, *Cutting noise*). How fast the line decays
-        # tells them apart where the ring is wide enough: a chatter's limit cycle is a steady tone
-        from .growth import ring_decay
+        # tells them apart where the ring is wide enough: a chatter's limit cycle is a steady tone. Not read on a
+        # spindle harmonic (line_db None: the test on the harmonics), whose line the ring's reading removes
+        from .growth import RingDecay, ring_decay
 
-        ring = ring_decay(x, rate, rpm=60 * f_s, teeth=teeth, line_hz=chatter_hz, start_s=longest.start_s,
-                          end_s=longest.end_s)
+        ring = (ring_decay(x, rate, rpm=60 * f_s, teeth=teeth, line_hz=chatter_hz, start_s=longest.start_s,
+                           end_s=longest.end_s) if longest.line_db is not None else
+                RingDecay(None, reason="the chatter lies on a spindle harmonic, which the reading removes"))
         res = replace(res, ring=ring)
         if _rings(ring, longest.end_s - longest.start_s):
             # judged again without the aliases' lower bar: what else the record holds (a growing line, chatter on a
@@ -1188,8 +1190,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             segs = [judge(sg.start_s, sg.end_s, d_alias=0.0) if sg.kind == "cut" and sg.verdict == "chatter"
                     and sg.dominance < dominance and sg.line_db is not None else sg for sg in res.segments]
             # and a run of cut windows that holds no chatter now is read beside the harmonics, as the first pass reads
-            # every such run: the pockets' chatter sits there, under the weak line's verdict (EM28-80, truth 26 of the
-            # whole loop with 5 % noise: a cut 8 % past the limit judged stable without this)
+            # every such run (the pockets' chatter sits there, and the weak line's verdict kept the first pass from it)
             out, i = [], 0
             while i < len(segs):
                 j = i
