@@ -1840,7 +1840,7 @@ def _rings(ring, dur_s) -> bool:
 
     On simulated pocket records with 5 % force noise (``docs/design/shop.md``, *A stable cut's ring*) the Cornelius
     case's stable records 10–40 % under the limit called chatter fell from 13 to 1 of 36 (6 of 36 on held-out
-    truths, from 12), at the price of 4 of 48 chattering records at 1.02 × the limit and 2 of 192 at 1.05–1.4 × judged
+    truths, from 12), at the price of 4 of 48 chattering records at 1.02 × the limit and 1 of 192 at 1.05–1.4 × judged
     stable; a weak, noise-spread limit cycle reads like a ring of 20–30 /s. The real recording's chatter reads 0.8 /s.
     """
     r = ring.rate_per_s

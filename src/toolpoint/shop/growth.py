@@ -321,7 +321,14 @@ def ring_decay(samples, rate_hz: float, *, rpm: float, teeth: int, line_hz: floa
     from scipy.optimize import minimize
     from scipy.signal import butter, sosfiltfilt
 
+    from ..errors import InputError
+
     rate = float(rate_hz)
+    for v, name in ((rate, "rate_hz"), (float(rpm), "rpm")):
+        if not (math.isfinite(v) and v > 0):
+            raise InputError(f"must be a positive number, got {v:g}", field=name)
+    if int(teeth) != teeth or teeth < 1:
+        raise InputError(f"must be a whole number ≥ 1, got {teeth}", field="teeth")
     f_s = float(rpm) / 60.0
     f_t = int(teeth) * f_s
     f_p = float(line_hz)
