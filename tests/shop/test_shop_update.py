@@ -328,7 +328,13 @@ def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):
     ("rpm,result\n12000,stable\n", "depth_mm"), ("rpm,depth_mm,result,chatter_hz\n1e9,1,chatter,900\n", "rpm"),
     ("rpm,depth_mm,result,duration_s\n12000,1,stable,0\n", "duration_s"),
     ("rpm,depth_mm,result,duration_s\n12000,1,stable,1e5\n", "duration_s"),
-    ("rpm,depth_mm,result,duration_s\n12000,1,stable,x\n", "duration_s")])
+    ("rpm,depth_mm,result,duration_s\n12000,1,stable,x\n", "duration_s"),
+    # a stable cut's ring: it decays (σ < 0), needs its frequency, and a chattering cut has none
+    ("rpm,depth_mm,result,ring_per_s,ring_hz\n12000,1,stable,30,1250\n", "ring_per_s"),
+    ("rpm,depth_mm,result,ring_per_s\n12000,1,stable,-30\n", "ring_hz"),
+    ("rpm,depth_mm,result,ring_hz\n12000,1,stable,1250\n", "ring_per_s"),
+    ("rpm,depth_mm,result,ring_per_s,ring_hz\n12000,1,chatter,-30,1250\n", "ring_per_s"),
+    ("rpm,depth_mm,result,ring_per_s,ring_hz\n12000,1,stable,x,1250\n", "ring_per_s")])
 def test_bad_tables_name_the_field(tmp_path, text, field):
     p = tmp_path / "c.csv"
     p.write_text(text)
@@ -429,7 +435,7 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     assert "growth rates: line 3: 60 /s (left out: --no-growth)" in said
     g = json.loads((tmp_path / "grown" / "update.json").read_text())
     assert [c["growth_per_s"] for c in g["cuts"]] == [None, 60.0, None] and doc["cuts"][1]["growth_per_s"] is None
-    assert "<th>growth 1/s (x: ln past the limit)</th>" in (tmp_path / "grown" / "report.html").read_text()
+    assert "<th>growth or ring 1/s (x: ln from the limit)</th>" in (tmp_path / "grown" / "report.html").read_text()
     assert (tmp_path / "ungrown" / "lobes.csv").read_text() == (out / "lobes.csv").read_text()
     assert (tmp_path / "grown" / "lobes.csv").read_text() != (out / "lobes.csv").read_text()
     # the zero-order forward model has no SDM check: the recommended depth is the band's 5 % limit

@@ -36,10 +36,14 @@ def register(sub) -> None:
     p.add_argument("--sigma-freq", help="with --library: log standard deviation of the natural frequencies "
                    "(default 0.01: the running spindle's shift, which the library does not model)")
     p.add_argument("--cuts", help="test-cut table CSV (rpm, depth_mm, result[, chatter_hz][, duration_s]"
-                   "[, growth_per_s][, record[, start_s, end_s]]); without it: the prior's lobes and the first cut")
+                   "[, growth_per_s][, ring_per_s, ring_hz][, record[, start_s, end_s]]); without it: the prior's"
+                   " lobes and the first cut")
     p.add_argument("--no-growth", action="store_true",
                    help="leave the chattering cuts' growth rates out of the update (their labels and chatter "
                    "frequencies stay): docs/design/shop.md, *A chattering cut's growth rate*")
+    p.add_argument("--no-ring", action="store_true",
+                   help="leave the stable cuts' rings out of the update (their labels stay): docs/design/shop.md, "
+                   "*A stable cut's ring in update*")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--seed", default="0", help="random seed (default 0)")
     p.add_argument("--samples", default="1000", help="posterior samples (default 1000)")
@@ -112,6 +116,8 @@ def run(args) -> int:
                                                     maximum=3600, unit="s")
     if args.no_growth:
         offset["growth_error"] = None
+    if args.no_ring:
+        offset["ring_error"] = None
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")
     if args.sigma_freq is not None and not args.library:
@@ -168,6 +174,9 @@ def run(args) -> int:
     rates = _growth_read(post, args.no_growth)
     if rates:
         print("growth rates: " + rates)
+    rings = _ring_read(post, args.no_ring)
+    if rings:
+        print("rings: " + rings)
     pocket = pocket_note({"rpm": rc["rpm"], "limit_p05_mm": 1e3 * rc["limit_p05_m"],
                           "own_sdm_p05_mm": None if rc["own_sdm_p05_m"] is None else 1e3 * rc["own_sdm_p05_m"]})
     if pocket is not None:
@@ -216,6 +225,22 @@ def _growth_read(post, left_out: bool) -> str:
                    " (per sample, the zero-order growth)" if post.forward == "zoa" else
                    " (not read: the references' growth curves do not reach it)"))
         parts.append(said)
+    return "; ".join(parts)
+
+
+def _ring_read(post, left_out: bool) -> str:
+    """What each stable cut's ring was read as (the report's table says the same), or ''."""
+    parts = []
+    for i, (c, x) in enumerate(zip(post.cuts, post.ring_under_limit or (None,) * len(post.cuts))):
+        if not c.stable or c.ring_per_s is None:
+            continue
+        where = f"cut {i + 1}" if c.line is None else f"line {c.line}"
+        parts.append(f"{where}: {c.ring_per_s:.3g} /s at {c.ring_hz:.1f} Hz"
+                     + (" (left out: --no-ring)" if left_out else
+                        f" = at most {100 * (1 - math.exp(x)):.1f} % under the limit by the SDM's decay"
+                        if x is not None else
+                        " (not read: the zero-order forward model)" if post.forward == "zoa" else
+                        " (not read: off the tool's modes, or faster than the decay curves reach)"))
     return "; ".join(parts)
 
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .model import ModalPrior, limit_at_speeds, sdm_limits
-from .update import TestCut, _limits, update
+from .update import TestCut, _limits, ring_fields, update
 
 __all__ = ["CampaignResult", "virtual_campaign", "zoa_shop", "simulated_shop", "sdm_limit", "microphone_record"]
 
@@ -137,8 +137,8 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
     -------
     callable
         ``shop(theta, rpm, depth_m, rng, duration_s=None) -> TestCut`` with the detector's verdict, chatter
-        frequency and growth rate (:mod:`toolpoint.shop.growth`); a cut lasts ``revolutions``, or ``duration_s``
-        (s) when that is longer.
+        frequency, growth rate and a stable cut's ring (:mod:`toolpoint.shop.growth`); a cut lasts ``revolutions``,
+        or ``duration_s`` (s) when that is longer.
     """
     from ..simulation import sensor_signal, simulate_milling
     from .detect import analyse_cut
@@ -160,7 +160,7 @@ def simulated_shop(prior: ModalPrior, *, revolutions: int = 250, rate: float = 4
         r = analyse_cut(x, fs, rpm=float(rpm), teeth=cut.teeth, **{"full_scale": 1.0, **opts})
         return TestCut(float(rpm), float(depth_m), r.verdict == "stable", r.chatter_hz,
                        duration_s=revs * 60.0 / float(rpm), warnings=tuple(r.criterion.get("warnings", ())),
-                       growth_per_s=None if r.growth is None else r.growth.rate_per_s)
+                       growth_per_s=None if r.growth is None else r.growth.rate_per_s, **ring_fields(r))
     return shop
 
 

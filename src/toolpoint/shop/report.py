@@ -104,9 +104,12 @@ def _doc(post: Posterior) -> dict:
         "cuts": [{"rpm": c.rpm, "depth_mm": round(1e3 * c.depth_m, 6), "result": "stable" if c.stable else "chatter",
                   "chatter_hz": c.chatter_hz, "duration_s": c.duration_s, "growth_per_s": c.growth_per_s,
                   "growth_past_limit_ln": None if x is None else round(x, 4),
+                  "ring_per_s": c.ring_per_s, "ring_hz": c.ring_hz,
+                  "ring_under_limit_ln": None if xr is None else round(xr, 4),
                   "record": c.record,
                   "warnings": [f"line {c.line}: {w}" if c.line else w for w in c.warnings]}
-                 for c, x in zip(post.cuts, post.growth_past_limit or (None,) * len(post.cuts))],
+                 for c, x, xr in zip(post.cuts, post.growth_past_limit or (None,) * len(post.cuts),
+                                     post.ring_under_limit or (None,) * len(post.cuts))],
         "sampler": {"method": post.method, "forward": post.forward, "samples": int(post.z.shape[0]),
                     "ess": [round(e, 1) for e in post.ess],
                     "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
@@ -186,7 +189,11 @@ def away_note(cuts) -> str:
 
 
 def _growth_cell(c) -> str:
-    """A cut's growth rate, 1/s, with how far past the limit (ln) the SDM's growth curves read it, where they did."""
+    """A cut's growth rate, 1/s, with how far past the limit (ln) the SDM's growth curves read it, where they did; a
+    stable cut's ring, with how close under the limit (ln) the SDM's decay curves said it was at least."""
+    if c.get("ring_per_s") is not None:
+        xr = c.get("ring_under_limit_ln")
+        return f"ring {c['ring_per_s']:.3g}" + ("" if xr is None else f" (x ≥ {xr:.3f})")
     if c["growth_per_s"] is None:
         return ""
     x = c.get("growth_past_limit_ln")
@@ -226,7 +233,7 @@ def _html(post, doc, rows, png) -> str:
         + f", P(chatter) {nc['p_chatter']:.2f}.</p>{caveat}"
         f"<img alt='lobes' style='max-width:100%' src='data:image/png;base64,{base64.b64encode(png).decode()}'>"
         "<h2>Test cuts</h2><table><tr><th>rpm</th><th>depth mm</th><th>result</th><th>chatter Hz</th>"
-        "<th>growth 1/s (x: ln past the limit)</th><th>record</th></tr>"
+        "<th>growth or ring 1/s (x: ln from the limit)</th><th>record</th></tr>"
         f"{cut_rows}</table>"
         "<h2>Parameters (5 / 50 / 95 %)</h2><table><tr><th>name</th><th>unit</th><th>prior 5</th><th>prior 50</th>"
         f"<th>prior 95</th><th>post 5</th><th>post 50</th><th>post 95</th></tr>{par_rows}</table>"

@@ -41,6 +41,11 @@ A chattering cut whose record shows how fast its chatter grew, σ_m (1/s, :mod:`
 how far past the limit it was: just past it σ = κ ln(a/a_lim), so x_m = σ_m / (b κ(θ)) is read against the sample's
 x = ln(a/a_lim) (``growth_error``; :data:`GROWTH_ERROR`). Its error grows with x_m and adds to the boundary width w:
 the label bounds the limit from above, the rate from below too.
+A stable cut whose record shows its ring — how fast the line it rings at decays, σ_m < 0 (the cutting noise drives the
+closed loop's least damped mode: :func:`toolpoint.shop.growth.ring_decay`) — says the cut was at least as close under
+the limit as the x where the SDM's decay ln ρ(a_SDM e^x) / T first reaches σ_m: that mode decays no faster than any line
+the record holds. A sample that puts the cut further below is penalised, one that puts it closer is not
+(``ring_error``; :data:`RING_ERROR`; one ring per speed): the label bounds the limit from below, the ring from above.
 
 The posterior is sampled by sequential Monte Carlo (Chopin 2002; Del Moral, Doucet & Jasra 2006): prior
 samples are tempered, L^β with β from 0 to 1 in steps that keep the effective sample size at half the
@@ -123,6 +128,18 @@ chattering cut's growth rate*). With ``forward="sdm"`` the model's part of s₊ 
 instead, whose references' spread is added on top; s₊ is kept, on the side of a wider band."""
 
 
+RING_ERROR = (0.4, 0.05)
+"""A stable cut's ring (``TestCut.ring_per_s``) against the SDM's decay f_t ln ρ at its depth: (ln sd on the slow side,
+outlier share). On pocket records of two tools with 5 % cutting-force noise (Cornelius truths 40–43, EM28-80 truths
+40–43; 0.6–0.98 × the limit, resolved readings of stable verdicts, 126 records) ln(|σ_m| / |σ_SDM|) had its 5 %
+quantile at −0.40 and its 10 % at −0.25: a reading can be slower than the SDM's decay by that much. Faster it often is
+(a more damped line than the least damped mode, the reading's floor of 15–25 /s near the limit), and that side is not
+used (:func:`log_likelihood`'s ``ring_x``). The reading's own ln sd is added in quadrature. 0.4, not the records'
+0.25: in the whole loop (Cornelius truths 20–29, 5 % noise) 0.25 with every stable cut's ring left the band's coverage
+after 6 cuts at 0.73 against 0.86 without the rings — one wrong label near a band the rings had narrowed broke it —,
+0.4 with one ring per speed (``_sdm_ring_x``) at 0.86 (``docs/design/shop.md``, *A stable cut's ring in update*)."""
+
+
 @dataclass(frozen=True)
 class TestCut:
     """One test cut: speed (rpm), depth (m), stable or not, measured chatter frequency (Hz) if any, how long
@@ -130,7 +147,8 @@ class TestCut:
     could not rule out (``warnings``: :func:`toolpoint.shop.analyse_cut`'s, e.g. chatter on a mains harmonic) and
     the record (``record``: the table's file name, with its part ``(start–end s)`` where the row names one), and
     how fast a chattering cut's chatter grew (``growth_per_s``, σ in 1/s: :mod:`toolpoint.shop.growth`; None: not
-    read)."""
+    read); a stable cut's ring (``ring_per_s`` σ ≤ 0, 1/s, at ``ring_hz``, with ``ring_ln_sd`` the reading's own
+    ln sd: :func:`toolpoint.shop.growth.ring_decay`; None: not read)."""
 
     __test__ = False  # a shop's test cut, not a pytest test class
 
@@ -144,17 +162,23 @@ class TestCut:
     warnings: tuple = ()
     record: str | None = None
     growth_per_s: float | None = None
+    ring_per_s: float | None = None
+    ring_hz: float | None = None
+    ring_ln_sd: float | None = None
 
 
 def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
     """Read a test-cut table: CSV ``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz``,
     ``duration_s`` (how long the tool cut, s), ``growth_per_s`` (how fast a chattering cut's chatter grew, 1/s:
-    :mod:`toolpoint.shop.growth`), ``record``, ``start_s`` and ``end_s``; column names in any case,
+    :mod:`toolpoint.shop.growth`), ``ring_per_s`` and ``ring_hz`` (a stable cut's ring: how fast its line at
+    ``ring_hz`` decays, σ < 0 in 1/s, :func:`toolpoint.shop.growth.ring_decay`), ``record``, ``start_s`` and
+    ``end_s``; column names in any case,
     cells split at commas or (a spreadsheet's export with the decimal comma) semicolons
     (:func:`toolpoint.io.table.read_rows`).
 
     A ``record`` (path relative to the table) is analysed by :func:`toolpoint.shop.analyse_cut` (needs
-    ``teeth``): it gives ``result``, ``chatter_hz`` and ``growth_per_s`` where the table leaves them empty, and
+    ``teeth``): it gives ``result``, ``chatter_hz``, ``growth_per_s`` and a stable cut's ring (where resolved) where
+    the table leaves them empty, and
     ``duration_s`` (its longest run of entry, cut and exit); where both are given and disagree the table is refused (a
     contradiction is reported, not averaged). ``start_s`` and ``end_s`` (s from the record's start; either may be
     empty: its start, its end) name the part of the record that holds the row's cut, as ``toolpoint cut --start
@@ -208,6 +232,16 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                              field="growth_per_s")
         if dur is not None and dur > 3600:
             raise InputError(f"line {line}: {dur:g} s is not a test cut's duration", file=p, field="duration_s")
+        # a stable cut's ring: σ ≤ 0 (1/s) is how fast the line decays, so the table gives it as a negative number
+        ring = num("ring_per_s", required=False, lo=-1e4)
+        ring_hz = num("ring_hz", required=False)
+        if ring is not None and ring >= 0:
+            raise InputError(f"line {line}: a ring decays, so its rate σ is negative (1/s), got {ring:g}", file=p,
+                             field="ring_per_s")
+        if (ring is None) != (ring_hz is None):
+            raise InputError(f"line {line}: a ring needs both its rate and its frequency", file=p,
+                             field="ring_hz" if ring is not None else "ring_per_s")
+        ring_sd = None
         res = (row.get("result") or "").strip().lower()
         if res and res not in ("stable", "chatter"):
             raise InputError(f"line {line}: must be 'stable' or 'chatter', got {res!r}", file=p, field="result")
@@ -263,6 +297,8 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                 grow = a.growth.rate_per_s
             if dur is None:
                 dur = _cutting_s(a)
+            if ring is None:
+                ring, ring_hz, ring_sd = ring_fields(a).values()
             warns = tuple(f"{what}: {w}" for w in a.criterion.get("warnings", ()))
             if len({v for *_, v, _ in a.cuts}) > 1:  # a row is one cut; its record holds cuts that disagree
                 warns += (f"{what}: the {'record' if span is None else 'part'} holds {len(a.cuts)} cuts ("
@@ -275,12 +311,26 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             raise InputError(f"line {line}: a stable cut has no chatter frequency", file=p, field="chatter_hz")
         if res == "stable" and grow is not None:
             raise InputError(f"line {line}: a stable cut has no chatter growth", file=p, field="growth_per_s")
+        if res == "chatter" and ring is not None:
+            raise InputError(f"line {line}: a ring is a stable cut's (a chatter's line does not decay)", file=p,
+                             field="ring_per_s")
         cuts.append(TestCut(rpm, depth * 1e-3, res == "stable", fc, line, str(p), dur, warns, what if rec else None,
-                            grow))
+                            grow, ring, ring_hz, ring_sd))
     if not cuts:
         raise InputError("no test cuts", file=p, field="rpm")
     check_consistent(cuts, source=str(p))
     return cuts
+
+
+def ring_fields(analysis) -> dict:
+    """A stable verdict's ring as :class:`TestCut`'s ``ring_per_s``, ``ring_hz`` and ``ring_ln_sd`` (None each
+    where :func:`toolpoint.shop.analyse_cut` read none, or an unresolved line: as narrow as a steady tone, it says no
+    rate)."""
+    rg = analysis.ring
+    ok = (analysis.verdict == "stable" and rg is not None and rg.rate_per_s is not None and rg.resolved
+          and rg.freq_hz is not None)
+    return {"ring_per_s": rg.rate_per_s if ok else None, "ring_hz": rg.freq_hz if ok else None,
+            "ring_ln_sd": rg.ln_sd if ok else None}
 
 
 def _cutting_s(analysis) -> float | None:
@@ -311,7 +361,8 @@ def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, s
 def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.05, label_noise: float = 0.002,
                    freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None,
                    miss_rate: float = 0.0, label_offset=0.0, label_growth=0.0,
-                   cut_duration_s: float = 1.0, growth_error=None, growth_x=None) -> np.ndarray:
+                   cut_duration_s: float = 1.0, growth_error=None, growth_x=None, ring_x=None,
+                   ring_outlier: float = RING_ERROR[1]) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
     ``log_ratio`` (per cut, optional): ln of a factor on the zero-order limit at the cut's speed (the SDM
@@ -330,7 +381,13 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     (the SDM's limiting lobe may be another than the zero-order's, whose κ this is). ``growth_x`` (x_m, sd), each
     (C,), nan where a cut's reading is not used: the distances past the limit the readings say by the SDM's own
     growth (``_sdm_growth_x``), used instead of σ_m / (b κ) and the 10 % rule; its sd (the references' spread)
-    is added to the error in quadrature, and the outliers are uniform over x_m ∈ [0, 1.5]."""
+    is added to the error in quadrature, and the outliers are uniform over x_m ∈ [0, 1.5]. ``ring_x`` (x_r, sd), each
+    (C,), nan where a cut has none, in 1/s (κ x): how close under the limit a stable cut's ring says it was at least
+    (``_sdm_ring_x``), x_r = S_r / κ for each sample (κ its :func:`~toolpoint.shop.model.growth_rate`): the least damped
+    mode decays no faster than any line the record holds, so only a sample that puts the cut further below the limit
+    than x_r is penalised, by a half-normal of sd √((sd / κ)² + w²); a share
+    ``ring_outlier`` of readings says nothing (the penalty's floor). The ring lowers the band's upper side, never
+    lifts it."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
@@ -363,6 +420,21 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         sd = freq_sigma * c.chatter_hz
         gauss = -0.5 * (d / sd) ** 2 - math.log(sd * math.sqrt(2 * math.pi))
         ll = ll + np.logaddexp(math.log(1 - freq_outlier) + gauss, math.log(freq_outlier / c.chatter_hz))
+    if ring_x is not None:
+        xr, xrsd = (np.asarray(v, float) for v in ring_x)
+        idx = [r for r, c in enumerate(cuts) if c.stable and np.isfinite(xr[r])]
+        if idx:
+            w = np.broadcast_to(np.asarray(boundary_width, float), (len(cuts),))[idx][None, :]
+            # the references' curves are their own: scaled to each sample's by its κ (its own damping: the
+            # references' mean put a ring 0.21 under the limit at 0.12 on a Cornelius campaign, their κ steeper)
+            kap = growth_rate(prior, theta, rpm[idx], f_c[:, idx])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                x_s = np.log(depth[idx])[None, :] - np.log(a_lim[:, idx]) - lr[None, idx]  # ≤ 0 below the limit
+                x_r, sd_r = xr[idx][None, :] / kap, xrsd[idx][None, :] / kap
+                d = np.maximum(x_r - x_s, 0.0) / np.sqrt(sd_r ** 2 + w ** 2)
+            # no lobe reaches the speed, or no growth at the sample's lobe: the floor alone
+            g = np.where(np.isfinite(d) & (kap > 0), -0.5 * d * d, -np.inf)
+            ll = ll + np.logaddexp(math.log1p(-ring_outlier) + g, math.log(ring_outlier)).sum(axis=1)
     if growth_error is not None and growth_x is not None:
         # the readings as distances past the limit by the SDM's own growth curves (the references'): x_m the same for
         # every sample, so no Jacobian; the references' spread joins the reading's error
@@ -414,6 +486,9 @@ def _rate(cut) -> float | None:
     g = cut.growth_per_s
     return float(g) if not cut.stable and g is not None and math.isfinite(g) and g > 0 else None
 
+
+_RING_HZ_REL = 0.1  # a ring more than 10 % from the references' chatter frequency (and its aliases) is not read
+_RING_LN_SD_MAX = 0.5  # nor one read to worse than this ln sd (as `cut` calls a line a ring: detect._rings)
 
 _GROWTH_LR_MAX = 0.1  # |ln(a_SDM / a_ZOA)| at a cut beyond which its growth rate is not read (log_likelihood)
 _GROWTH_CAP = 0.5  # ln: a chatter that cannot grow audibly within the cut leaves the label uninformative, not wild
@@ -473,6 +548,9 @@ class Posterior:
         Per cut: how far past the limit (ln) its measured growth rate said it was, read from the SDM's growth curves
         (``forward="sdm"``); None where no rate entered that way (a stable cut, no rate, ``growth_error`` None,
         ``forward="zoa"`` — where κ x is per sample —, or a rate the references' curves do not bracket).
+    ring_under_limit : tuple of (float or None)
+        Per cut: how close under the limit (ln, ≤ 0) a stable cut's ring said it was at least, read from the SDM's
+        decay curves (``forward="sdm"``, :func:`update`'s ``ring_error``); None where no ring entered.
     """
 
     prior: ModalPrior
@@ -493,6 +571,7 @@ class Posterior:
     label_growth: tuple = (0.0, 0.0)
     forward: str = "sdm"
     growth_past_limit: tuple = ()
+    ring_under_limit: tuple = ()
 
     @property
     def theta(self) -> np.ndarray:
@@ -534,7 +613,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
            cut_duration_s: float = 1.0, risk_after_chatter: float | None = None,
            skip_repeats: bool = True, audible_margin: float = 0.0, max_cut_duration_s: float = 5.0,
-           growth_error: tuple | None = GROWTH_ERROR) -> Posterior:
+           growth_error: tuple | None = GROWTH_ERROR, ring_error: tuple | None = RING_ERROR) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -646,6 +725,15 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         the zero-order κ (``_sdm_growth_x``: at a pocket or a flip lobe another lobe limits and grows, and κ x
         was 0.04–2.2× the SDM's rate there); the references' spread joins the error. None: the rates are not
         used.
+    ring_error : (float, float) or None, default :data:`RING_ERROR`
+        How a stable cut's ring (``TestCut.ring_per_s``: how fast the line it rings at decays,
+        :func:`toolpoint.shop.growth.ring_decay`) enters, with ``forward="sdm"``: (ln sd of a reading slower than
+        the SDM's decay, outlier share). The least damped mode decays no faster than the line read, so the SDM's
+        decay curves at the references say how close under the limit the cut was at least, and a sample that puts
+        it further below is penalised (``_sdm_ring_x``, :func:`log_likelihood`'s ``ring_x``): a stable cut near
+        the limit then bounds the limit from above as well as from below. One-sided: a reading too fast (a more
+        damped line, the reading's floor near the limit) says nothing, and the ring never lifts the band. None: not
+        used.
     skip_repeats : bool, default True
         ``"info"`` rule: no candidate at the speed of an earlier cut (±0.5 %) that is no deeper than a stable cut there,
         or no shallower than a chattering one — the shop already knows how it ends. The likelihood takes each cut's
@@ -735,6 +823,14 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 and 0 < ge[3] < 1):
             raise InputError(f"needs bias in [0.2, 5], sds in [0.05, 2] (ln), outliers in (0, 1); got {growth_error!r}",
                              field="growth_error")
+    if ring_error is not None:
+        try:
+            re_ = tuple(float(v) for v in ring_error)
+        except (TypeError, ValueError):
+            raise InputError(f"must be (ln sd, outliers) or None, got {ring_error!r}", field="ring_error") from None
+        if not (len(re_) == 2 and 0.05 <= re_[0] <= 2 and 0 < re_[1] < 1):
+            raise InputError(f"needs an ln sd in [0.05, 2] and outliers in (0, 1); got {ring_error!r}",
+                             field="ring_error")
     if min_step > 0 and rule != "info":
         raise InputError("the step above stable cuts belongs to the info rule; the risk rule has none",
                          field="min_step")
@@ -752,6 +848,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     ess_hist, acc = [], []
     log_ratio_grid = None
     gx = None  # the SDM growth curves' reading of the rates (forward="sdm" with cuts)
+    rx = None  # and of the stable cuts' rings
     grid = _default_grid(prior) if rpm_grid is None else np.asarray(rpm_grid, float)  # speeds of the lobes
     if cuts:
         z = _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc)
@@ -764,8 +861,11 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
             spread = lr_c.std(axis=0) if sdm_refs > 1 else np.zeros(rpm_c.size)
             gx = None if growth_error is None else _sdm_growth_x(prior, prior.theta(ref), cuts, lr_c, f,
                                                                   float(growth_error[0]))
+            if ring_error is not None:
+                rx = _sdm_ring_x(prior, prior.theta(ref), cuts, lr_c, f, float(ring_error[0]))
+            ring_kw = {} if rx is None else dict(ring_x=rx[:2], ring_outlier=float(ring_error[1]))
             kw2 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + spread ** 2),
-                       log_ratio=lr_c.mean(axis=0), growth_error=growth_error, growth_x=gx)
+                       log_ratio=lr_c.mean(axis=0), growth_error=growth_error, growth_x=gx, **ring_kw)
             z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw2, method, n_moves, rng,
                         ess_hist, acc)
             log_ratio_grid = lr_g
@@ -783,7 +883,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 mean_u = lr_tr.mean(axis=0)
                 sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
                 kw3 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + sd_u[inv] ** 2),
-                           log_ratio=mean_u[inv], growth_error=growth_error, growth_x=gx)
+                           log_ratio=mean_u[inv], growth_error=growth_error, growth_x=gx, **ring_kw)
                 z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw3, method, n_moves,
                             rng, ess_hist, acc)
                 log_ratio_grid = lr_g + _carry(mean_u[None, :] - lr_ref_u, grid, u)
@@ -865,6 +965,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     return Posterior(prior, cuts, method, z, tuple(ess_hist), float(np.mean(acc)) if acc else float("nan"), grid, q,
                      depths, p_st, qp, rec, nxt, time.process_time() - c0, (off_mu, off_sd), (g_med, g_sd), forward,
                      tuple(float(v) if np.isfinite(v) else None for v in (gx[0] if gx is not None else
+                                                                           np.full(len(cuts), np.nan))),
+                     tuple(float(v) if np.isfinite(v) else None for v in (rx[2] if rx is not None else
                                                                            np.full(len(cuts), np.nan))))
 
 
@@ -991,7 +1093,6 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
     limit, and where the SDM's limit lies more than 10 % from it (a pocket, a flip lobe) another lobe limits and
     grows: there κ x was 0.04–2.2× the SDM's σ on four EM12-60 truths, and a cut 10 % past a pocket's limit can grow
     16× faster than the pocket's slope says, as the next lobe takes over (``docs/design/shop.md``)."""
-    from ..stability.sdm import sdm_spectral_radius
 
     C = len(cuts)
     xm, xsd = np.full(C, np.nan), np.full(C, np.nan)
@@ -1005,14 +1106,8 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
     ft = prior.cutting.teeth * rpm / 60.0
     got = np.full((theta.shape[0], len(use)), np.nan)
     for i, t in enumerate(theta):
-        mm, cut = prior.tool(t)
         ok = np.isfinite(a_s[i]) & (a_s[i] > 0)
-        if not ok.any():
-            continue
-        rho = sdm_spectral_radius(mm, mm, cut, rpm=rpm[ok][None, :],
-                                  depth=a_s[i, ok][None, :] * np.exp(_GROWTH_X)[:, None])  # (X, U')
-        sig = np.maximum.accumulate(np.log(np.maximum(rho, 1e-300)) * ft[ok][None, :], axis=0)
-        for j, q in zip(np.flatnonzero(ok), sig.T):
+        for j, q in _sdm_curves(prior, t, rpm, a_s[i], ft, ok, _GROWTH_X):
             if q[0] >= 0 or q[-1] < sig_m[j]:
                 continue
             got[i, j] = _cross(q, sig_m[j]) - _cross(q, 0.0)
@@ -1025,12 +1120,90 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
     return xm, xsd
 
 
-def _cross(q, level):
-    """x where the non-decreasing curve q over :data:`_GROWTH_X` first reaches ``level`` (q[0] < level ≤ q[-1]);
-    linear between the grid's points."""
+def _sdm_curves(prior, theta, rpm, a_sdm, ft, ok, grid):
+    """(j, σ(x)) for each speed rpm[j] where ``ok``: the sample's SDM σ(x) = ln ρ(a_sdm e^x) · f_t (1/s) over the
+    ln offsets ``grid``, made monotone (its running maximum: the first x a level is reached)."""
+    from ..stability.sdm import sdm_spectral_radius
+
+    if not ok.any():
+        return []
+    mm, cut = prior.tool(theta)
+    rho = sdm_spectral_radius(mm, mm, cut, rpm=rpm[ok][None, :],
+                              depth=a_sdm[ok][None, :] * np.exp(grid)[:, None])  # (X, U')
+    sig = np.maximum.accumulate(np.log(np.maximum(rho, 1e-300)) * ft[ok][None, :], axis=0)
+    return list(zip(np.flatnonzero(ok), sig.T))
+
+
+def _cross(q, level, grid=_GROWTH_X):
+    """x where the non-decreasing curve q over ``grid`` first reaches ``level`` (q[0] < level ≤ q[-1]); linear
+    between the grid's points."""
     k = int(np.argmax(q >= level))
     u = (level - q[k - 1]) / (q[k] - q[k - 1])
-    return float(_GROWTH_X[k - 1] + u * (_GROWTH_X[k] - _GROWTH_X[k - 1]))
+    return float(grid[k - 1] + u * (grid[k] - grid[k - 1]))
+
+
+_RING_X = np.array([-1.0, -0.8, -0.6, -0.5, -0.4, -0.3, -0.25, -0.2, -0.15, -0.1, -0.07, -0.05, -0.03, -0.02, -0.01,
+                    0.0, 0.01, 0.02, 0.035, 0.05])  # ln(a / a_SDM) of the decay curves (_sdm_ring_x)
+
+
+def _sdm_ring_x(prior, theta, cuts, lr_c, f, ring_sd: float = RING_ERROR[0]):
+    """How close under the limit, at least, each stable cut's ring says it was (x_r ≤ 0, ln), by the SDM's own decay:
+    at each reference sample (rows of ``theta``) its σ(x) = ln ρ(a_SDM e^x) / T at the cut's speed (ρ the spectral
+    radius per tooth period: the least damped mode's decay below the limit), made monotone (its running maximum),
+    over x ∈ [−1, 0.05]. The least damped mode decays no faster than any line the record holds, so the cut was at
+    least as close as the x where the curve first reaches the reading σ_m: x_r = x(σ_m) − x(0). Its sd on the side
+    that matters (the truth further below) is x_r − x(σ_m e^s), s = √(``ring_sd``² + the reading's ln sd²),
+    x(·) = −1 past the grid. Each reference's x_r and sd are multiplied by its κ at the cut
+    (:func:`~toolpoint.shop.model.growth_rate`), so that the likelihood divides them by each sample's own: a curve's
+    slope is its damping, and the references' is not the sample's. (mean of κ x_r over the references, sd: theirs in
+    quadrature with the mean of the κ sds), each (C,), 1/s; and the references' mean x_r itself (C,), ln;
+    nan where a stable cut has no ring (or one read to an ln sd over 0.5, or not its speed's deepest stable cut: rings
+    at one speed share their error), the ring lies more than 10 % from every reference's chatter frequency and its
+    tooth-passing aliases (j = −2…2: another line than the tool's), decays faster than the curve at x = −1 (it says
+    nothing), or fewer than two references read it."""
+
+    C = len(cuts)
+    xm, xsd, xp = np.full(C, np.nan), np.full(C, np.nan), np.full(C, np.nan)
+    use = [r for r, c in enumerate(cuts) if c.stable and c.ring_per_s is not None and c.ring_hz is not None
+           and math.isfinite(c.ring_per_s) and c.ring_per_s < 0
+           and (c.ring_ln_sd is None or c.ring_ln_sd <= _RING_LN_SD_MAX)]
+    # one ring per speed (±0.5 %): the deepest stable cut's. Rings read at one speed share their error against the
+    # SDM (the same modes, the same noise), so the likelihood may not multiply them as independent readings
+    use = [r for r in use if not any(q != r and abs(cuts[q].rpm / cuts[r].rpm - 1) <= 0.005
+                                     and (cuts[q].depth_m, q) > (cuts[r].depth_m, r) for q in use)]
+    if not use:
+        return xm, xsd, xp
+    rpm = np.array([cuts[r].rpm for r in use])
+    sig_m = np.array([cuts[r].ring_per_s for r in use], float)
+    hz = np.array([cuts[r].ring_hz for r in use], float)
+    s_tot = np.hypot(ring_sd, np.array([cuts[r].ring_ln_sd or 0.0 for r in use], float))
+    a_z, f_c = limit_at_speeds(prior, theta, rpm, f)  # (R, U)
+    a_s = a_z * np.exp(np.asarray(lr_c, float)[:, use])
+    ft = prior.cutting.teeth * rpm / 60.0
+    kap = growth_rate(prior, theta, rpm, f_c)  # (R, U)
+    with np.errstate(invalid="ignore"):
+        alias = f_c[:, :, None] + ft[None, :, None] * np.arange(-2, 3)[None, None, :]
+        near = np.nanmin(np.abs(alias - hz[None, :, None]), axis=2) <= _RING_HZ_REL * hz[None, :]
+    got, lo = (np.full((theta.shape[0], len(use)), np.nan) for _ in range(2))
+    for i, t in enumerate(theta):
+        ok = np.isfinite(a_s[i]) & (a_s[i] > 0) & near[i] & (kap[i] > 0)
+        for j, q in _sdm_curves(prior, t, rpm, a_s[i], ft, ok, _RING_X):
+            if q[0] >= sig_m[j] or q[-1] < 0:  # faster than far below the limit; no limit near the search's
+                continue
+            x0 = _cross(q, 0.0, _RING_X)
+            got[i, j] = kap[i, j] * (_cross(q, sig_m[j], _RING_X) - x0)
+            deeper = sig_m[j] * math.exp(s_tot[j])
+            lo[i, j] = kap[i, j] * ((_cross(q, deeper, _RING_X) if q[0] < deeper else _RING_X[0]) - x0)
+    n = np.sum(np.isfinite(got), axis=0)
+    need = min(2, theta.shape[0])
+    for j, r in enumerate(use):
+        if n[j] >= need:
+            k = np.isfinite(got[:, j])
+            v, e = got[k, j], got[k, j] - lo[k, j]
+            spread = float(v.std(ddof=1)) if v.size > 1 else 0.0
+            xm[r], xsd[r] = float(v.mean()), float(math.sqrt(np.mean(e ** 2) + spread ** 2))
+            xp[r] = float(np.mean(v / kap[k, j]))
+    return xm, xsd, xp
 
 
 def _sdm_own_log_ratio(prior, z, u, f, lr_guess, zoa=None):
