@@ -240,7 +240,8 @@ def _ring_read(post, left_out: bool) -> str:
                         f" = at most {100 * (1 - math.exp(x)):.1f} % under the limit by the SDM's decay"
                         if x is not None else
                         " (not read: the zero-order forward model)" if post.forward == "zoa" else
-                        " (not read: off the tool's modes, or faster than the decay curves reach)"))
+                        " (not read: off the tool's modes, read to an ln sd over 0.5, a deeper cut's ring at its "
+                        "speed counts instead, or faster than the decay curves reach)"))
     return "; ".join(parts)
 
 

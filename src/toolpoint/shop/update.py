@@ -1093,7 +1093,6 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
     limit, and where the SDM's limit lies more than 10 % from it (a pocket, a flip lobe) another lobe limits and
     grows: there κ x was 0.04–2.2× the SDM's σ on four EM12-60 truths, and a cut 10 % past a pocket's limit can grow
     16× faster than the pocket's slope says, as the next lobe takes over (``docs/design/shop.md``)."""
-
     C = len(cuts)
     xm, xsd = np.full(C, np.nan), np.full(C, np.nan)
     use = [r for r, c in enumerate(cuts) if _rate(c)]
@@ -1157,11 +1156,10 @@ def _sdm_ring_x(prior, theta, cuts, lr_c, f, ring_sd: float = RING_ERROR[0]):
     (:func:`~toolpoint.shop.model.growth_rate`), so that the likelihood divides them by each sample's own: a curve's
     slope is its damping, and the references' is not the sample's. (mean of κ x_r over the references, sd: theirs in
     quadrature with the mean of the κ sds), each (C,), 1/s; and the references' mean x_r itself (C,), ln;
-    nan where a stable cut has no ring (or one read to an ln sd over 0.5, or not its speed's deepest stable cut: rings
-    at one speed share their error), the ring lies more than 10 % from every reference's chatter frequency and its
-    tooth-passing aliases (j = −2…2: another line than the tool's), decays faster than the curve at x = −1 (it says
-    nothing), or fewer than two references read it."""
-
+    nan where a stable cut has no ring (or one read to an ln sd over 0.5, or a deeper stable cut at its speed, ±0.5 %,
+    has one of those: rings at one speed share their error), the ring lies more than 10 % from every reference's
+    chatter frequency and its tooth-passing aliases (j = −2…2: another line than the tool's), decays faster than the
+    curve at x = −1 (it says nothing), or fewer than two references read it."""
     C = len(cuts)
     xm, xsd, xp = np.full(C, np.nan), np.full(C, np.nan), np.full(C, np.nan)
     use = [r for r, c in enumerate(cuts) if c.stable and c.ring_per_s is not None and c.ring_hz is not None
