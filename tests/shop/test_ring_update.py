@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from toolpoint.shop.model import cornelius_2024, growth_rate, limit_at_speeds, sdm_limits
-from toolpoint.shop.update import (TestCut, _sdm_log_ratio, _sdm_ring_x, log_likelihood, read_test_cuts,
+from toolpoint.shop.update import (TestCut, _sdm_log_ratio, _sdm_ring_x, log_likelihood, read_test_cuts, ring_left_out,
                                    update)
 
 
@@ -165,3 +165,17 @@ def test_cli_update_says_what_each_ring_was_read_as(tmp_path, capsys):
     assert main(args + ["--out", str(tmp_path / "b"), "--no-ring"]) == 0
     assert "rings: line 2: -30 /s at 1270.0 Hz (left out: --no-ring)" in capsys.readouterr().out
     assert json.loads((tmp_path / "b" / "update.json").read_text())["cuts"][0]["ring_under_limit_ln"] is None
+
+
+def test_why_a_ring_is_left_out_is_said():
+    """A loosely read ring (ln sd over 0.5) is left out and does not displace a shallower cut's ring at its speed; a
+    shallower ring gives way to the deeper one's, naming it; a chattering cut has none."""
+    cuts = [TestCut(12800.0, 0.22e-3, True, ring_per_s=-40.0, ring_hz=1270.0, ring_ln_sd=0.2, line=2),
+            TestCut(12810.0, 0.24e-3, True, ring_per_s=-35.0, ring_hz=1270.0, ring_ln_sd=0.3, line=3),
+            TestCut(12800.0, 0.26e-3, True, ring_per_s=-30.0, ring_hz=1270.0, ring_ln_sd=0.8, line=4),
+            TestCut(12800.0, 0.30e-3, False, 1270.0, line=5)]
+    why = [ring_left_out(cuts, r) for r in range(4)]
+    assert why[0] == "the deeper cut at its speed (line 3) counts instead"
+    assert why[1] is None
+    assert why[2] == "read to an ln sd of 0.80, over 0.5"
+    assert why[3] == "no ring"

@@ -230,18 +230,21 @@ def _growth_read(post, left_out: bool) -> str:
 
 def _ring_read(post, left_out: bool) -> str:
     """What each stable cut's ring was read as (the report's table says the same), or ''."""
+    from ..shop.update import ring_left_out
+
     parts = []
     for i, (c, x) in enumerate(zip(post.cuts, post.ring_under_limit or (None,) * len(post.cuts))):
         if not c.stable or c.ring_per_s is None:
             continue
         where = f"cut {i + 1}" if c.line is None else f"line {c.line}"
+        why_off = ("more than 10 % from the tool's chatter frequency and its tooth-passing aliases, or faster than "
+                   "the SDM's decay curves reach")
         parts.append(f"{where}: {c.ring_per_s:.3g} /s at {c.ring_hz:.1f} Hz"
                      + (" (left out: --no-ring)" if left_out else
                         f" = at most {100 * (1 - math.exp(x)):.1f} % under the limit by the SDM's decay"
                         if x is not None else
                         " (not read: the zero-order forward model)" if post.forward == "zoa" else
-                        " (not read: off the tool's modes, read to an ln sd over 0.5, a deeper cut's ring at its "
-                        "speed counts instead, or faster than the decay curves reach)"))
+                        f" (not read: {ring_left_out(post.cuts, i) or why_off})"))
     return "; ".join(parts)
 
 

@@ -1119,6 +1119,31 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
     return xm, xsd
 
 
+def _ring_readable(c) -> bool:
+    return (c.stable and c.ring_per_s is not None and c.ring_hz is not None and math.isfinite(c.ring_per_s)
+            and c.ring_per_s < 0 and (c.ring_ln_sd is None or c.ring_ln_sd <= _RING_LN_SD_MAX))
+
+
+def ring_left_out(cuts, r: int) -> str | None:
+    """Why cut ``r``'s ring does not enter :func:`update` before the SDM's curves are read, or None (it is read
+    there): no ring (or not a stable cut's), one read to an ln sd over 0.5, or a deeper stable cut at its speed
+    (±0.5 %) whose ring counts instead — rings read at one speed share their error against the SDM (the same modes,
+    the same noise), so the likelihood may not multiply them as independent readings."""
+    c = cuts[r]
+    if not c.stable or c.ring_per_s is None:
+        return "no ring"
+    if not _ring_readable(c):
+        return (f"read to an ln sd of {c.ring_ln_sd:.2f}, over {_RING_LN_SD_MAX:g}"
+                if c.ring_ln_sd is not None and c.ring_ln_sd > _RING_LN_SD_MAX else "not a decaying line")
+    deeper = [q for q, o in enumerate(cuts) if q != r and _ring_readable(o) and abs(o.rpm / c.rpm - 1) <= 0.005
+              and (o.depth_m, q) > (c.depth_m, r)]
+    if deeper:
+        q = max(deeper, key=lambda q: (cuts[q].depth_m, q))
+        where = f"line {cuts[q].line}" if cuts[q].line is not None else f"cut {q + 1}"
+        return f"the deeper cut at its speed ({where}) counts instead"
+    return None
+
+
 def _sdm_curves(prior, theta, rpm, a_sdm, ft, ok, grid):
     """(j, σ(x)) for each speed rpm[j] where ``ok``: the sample's SDM σ(x) = ln ρ(a_sdm e^x) · f_t (1/s) over the
     ln offsets ``grid``, made monotone (its running maximum: the first x a level is reached)."""
@@ -1162,13 +1187,7 @@ def _sdm_ring_x(prior, theta, cuts, lr_c, f, ring_sd: float = RING_ERROR[0]):
     curve at x = −1 (it says nothing), or fewer than two references read it."""
     C = len(cuts)
     xm, xsd, xp = np.full(C, np.nan), np.full(C, np.nan), np.full(C, np.nan)
-    use = [r for r, c in enumerate(cuts) if c.stable and c.ring_per_s is not None and c.ring_hz is not None
-           and math.isfinite(c.ring_per_s) and c.ring_per_s < 0
-           and (c.ring_ln_sd is None or c.ring_ln_sd <= _RING_LN_SD_MAX)]
-    # one ring per speed (±0.5 %): the deepest stable cut's. Rings read at one speed share their error against the
-    # SDM (the same modes, the same noise), so the likelihood may not multiply them as independent readings
-    use = [r for r in use if not any(q != r and abs(cuts[q].rpm / cuts[r].rpm - 1) <= 0.005
-                                     and (cuts[q].depth_m, q) > (cuts[r].depth_m, r) for q in use)]
+    use = [r for r in range(C) if ring_left_out(cuts, r) is None]
     if not use:
         return xm, xsd, xp
     rpm = np.array([cuts[r].rpm for r in use])
