@@ -865,6 +865,7 @@ def test_a_speed_given_in_rev_per_s_is_named():
     assert not any("rev/s" in w for w in ok.criterion["warnings"])
 
 
+@pytest.mark.slow  # 5–8 s: the fast tier stays under 3 min
 def test_a_record_that_does_not_hear_the_spindle_is_refused_not_judged(tmp_path, capsys):
     """White noise (a microphone left unplugged, a wrong file) was "chatter" in 7 of 12 records of 20 s: without
     spindle harmonics "strong" (against the strongest harmonic) holds for any noise peak, and one significant peak

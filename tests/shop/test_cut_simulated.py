@@ -149,6 +149,7 @@ def test_a_table_the_record_contradicts_through_a_wrong_tooth_count_says_why(tmp
         in msg, msg
 
 
+@pytest.mark.slow  # 5–8 s: the fast tier stays under 3 min
 def test_chatter_a_few_hz_beside_the_tooth_passing_at_a_pocket_s_top_is_heard():
     """At the top of a pocket the tooth passing sits on the mode and the chatter grows a few Hz beside it, inside the
     harmonic's mask at the frames' resolution: a one-mode tool like EM28-80's (a `library` tool of the campaign:

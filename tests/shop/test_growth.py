@@ -202,6 +202,7 @@ def test_the_sdm_s_own_growth_reads_the_distance_past_a_pocket_s_limit():
     assert term[near].min() > term[far].max()
 
 
+@pytest.mark.slow  # 5–8 s: the fast tier stays under 3 min
 def test_the_update_says_how_far_past_the_limit_each_rate_read(tmp_path):
     """``forward="sdm"``: the posterior and update.json carry, per cut, the distance past the limit the SDM's growth
     curves read from its rate — for the chattering cut with a rate only, near where the truth's own curve puts it (a

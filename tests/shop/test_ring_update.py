@@ -73,6 +73,7 @@ def test_the_ring_term_only_ever_penalises_samples_that_put_the_cut_further_belo
     assert np.array_equal(log_likelihood(pr, th, ch, ring_x=(s_r, sd)), log_likelihood(pr, th, ch))
 
 
+@pytest.mark.slow  # 5–8 s: the fast tier stays under 3 min
 def test_a_ring_lowers_the_band_s_upper_side_and_a_fast_one_leaves_it():
     """At the cut's speed a slow ring (−30 /s, the cut near the limit) brings the 95 % limit down toward the cut, and
     the band still holds the cut's depth; a fast ring (−150 /s, far below) leaves the band within the sampler's
