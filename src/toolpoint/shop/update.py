@@ -131,13 +131,14 @@ instead, whose references' spread is added on top; s₊ is kept, on the side of 
 RING_ERROR = (0.4, 0.05)
 """A stable cut's ring (``TestCut.ring_per_s``) against the SDM's decay f_t ln ρ at its depth: (ln sd on the slow side,
 outlier share). On pocket records of two tools with 5 % cutting-force noise (Cornelius truths 40–43, EM28-80 truths
-40–43; 0.6–0.98 × the limit, resolved readings of stable verdicts, 126 records) ln(|σ_m| / |σ_SDM|) had its 5 %
-quantile at −0.40 and its 10 % at −0.25: a reading can be slower than the SDM's decay by that much. Faster it often is
+40–43; 0.6–0.98 × the limit, resolved readings of stable verdicts, 138 records) ln(|σ_m| / |σ_SDM|) had its 5 %
+quantile at −0.37 and its 10 % at −0.24: a reading can be slower than the SDM's decay by that much. Faster it often is
 (a more damped line than the least damped mode, the reading's floor of 15–25 /s near the limit), and that side is not
-used (:func:`log_likelihood`'s ``ring_x``). The reading's own ln sd is added in quadrature. 0.4, not the records'
-0.25: in the whole loop (Cornelius truths 20–29, 5 % noise) 0.25 with every stable cut's ring left the band's coverage
-after 6 cuts at 0.73 against 0.86 without the rings — one wrong label near a band the rings had narrowed broke it —,
-0.4 with one ring per speed (``_sdm_ring_x``) at 0.86 (``docs/design/shop.md``, *A stable cut's ring in update*)."""
+used (:func:`log_likelihood`'s ``ring_x``). The reading's own ln sd is added in quadrature. 0.4, not the 0.25 the
+records suggest: in the whole loop (Cornelius truths 20–29, 5 % noise) 0.25 with every stable cut's ring left the
+band's coverage after 6 cuts at 0.73 against 0.86 without the rings — one wrong label near a band the rings had
+narrowed broke it —, 0.4 with one ring per speed (``_sdm_ring_x``) at 0.86 (``docs/design/shop.md``, *A stable cut's
+ring in update*)."""
 
 
 @dataclass(frozen=True)
