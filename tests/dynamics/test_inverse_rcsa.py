@@ -349,6 +349,7 @@ def test_modal_fit_of_four_noisy_files(true_noise, tmp_path):
     assert e.value.field == "smooth"
 
 
+@pytest.mark.slow  # 7–9 s: the fast tier read 177 s on the shared VM (limit 3 min)
 def test_the_blank_fit_does_not_flip_with_round_off(tmp_path):
     # The seed-0 campaign's blank FRFs, perturbed by a relative 1e-15 (what another CPU's SIMD rounding does): the
     # modal fit must choose the same model every time. Before Moré's scaling in the Levenberg–Marquardt refinement

@@ -803,6 +803,7 @@ def test_the_example_session_is_heard_as_the_true_tool_s_sdm_limit_says():
 
 
 
+@pytest.mark.slow  # 7–9 s: the fast tier read 177 s on the shared VM (limit 3 min)
 def test_a_prior_from_a_measured_frf_holds_its_modes(tmp_path, capsys):
     """A shop's usual start: a tap test. The prior from its FRF (the trusted band, a driving point's modal fit) holds
     the virtual tap's three dominant modes — against the modes the records were made from, not against the fit — and

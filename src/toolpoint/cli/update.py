@@ -44,6 +44,10 @@ def register(sub) -> None:
     p.add_argument("--no-ring", action="store_true",
                    help="leave the stable cuts' rings out of the update (their labels stay): docs/design/shop.md, "
                    "*A stable cut's ring in update*")
+    p.add_argument("--no-precursor", action="store_true",
+                   help="take every chatter label at its word even where the stable cuts ring (a noisy shop's "
+                   "false chatter: docs/design/shop.md, *A noisy shop's false chatter*), e.g. labels checked on the "
+                   "surface")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--seed", default="0", help="random seed (default 0)")
     p.add_argument("--samples", default="1000", help="posterior samples (default 1000)")
@@ -118,6 +122,8 @@ def run(args) -> int:
         offset["growth_error"] = None
     if args.no_ring:
         offset["ring_error"] = None
+    if args.no_precursor:
+        offset["precursor"] = None
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")
     if args.sigma_freq is not None and not args.library:
@@ -128,7 +134,7 @@ def run(args) -> int:
     import numpy as np
 
     from ..shop.prior import prior_from_library, read_modal_prior
-    from ..shop.report import away_note, pocket_note, write_update
+    from ..shop.report import away_note, pocket_note, precursor_doc, precursor_note, write_update
     from ..shop.update import read_test_cuts, update
 
     if args.frf is not None and not args.prior:
@@ -177,6 +183,8 @@ def run(args) -> int:
     rings = _ring_read(post, args.no_ring)
     if rings:
         print("rings: " + rings)
+    if (pc := precursor_doc(post)) is not None:
+        print("noisy shop: " + precursor_note(pc))
     pocket = pocket_note({"rpm": rc["rpm"], "limit_p05_mm": 1e3 * rc["limit_p05_m"],
                           "own_sdm_p05_mm": None if rc["own_sdm_p05_m"] is None else 1e3 * rc["own_sdm_p05_m"]})
     if pocket is not None:

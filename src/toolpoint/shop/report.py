@@ -7,8 +7,9 @@ In the output folder (written atomically, all or none of each file):
 * ``parameters.csv`` — ``name, unit, prior_p05, prior_p50, prior_p95, post_p05, post_p50, post_p95``
   (K_t in N/mm²);
 * ``update.json`` — recommended point, next test cut (rule, rpm, depth_mm, duration_s, P(chatter)), the test
-  cuts (each with its record and part, where the table named one), the forward model and sampler diagnostics
-  (method, ESS per tempering step, acceptance, CPU s);
+  cuts (each with its record and part, where the table named one), ``precursor`` (a noisy shop's false chatter
+  the likelihood allowed for, and the stable cut whose ring said the shop is noisy; null in a quiet shop), the
+  forward model and sampler diagnostics (method, ESS per tempering step, acceptance, CPU s);
 * ``lobes.png`` — prior and posterior bands, the P(stable) map, the test cuts, the next cut;
 * ``report.html`` — one self-contained page (figure embedded) of all of the above.
 """
@@ -20,6 +21,7 @@ import csv
 import html
 import io
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -110,6 +112,7 @@ def _doc(post: Posterior) -> dict:
                   "warnings": [f"line {c.line}: {w}" if c.line else w for w in c.warnings]}
                  for c, x, xr in zip(post.cuts, post.growth_past_limit or (None,) * len(post.cuts),
                                      post.ring_under_limit or (None,) * len(post.cuts))],
+        "precursor": precursor_doc(post),
         "sampler": {"method": post.method, "forward": post.forward, "samples": int(post.z.shape[0]),
                     "ess": [round(e, 1) for e in post.ess],
                     "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
@@ -200,6 +203,28 @@ def _growth_cell(c) -> str:
     return format(c["growth_per_s"], ".3g") + ("" if x is None else f" (x {x:.3f})")
 
 
+def precursor_doc(post: Posterior) -> dict | None:
+    """The noisy shop's false chatter the likelihood used (``update.json``'s ``precursor``), or None (a quiet shop,
+    or left out)."""
+    if post.precursor is None:
+        return None
+    pi, reach, sd = post.precursor
+    c = post.cuts[post.noisy_evidence]
+    return {"share": pi, "reach_ln": reach, "sd_ln": sd,
+            "evidence": {"line": c.line, "cut": post.noisy_evidence + 1, "ring_per_s": c.ring_per_s,
+                         "ring_hz": c.ring_hz}}
+
+
+def precursor_note(pc: dict) -> str:
+    """One line on the noisy shop's false chatter (the CLI's summary and the report say the same)."""
+    ev = pc["evidence"]
+    where = f"line {ev['line']}" if ev["line"] is not None else f"cut {ev['cut']}"
+    return (f"the stable cut of {where} rings ({ev['ring_per_s']:.3g} /s at {ev['ring_hz']:.1f} Hz): the cutting "
+            f"noise drives the tool's modes, so a chatter label without a growth reading is taken as possibly a "
+            f"stable cut ~{100 * (1 - math.exp(-pc['reach_ln'])):.0f} % or less under the limit, ringing "
+            f"(P ≤ {pc['share']:g}); a cut that chatters strongly, or the surface, settles such a label")
+
+
 def _html(post, doc, rows, png) -> str:
     e = html.escape
     rc, nc = doc["recommended"], doc["next_cut"]
@@ -212,6 +237,8 @@ def _html(post, doc, rows, png) -> str:
     caveat = f"<p><b>Note</b>: {e(away_note(doc['cuts']))}</p>" if doc["cuts"] else ""
     if (pocket := pocket_note(rc)) is not None:
         caveat += f"<p><b>Note</b>: {e(pocket)}</p>"
+    if doc.get("precursor") is not None:
+        caveat += f"<p><b>Noisy shop</b>: {e(precursor_note(doc['precursor']))}.</p>"
     warns = [w for c in doc["cuts"] for w in c["warnings"]]
     if warns:  # what the records' analysis could not rule out: the labels above rest on it
         caveat += "<p><b>Warnings from the records</b>:</p><ul>" + "".join(f"<li>{e(w)}</li>" for w in warns) + "</ul>"

@@ -46,6 +46,11 @@ closed loop's least damped mode: :func:`toolpoint.shop.growth.ring_decay`) — s
 the limit as the x where the SDM's decay ln ρ(a_SDM e^x) / T first reaches σ_m: that mode decays no faster than any line
 the record holds. A sample that puts the cut further below is penalised, one that puts it closer is not
 (``ring_error``; :data:`RING_ERROR`; one ring per speed): the label bounds the limit from below, the ring from above.
+In a noisy shop — one whose stable cuts' records ring at the tool's modes (:func:`noisy_shop`) — a stable cut near
+its limit may be heard as chatter: its mode, driven by the cutting noise, rings at the chatter frequency. A chatter
+label without a growth reading then has P(label chatter) = p_c + π Φ((u + r)/s) p_s (``precursor``;
+:data:`PRECURSOR`), u = ln(a / a_lim): one-sided, the stable labels keep p_s, so the term only widens the band above a
+chatter label.
 
 The posterior is sampled by sequential Monte Carlo (Chopin 2002; Del Moral, Doucet & Jasra 2006): prior
 samples are tempered, L^β with β from 0 to 1 in steps that keep the effective sample size at half the
@@ -112,8 +117,8 @@ from ..errors import InputError
 from ..stability.zoa_batch import zoa_limits
 from .model import ModalPrior, growth_rate, limit_at_speeds, receptance, sdm_limits
 
-__all__ = ["DEFAULT_RISK", "GROWTH_ERROR", "TestCut", "Posterior", "read_test_cuts", "check_consistent",
-           "log_likelihood", "update"]
+__all__ = ["DEFAULT_RISK", "GROWTH_ERROR", "PRECURSOR", "RING_ERROR", "TestCut", "Posterior", "read_test_cuts",
+           "check_consistent", "log_likelihood", "noisy_shop", "update"]
 
 
 DEFAULT_RISK = {"info": 0.3, "risk": 0.1}
@@ -359,11 +364,31 @@ def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, s
                                  f"({s.rpm:g} / {c.rpm:g} rpm); check the labels", file=source, field="result")
 
 
+PRECURSOR = (0.5, 0.1, 0.08)
+"""A noisy shop's false chatter (π, r, s): where the cutting force's noise drives the tool's modes, a stable cut near
+its limit rings at the chatter frequency and may be heard as chatter — P(chatter heard | stable, u) = π Φ((u + r)/s),
+u = ln(a / a_lim) ≤ 0 — unless the record shows the chatter grew (a ring does not). Read from the labels of `cut` on
+pocket records with 5 % force noise (Cornelius truths 40–43 at each truth's pocket speeds, 24 records per depth):
+chatter heard on 0 / 1 / 6 / 11 / 12 of 24 stable records at 0.6 / 0.8 / 0.9 / 0.95 / 0.98 × the SDM limit (a fit
+of the three gives π ≈ 0.7, r 0.08, s 0.09; −ln L 50.9 against 51.7 for these rounder values). Off the pocket it
+over-states: 1 of 48 records heard at 0.85–0.975 × on two tools at 20276 rpm (``docs/design/shop.md``, *A noisy
+shop's false chatter*). :func:`update` applies it only where the stable cuts' own records say the shop is noisy
+(:func:`noisy_shop`)."""
+
+
+def noisy_shop(cuts) -> int | None:
+    """The first stable cut whose record rings (its ring read to an ln sd ≤ 0.5: :func:`toolpoint.shop.growth.
+    ring_decay`), or None: the evidence that the cutting noise drives the tool's modes, so that a stable cut near its
+    limit may be heard as chatter (:data:`PRECURSOR`). A quiet cut's record holds the entry's decaying kick at most,
+    which reads loosely (ln sd 1.3–2.2 on noise-free Cornelius records, 0.14–0.32 with 5 % force noise)."""
+    return next((r for r, c in enumerate(cuts) if _ring_readable(c)), None)
+
+
 def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.05, label_noise: float = 0.002,
                    freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None,
                    miss_rate: float = 0.0, label_offset=0.0, label_growth=0.0,
                    cut_duration_s: float = 1.0, growth_error=None, growth_x=None, ring_x=None,
-                   ring_outlier: float = RING_ERROR[1]) -> np.ndarray:
+                   ring_outlier: float = RING_ERROR[1], precursor=None) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
     ``log_ratio`` (per cut, optional): ln of a factor on the zero-order limit at the cut's speed (the SDM
@@ -388,7 +413,11 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     mode decays no faster than any line the record holds, so only a sample that puts the cut further below the limit
     than x_r is penalised, by a half-normal of sd √((sd / κ)² + w²); a share
     ``ring_outlier`` of readings says nothing (the penalty's floor). The ring lowers the band's upper side, never
-    lifts it."""
+    lifts it. ``precursor`` (π, r, s), None to leave it out: a stable cut u = ln(a / a_lim) from the limit is heard as
+    chatter with a further probability π Φ((u + r)/s) (:data:`PRECURSOR`) — P(label chatter) = p_c + π h p_s —
+    except a chattering cut whose growth was read (a ring does not grow). One-sided: P(label stable) stays p_s (not
+    (1 − π h) p_s), so a stable label says no more than in a quiet shop and the term never lifts the band's lower
+    side."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
@@ -408,6 +437,18 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     if miss_rate > 0:  # a chattering cut heard as stable
         ls = np.logaddexp(ls, math.log(miss_rate) + lc)
         lc = lc + math.log1p(-miss_rate)
+    if precursor is not None:  # a noisy shop: a stable cut near its limit heard as chatter (its mode's ring)
+        pi, reach, spread = (float(v) for v in precursor)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = np.log(depth)[None, :] - np.log(a_lim) - lr[None, :]
+        u = np.where(np.isfinite(u), u, -np.inf)  # no lobe reaches the speed: stable, and no ring to hear
+        lh = math.log(pi) + log_ndtr((u + reach) / spread)  # ln(π h)
+        on = np.array([_rate(c) is None for c in cuts])[None, :]  # a growth read: chatter that grew, not a ring
+        # one-sided: a chatter label says less, a stable label no more than in a quiet shop — with its factor
+        # (1 − π h) a stable cut near the limit lifted the band's lower side over truth 25's limit (Cornelius, 5 %
+        # noise, recommended depth above the truth after 4 and 6 cuts): π varies from shop to shop, and a wrong
+        # one may not lift the recommended depth
+        lc = np.where(on, np.logaddexp(lc, ls + lh), lc)
     ll = np.where(stable[None, :], ls, lc).sum(axis=1)
     N = prior.cutting.teeth
     for r, c in enumerate(cuts):
@@ -552,6 +593,11 @@ class Posterior:
     ring_under_limit : tuple of (float or None)
         Per cut: how close under the limit (ln, ≤ 0) a stable cut's ring said it was at least, read from the SDM's
         decay curves (``forward="sdm"``, :func:`update`'s ``ring_error``); None where no ring entered.
+    precursor : (float, float, float) or None
+        The noisy shop's false chatter (π, r, s; ln) the likelihood used (:data:`PRECURSOR`); None where it
+        was left out (``update``'s ``precursor`` None, or no stable cut's record rang: a quiet shop).
+    noisy_evidence : int or None
+        Index of the stable cut whose ring said the shop is noisy (:func:`noisy_shop`).
     """
 
     prior: ModalPrior
@@ -573,6 +619,8 @@ class Posterior:
     forward: str = "sdm"
     growth_past_limit: tuple = ()
     ring_under_limit: tuple = ()
+    precursor: tuple | None = None
+    noisy_evidence: int | None = None
 
     @property
     def theta(self) -> np.ndarray:
@@ -614,7 +662,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
            cut_duration_s: float = 1.0, risk_after_chatter: float | None = None,
            skip_repeats: bool = True, audible_margin: float = 0.0, max_cut_duration_s: float = 5.0,
-           growth_error: tuple | None = GROWTH_ERROR, ring_error: tuple | None = RING_ERROR) -> Posterior:
+           growth_error: tuple | None = GROWTH_ERROR, ring_error: tuple | None = RING_ERROR,
+           precursor: tuple | None = PRECURSOR) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -735,6 +784,12 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         the limit then bounds the limit from above as well as from below. One-sided: a reading too fast (a more
         damped line, the reading's floor near the limit) says nothing, and the ring never lifts the band. None: not
         used.
+    precursor : (float, float, float) or None, default :data:`PRECURSOR`
+        A noisy shop's false chatter (π, r, s): once a stable cut's record rings (:func:`noisy_shop`: the cutting
+        noise drives the tool's modes), each chatter label without a growth reading may be a stable cut up to
+        about r under the limit, heard as chatter with probability π Φ((u + r)/s) (:func:`log_likelihood`): a
+        chatter label then bounds the limit from above less tightly. In a quiet shop (no stable cut rings) it is
+        left out. None: never (a shop whose chatter labels are checked, e.g. on the surface).
     skip_repeats : bool, default True
         ``"info"`` rule: no candidate at the speed of an earlier cut (±0.5 %) that is no deeper than a stable cut there,
         or no shallower than a chattering one — the shop already knows how it ends. The likelihood takes each cut's
@@ -832,6 +887,14 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         if not (len(re_) == 2 and 0.05 <= re_[0] <= 2 and 0 < re_[1] < 1):
             raise InputError(f"needs an ln sd in [0.05, 2] and outliers in (0, 1); got {ring_error!r}",
                              field="ring_error")
+    if precursor is not None:
+        try:
+            pc = tuple(float(v) for v in precursor)
+        except (TypeError, ValueError):
+            raise InputError(f"must be (share, reach, sd) or None, got {precursor!r}", field="precursor") from None
+        if not (len(pc) == 3 and 0 < pc[0] < 1 and 0 <= pc[1] <= 0.5 and 0.01 <= pc[2] <= 0.5):
+            raise InputError(f"needs a share in (0, 1), a reach in [0, 0.5] and an sd in [0.01, 0.5] (ln); got "
+                             f"{precursor!r}", field="precursor")
     if min_step > 0 and rule != "info":
         raise InputError("the step above stable cuts belongs to the info rule; the risk rule has none",
                          field="min_step")
@@ -845,6 +908,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     kw = dict(boundary_width=boundary_width, label_noise=label_noise, freq_sigma=freq_sigma, freq_hz=f,
               miss_rate=miss_rate, label_offset=(off_mu, off_sd), label_growth=(g_med, g_sd),
               cut_duration_s=cut_duration_s, growth_error=growth_error if forward == "zoa" else None)
+    # a noisy shop (a stable cut's record rings at a tool's mode): a chatter label may be a stable cut's ring
+    noisy = None if precursor is None else noisy_shop(cuts)
+    if noisy is not None:
+        kw["precursor"] = tuple(float(v) for v in precursor)
     z = _draw_z(rng, n_samples, free)
     ess_hist, acc = [], []
     log_ratio_grid = None
@@ -968,7 +1035,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                      tuple(float(v) if np.isfinite(v) else None for v in (gx[0] if gx is not None else
                                                                            np.full(len(cuts), np.nan))),
                      tuple(float(v) if np.isfinite(v) else None for v in (rx[2] if rx is not None else
-                                                                           np.full(len(cuts), np.nan))))
+                                                                           np.full(len(cuts), np.nan))),
+                     kw.get("precursor"), noisy)
 
 
 def _draw_z(rng, n, free):
