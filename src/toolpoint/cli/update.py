@@ -183,8 +183,8 @@ def run(args) -> int:
     rings = _ring_read(post, args.no_ring)
     if rings:
         print("rings: " + rings)
-    if (pc := precursor_doc(post)) is not None:
-        print("noisy shop: " + precursor_note(pc))
+    if (pc := precursor_doc(post)) is not None and any(not c.stable and c.growth_per_s is None for c in cuts):
+        print("noisy shop: " + precursor_note(pc))  # said where a chatter label is read differently
     pocket = pocket_note({"rpm": rc["rpm"], "limit_p05_mm": 1e3 * rc["limit_p05_m"],
                           "own_sdm_p05_mm": None if rc["own_sdm_p05_m"] is None else 1e3 * rc["own_sdm_p05_m"]})
     if pocket is not None:

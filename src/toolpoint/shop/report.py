@@ -237,7 +237,8 @@ def _html(post, doc, rows, png) -> str:
     caveat = f"<p><b>Note</b>: {e(away_note(doc['cuts']))}</p>" if doc["cuts"] else ""
     if (pocket := pocket_note(rc)) is not None:
         caveat += f"<p><b>Note</b>: {e(pocket)}</p>"
-    if doc.get("precursor") is not None:
+    if doc.get("precursor") is not None and any(c["result"] == "chatter" and c["growth_per_s"] is None
+                                                for c in doc["cuts"]):
         caveat += f"<p><b>Noisy shop</b>: {e(precursor_note(doc['precursor']))}.</p>"
     warns = [w for c in doc["cuts"] for w in c["warnings"]]
     if warns:  # what the records' analysis could not rule out: the labels above rest on it
