@@ -870,31 +870,17 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     if not (math.isfinite(max_cut_duration_s) and 0 < max_cut_duration_s <= 3600):
         raise InputError(f"must be in (0, 3600] s, got {max_cut_duration_s}", field="max_cut_duration_s")
     if growth_error is not None:
-        try:
-            ge = tuple(float(v) for v in growth_error)
-        except (TypeError, ValueError):
-            raise InputError(f"must be (bias, sd above, sd below, outliers) or None, got {growth_error!r}",
-                             field="growth_error") from None
-        if not (len(ge) == 4 and 0.2 <= ge[0] <= 5 and 0.05 <= ge[1] <= 2 and 0.05 <= ge[2] <= 2
-                and 0 < ge[3] < 1):
-            raise InputError(f"needs bias in [0.2, 5], sds in [0.05, 2] (ln), outliers in (0, 1); got {growth_error!r}",
-                             field="growth_error")
+        _option(growth_error, "growth_error", "(bias, sd above, sd below, outliers) or None",
+                lambda v: len(v) == 4 and 0.2 <= v[0] <= 5 and 0.05 <= v[1] <= 2 and 0.05 <= v[2] <= 2
+                and 0 < v[3] < 1, "needs bias in [0.2, 5], sds in [0.05, 2] (ln), outliers in (0, 1)")
     if ring_error is not None:
-        try:
-            re_ = tuple(float(v) for v in ring_error)
-        except (TypeError, ValueError):
-            raise InputError(f"must be (ln sd, outliers) or None, got {ring_error!r}", field="ring_error") from None
-        if not (len(re_) == 2 and 0.05 <= re_[0] <= 2 and 0 < re_[1] < 1):
-            raise InputError(f"needs an ln sd in [0.05, 2] and outliers in (0, 1); got {ring_error!r}",
-                             field="ring_error")
+        _option(ring_error, "ring_error", "(ln sd, outliers) or None",
+                lambda v: len(v) == 2 and 0.05 <= v[0] <= 2 and 0 < v[1] < 1,
+                "needs an ln sd in [0.05, 2] and outliers in (0, 1)")
     if precursor is not None:
-        try:
-            pc = tuple(float(v) for v in precursor)
-        except (TypeError, ValueError):
-            raise InputError(f"must be (share, reach, sd) or None, got {precursor!r}", field="precursor") from None
-        if not (len(pc) == 3 and 0 < pc[0] < 1 and 0 <= pc[1] <= 0.5 and 0.01 <= pc[2] <= 0.5):
-            raise InputError(f"needs a share in (0, 1), a reach in [0, 0.5] and an sd in [0.01, 0.5] (ln); got "
-                             f"{precursor!r}", field="precursor")
+        _option(precursor, "precursor", "(share, reach, sd) or None",
+                lambda v: len(v) == 3 and 0 < v[0] < 1 and 0 <= v[1] <= 0.5 and 0.01 <= v[2] <= 0.5,
+                "needs a share in (0, 1), a reach in [0, 0.5] and an sd in [0.01, 0.5] (ln)")
     if min_step > 0 and rule != "info":
         raise InputError("the step above stable cuts belongs to the info rule; the risk rule has none",
                          field="min_step")
@@ -1037,6 +1023,18 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                      tuple(float(v) if np.isfinite(v) else None for v in (rx[2] if rx is not None else
                                                                            np.full(len(cuts), np.nan))),
                      kw.get("precursor"), noisy)
+
+
+def _option(value, field: str, form: str, ok, need: str) -> tuple:
+    """A tuple option of :func:`update` as floats, refused naming ``field`` where it is not numbers (``form``) or
+    ``ok`` fails (``need``)."""
+    try:
+        v = tuple(float(x) for x in value)
+    except (TypeError, ValueError):
+        raise InputError(f"must be {form}, got {value!r}", field=field) from None
+    if not ok(v):
+        raise InputError(f"{need}; got {value!r}", field=field)
+    return v
 
 
 def _draw_z(rng, n, free):
