@@ -54,6 +54,10 @@ def register(sub) -> None:
     p.add_argument("--growth-db", default="6",
                    help="a new line whose power rises steadily by this much over a judged part is chatter, however "
                         "weak (default 6 dB, with t >= 4; 0: no growth test)")
+    p.add_argument("--hump-db", default="10",
+                   help="a strong chatter line standing less than this over its neighbours is a hump: its ring is "
+                        "read, and one that decays as a stable cut's (a mode the cutting noise drives) is not "
+                        "chatter (default 10 dB; 0: not read)")
     p.add_argument("--start", help="judge the record from this time on, s (one cut of a record that holds cuts at "
                    "several speeds; times stay the record's)")
     p.add_argument("--end", help="judge the record up to this time, s")
@@ -90,6 +94,7 @@ def run(args) -> int:
     dominance = check_number(args.dominance, "--dominance", above=0)
     alias_dominance = check_number(args.alias_dominance, "--alias-dominance", minimum=0)
     growth_db = check_number(args.growth_db, "--growth-db", minimum=0, unit="dB")
+    hump_db = check_number(args.hump_db, "--hump-db", minimum=0, unit="dB")
     from ..io.atomic import atomic_open
     from ..io.records import read_cut_record
     from ..shop import analyse_cut
@@ -100,7 +105,7 @@ def run(args) -> int:
                          field="--start")
     res = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=teeth, rpm_tolerance=tol, window_s=window,
                       dominance=dominance, alias_dominance=alias_dominance, growth_db=growth_db,
-                      full_scale=rec.full_scale, source=str(rec_path),
+                      hump_db=hump_db, full_scale=rec.full_scale, source=str(rec_path),
                       span_s=None if start is None and end is None else (start or 0.0, end or math.inf))
     doc = {"record": str(rec_path), "channel": rec.channel, "rate_hz": rec.rate_hz, **res.to_dict()}
     fig = None

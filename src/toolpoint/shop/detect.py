@@ -88,7 +88,12 @@ The detector (:func:`analyse_cut`):
      cut's ring decays at the closed loop's rate σ. A line that decays at ≥ 20 /s and ≥ 10/T (T the part read),
      to a ln sd ≤ 0.5, is a ring: the part is judged again without the alias bar (a chatter on a spindle harmonic —
      a flip lobe's — that the weak line hid is still found) and said so; else the verdict stands, warned of
-     (``docs/design/shop.md``, *A stable cut's ring*);
+     (``docs/design/shop.md``, *A stable cut's ring*). A **strong** line that is a hump, not a tone — less than
+     ``hump_db`` (10 dB) over the bins 3–4 away, its growth not read — has its ring read too: where the tooth-passing
+     harmonics are weak (a slot of an even-toothed cutter, a light cut) the mode that the cutting noise drives
+     outgrows them even far under the limit (0.1–0.7 ×, decaying at 40–170 /s: ``docs/design/shop.md``, *A stable
+     cut's hump*). Where it decays as a stable cut's does (the same bar), its band (±3 half-power widths) and its
+     tooth-passing aliases are left out of the candidates and the part is judged again, else the verdict stands;
    * *sustained*: over the segment's second half the line keeps ≥ ¼ of its first half's power (a free
      vibration left by the entry decays; chatter holds or grows);
    * *a line*: without a tooth-passing alias, the peak stands ≥ 5 dB over the mean power 3–4 bins either side
@@ -223,6 +228,7 @@ _MAINS_REL = 2e-3  # mains frequency tolerance (grids hold 50/60 Hz within ±0.2
 _LINE_DB = 5.0  # a peak without tooth-passing aliases stands this far over the bins 3–4 away: a line, not a hump
 _GAIN_WARN_DB = -3.0  # a cut's floor this far under the air cut's: the recorder's gain changed (warned)
 _STEADY_WARN_DB = 6.0  # dB: a chatter line of a record without an air cut that grew less is warned of
+_HUMP_DB = 10.0  # a strong chatter line this little over the bins 3–4 away is a hump; its ring is read
 _UNHEARD_LINE_DB = 20.0  # a record whose spindle harmonics do not stand out keeps a chatter line this far out
 _MASKED_WARN = 0.95  # a stable verdict with this much of the band under the spindle harmonics' masks is warned of
 _ELSEWHERE_REL = 0.25  # nominal speeds up to this far off are checked for (the range measured)
@@ -347,8 +353,9 @@ class CutAnalysis:
     ring : RingDecay or None
         How fast the line the longest judged cut rings at decays (:func:`toolpoint.shop.growth.ring_decay`: σ ≤ 0,
         1/s, or why it was not read): read for a stable cut's strongest non-harmonic line and for a chatter verdict
-        on a weak line whose growth was not read (the verdict it can turn: *Cutting noise* in the module docstring;
-        on a spindle harmonic not read, with the reason); None for a strong or a growing chatter, or no line.
+        on a weak line, or on a strong line that is a hump (``hump_db``), whose growth was not read (the verdict it
+        can turn: *Cutting noise* in the module docstring; on a spindle harmonic not read, with the reason); None for
+        a strong line that is a tone, a growing chatter, or no line.
     """
 
     verdict: str
@@ -684,7 +691,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 band_hz: tuple | None = None, window_s: float = 1.0, activity_db: float = 4.0,
                 rise_db: float = 10.0, dominance: float = 0.05, alias_dominance: float = 0.002,
                 growth_db: float = 6.0, alpha: float = _ALPHA, full_scale: float | None = None,
-                source: str | None = None, span_s: tuple | None = None) -> CutAnalysis:
+                source: str | None = None, span_s: tuple | None = None, hump_db: float = _HUMP_DB) -> CutAnalysis:
     """Judge a record of a milling cut: stable or chatter, per segment, with the chatter frequency.
 
     Parameters
@@ -725,6 +732,12 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     span_s : (float, float), optional
         The part of the record judged, (start, end) s: one cut of a record that holds cuts at several speeds (refused
         as a whole, field ``rpm``). Times in the result stay the record's.
+    hump_db : float, default 10.0
+        A strong chatter line (≥ ``dominance``) whose growth was not read and that stands less than this over the
+        bins 3–4 away is a hump, not a tone: its ring is read, and where it decays as a stable cut's does (the weak
+        line's rule) the hump and its aliases are left out and the part judged again (module docstring, *Cutting
+        noise*; 0: not read). A Lorentzian line decaying at 30 /s stands ~10 dB out at 0.24 s frames, a chatter's
+        tone 20–40 dB.
 
     Returns
     -------
@@ -755,7 +768,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     x = np.asarray(samples, float)
     kw = dict(rpm=rpm, teeth=teeth, rpm_tolerance=rpm_tolerance, band_hz=band_hz, window_s=window_s,
               activity_db=activity_db, rise_db=rise_db, dominance=dominance, alias_dominance=alias_dominance,
-              growth_db=growth_db, alpha=alpha, full_scale=full_scale, source=source)
+              growth_db=growth_db, alpha=alpha, full_scale=full_scale, source=source, hump_db=hump_db)
     if span_s is not None:
         a, b = (float(v) for v in span_s)
         if not (math.isfinite(rate_hz) and rate_hz > 0):
@@ -781,6 +794,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         raise InputError(f"must be a probability in (0, 1), got {alpha!r}", file=source, field="alpha")
     if not (math.isfinite(growth_db) and growth_db >= 0):
         raise InputError(f"must be ≥ 0 dB (0: no growth test), got {growth_db!r}", file=source, field="growth_db")
+    if not (math.isfinite(hump_db) and hump_db >= 0):
+        raise InputError(f"must be ≥ 0 dB (0: a strong line's hump not read), got {hump_db!r}", file=source,
+                         field="hump_db")
     k0, k1 = _live_part(x, float(rate_hz), source)
     if k0 > 0 or k1 < x.size:
         # digital silence before or after the signal (a recorder started before its input was live): judged without
@@ -1014,16 +1030,21 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     # 3. harmonic mask: all multiples of the spindle frequency
     keep, harm = _harmonic_mask(freq, inband, f_s, f_s, df)
 
-    def judge(ta, tb, d_alias=None):
+    def judge(ta, tb, d_alias=None, hump=None):
         sel = frames_in(ta, tb)
         keep_w, harm_w, f_w, f_range = keep, harm, f_s, None
         if track is not None:  # the speeds these frames ran at
             fr = np.interp(frame_t[sel], *track)
             f_w, f_range = float(np.median(fr)), (float(fr.min()), float(fr.max()))
             keep_w, harm_w = _harmonic_mask(freq, inband, *f_range, df)
+        out = None
+        if hump is not None:  # (f₀, half-width Hz): a ring's hump and its tooth-passing aliases are not candidates
+            f0, hw = hump  # (their bins still count in the floor and in the line test of the lines beside them)
+            off = (freq[:, None] - f0 - teeth * f_w * np.arange(-2, 3)[None, :])
+            out = np.any(np.abs(off) <= hw, axis=1)
         seg = _judge(P[sel], stats, freq, keep_w, harm_w, ref, rise_db,
                      (dominance, alias_dominance if d_alias is None else d_alias), alpha, df, f_w, teeth * f_w,
-                     growth_db, f_range)
+                     growth_db, f_range, out)
         opr = _once_per_rev(x[int(ta * rate):int(tb * rate)], rate, f_s)
         return CutSegment("cut", ta, tb, **seg, once_per_rev=opr)
 
@@ -1154,7 +1175,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                          "split into air and cut and the Harmonizer speed")
             break
     criterion = {"alpha": alpha, "rise_db": rise_db if ref is not None else None, "dominance": dominance,
-                 "alias_dominance": alias_dominance, "growth_db": growth_db, "growth_t": _GROWTH_T,
+                 "alias_dominance": alias_dominance, "growth_db": growth_db, "growth_t": _GROWTH_T, "hump_db": hump_db,
                  "mask_hz": f"2*{df:.4g} + {_MASK_REL:g}*f", "frame_s": L / rate, "band_hz": [lo, hi],
                  "spindle_multiples_removed": True,
                  "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None,
@@ -1171,8 +1192,13 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         res = replace(res, growth=chatter_growth(x, rate, rpm=60 * f_s, teeth=teeth, chatter_hz=hz, start_s=ta,
                                                  end_s=tb))
     grew = res.growth is not None and res.growth.rate_per_s is not None and res.growth.rate_per_s > 0
-    if chat and ref is not None and longest.dominance < dominance and not grew and not (
-            longest.growth_db is not None and growth_db > 0 and longest.growth_db >= growth_db):
+    # a strong line that is a hump, not a tone (≤ _HUMP_DB over the bins 3–4 out), whose growth was not read: the
+    # cutting noise drives the tool's mode in a stable cut too, and where the tooth-passing harmonics are weak (a
+    # slot, a light cut) its hump outgrows them (docs/design/shop.md, *A stable cut's hump*)
+    hump = (chat and ref is not None and hump_db > 0 and longest.dominance >= dominance and not grew
+            and longest.line_db is not None and longest.line_db < hump_db)
+    if chat and ref is not None and (hump or longest.dominance < dominance and not grew and not (
+            longest.growth_db is not None and growth_db > 0 and longest.growth_db >= growth_db)):
         # a line weaker than "strong" alone, kept by its tooth-passing aliases, whose growth was not read: a stable
         # cut near its limit makes such a family too — the cutting force's noise drives the closed loop's least damped
         # mode and the tooth passing modulates it (docs/design/shop.md, *Cutting noise*). How fast the line decays
@@ -1184,11 +1210,18 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                            end_s=longest.end_s) if longest.line_db is not None else
                 RingDecay(None, reason="the chatter lies on a spindle harmonic, which the reading removes"))
         res = replace(res, ring=ring)
+        longest_db = longest.line_db
         if _rings(ring, longest.end_s - longest.start_s):
             # judged again without the aliases' lower bar: what else the record holds (a growing line, chatter on a
             # spindle harmonic — a flip lobe's, which the weak line beside it hid) decides, else stable
-            segs = [judge(sg.start_s, sg.end_s, d_alias=0.0) if sg.kind == "cut" and sg.verdict == "chatter"
-                    and sg.dominance < dominance and sg.line_db is not None else sg for sg in res.segments]
+            if hump:  # the hump's band and its aliases left out: what else the record holds decides
+                hw = max(3 * -ring.rate_per_s / math.pi, 3 * df)  # ±3 half-power widths of the Lorentzian
+                segs = [judge(sg.start_s, sg.end_s, hump=(chatter_hz, hw)) if sg.kind == "cut"
+                        and sg.verdict == "chatter" and sg.line_db is not None and sg.line_db < hump_db
+                        and sg.dominance >= dominance else sg for sg in res.segments]
+            else:
+                segs = [judge(sg.start_s, sg.end_s, d_alias=0.0) if sg.kind == "cut" and sg.verdict == "chatter"
+                        and sg.dominance < dominance and sg.line_db is not None else sg for sg in res.segments]
             # and a run of cut windows that holds no chatter now is read beside the harmonics, as the first pass reads
             # every such run (the pockets' chatter sits there, and the weak line's verdict kept the first pass from it)
             out, i = [], 0
@@ -1216,9 +1249,11 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 rec, alts = harmonizer_rpm(chatter_hz, teeth, 60 * f_s)
             res = replace(res, verdict=verdict, chatter_hz=chatter_hz, segments=segs, recommended_rpm=rec,
                           alternatives_rpm=alts, growth=None)
-            warns.append(f"the weak line at {was:.1f} Hz with its tooth-passing aliases decays at "
+            what = (f"the line at {was:.1f} Hz, a hump {longest_db:.1f} dB over its neighbours,"
+                    if hump else f"the weak line at {was:.1f} Hz with its tooth-passing aliases")
+            warns.append(f"{what} decays at "
                          f"{-ring.rate_per_s:.3g} /s (a ring the cutting noise drives, not a steady chatter): "
-                         + ("judged stable, near its limit" if not chat2 else
+                         + (("judged stable" if hump else "judged stable, near its limit") if not chat2 else
                             f"judged on what else the record holds: chatter at {chatter_hz:.1f} Hz"))
             chatty = [c for c in res.cuts if c[2] == "chatter"]
             if chatty:
@@ -1227,7 +1262,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 ta, tb, _, hz = max(chatty, key=lambda c: c[1] - c[0])
                 res = replace(res, growth=chatter_growth(x, rate, rpm=60 * f_s, teeth=teeth, chatter_hz=hz,
                                                          start_s=ta, end_s=tb))
-        else:
+        elif not hump:
             heard = ("" if ring.rate_per_s is None else
                      f"; the line decays at {-ring.rate_per_s:.3g} /s, too slowly to call it a ring")
             warns.append(f"chatter at {chatter_hz:.1f} Hz rests on a weak line "
@@ -1757,10 +1792,11 @@ def _leakage(p, freq, harm, f_lo, f_hi, df):
 
 
 def _judge(Pseg, stats, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s, f_t, growth_db=0.0,
-           f_range=None) -> dict:
+           f_range=None, out=None) -> dict:
     """The chatter test on the mean of the frames ``Pseg`` (see the module docstring); ``stats`` the pair
     (:func:`_welch_dof`, :func:`_tone_threshold`) of the frames; ``dominance`` the pair (without, with a tooth-passing
-    alias); ``f_range`` the spindle frequencies (Hz) the frames ran at when the speed was tracked."""
+    alias); ``f_range`` the spindle frequencies (Hz) the frames ran at when the speed was tracked; ``out`` bins that
+    are no candidates (a ring's hump), though they count in the floor and the line test."""
     n = Pseg.shape[0]
     p = Pseg.mean(axis=0)
     nu1, thr = stats
@@ -1792,6 +1828,8 @@ def _judge(Pseg, stats, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_
         line_db = 10 * np.log10(np.maximum(p, 1e-300) / np.maximum(np.convolve(q, ring, "same"), 1e-300))
     # the strongest (in power) of the significant new lines; else the most significant new line, for the record
     good = keep & new & (z > t_a)
+    if out is not None:
+        good, new = good & ~out, new & ~out
     if good.any():
         i = int(np.argmax(np.where(good, p, -1.0)))
     else:
