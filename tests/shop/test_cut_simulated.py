@@ -181,8 +181,8 @@ def test_chatter_a_few_hz_beside_the_tooth_passing_at_a_pocket_s_top_is_heard():
 @pytest.mark.slow
 def test_a_slot_s_noise_driven_hump_is_not_chatter_and_heavy_chatter_still_is():
     """A slot with 4 teeth cuts with a nearly constant force, so its tooth-passing harmonics are weak; the cutting
-    force's noise (5 %) drives the tool's 1243 Hz mode (ζ 6 %) into a hump that outgrows them. The closed loop decays
-    at 120–170 /s there, 0.3–0.5 × the SDM limit, so the hump is 40–50 Hz wide: read as a ring, left out, stable.
+    force's noise (5 %) drives the tool's 1243 Hz mode (ζ 6 %) into a hump that outgrows them. At 0.3 and 0.5 × the
+    SDM limit its ring reads 167 and 118 /s, a hump 53 and 38 Hz wide (σ/π): read as a ring, left out, stable.
     Before ``hump_db`` these were chatter (``hump_db=0``). A cut at 2 × the limit still chatters (toolpoint.simulation
     through the tests' shop microphone; docs/design/shop.md, *A stable cut's hump*)."""
     import dataclasses

@@ -91,8 +91,8 @@ The detector (:func:`analyse_cut`):
      (``docs/design/shop.md``, *A stable cut's ring*). A **strong** line that is a hump, not a tone — less than
      ``hump_db`` (10 dB) over the bins 3–4 away, its growth not read — has its ring read too: where the tooth-passing
      harmonics are weak (a slot of an even-toothed cutter, a light cut) the mode that the cutting noise drives
-     outgrows them even far under the limit (0.1–0.7 ×, decaying at 40–170 /s: ``docs/design/shop.md``, *A stable
-     cut's hump*). Where it decays as a stable cut's does (the same bar), its band (±3 half-power widths) and its
+     outgrows them even far under the limit (from 0.1 × on, decaying at 40–175 /s: ``docs/design/shop.md``, *A
+     stable cut's hump*). Where it decays as a stable cut's does (the same bar), its band (±3 half-power widths) and its
      tooth-passing aliases are left out of the candidates and the part is judged again, else the verdict stands;
    * *sustained*: over the segment's second half the line keeps ≥ ¼ of its first half's power (a free
      vibration left by the entry decays; chatter holds or grows);
