@@ -54,10 +54,10 @@ def register(sub) -> None:
     p.add_argument("--growth-db", default="6",
                    help="a new line whose power rises steadily by this much over a judged part is chatter, however "
                         "weak (default 6 dB, with t >= 4; 0: no growth test)")
-    p.add_argument("--hump-db", default="10",
+    p.add_argument("--hump-db", default="15",
                    help="a strong chatter line standing less than this over its neighbours is a hump: its ring is "
                         "read, and one that decays as a stable cut's (a mode the cutting noise drives) is not "
-                        "chatter (default 10 dB; 0: not read)")
+                        "chatter (default 15 dB; 0: not read)")
     p.add_argument("--start", help="judge the record from this time on, s (one cut of a record that holds cuts at "
                    "several speeds; times stay the record's)")
     p.add_argument("--end", help="judge the record up to this time, s")

@@ -89,11 +89,12 @@ The detector (:func:`analyse_cut`):
      to a ln sd ≤ 0.5, is a ring: the part is judged again without the alias bar (a chatter on a spindle harmonic —
      a flip lobe's — that the weak line hid is still found) and said so; else the verdict stands, warned of
      (``docs/design/shop.md``, *A stable cut's ring*). A **strong** line that is a hump, not a tone — less than
-     ``hump_db`` (10 dB) over the bins 3–4 away, its growth not read — has its ring read too: where the tooth-passing
+     ``hump_db`` (15 dB) over the bins 3–4 away, its growth not read — has its ring read too: where the tooth-passing
      harmonics are weak (a slot of an even-toothed cutter, a light cut) the mode that the cutting noise drives
      outgrows them even far under the limit (from 0.1 × on, decaying at 40–175 /s: ``docs/design/shop.md``, *A
      stable cut's hump*). Where it decays as a stable cut's does (the same bar), its band (±3 half-power widths) and its
-     tooth-passing aliases are left out of the candidates and the part is judged again, else the verdict stands;
+     tooth-passing aliases are left out of the candidates — the chatter test's and the spindle-harmonic test's (the
+     hump raises a harmonic inside it over its neighbours) — and the part is judged again, else the verdict stands;
    * *sustained*: over the segment's second half the line keeps ≥ ¼ of its first half's power (a free
      vibration left by the entry decays; chatter holds or grows);
    * *a line*: without a tooth-passing alias, the peak stands ≥ 5 dB over the mean power 3–4 bins either side
@@ -228,7 +229,7 @@ _MAINS_REL = 2e-3  # mains frequency tolerance (grids hold 50/60 Hz within ±0.2
 _LINE_DB = 5.0  # a peak without tooth-passing aliases stands this far over the bins 3–4 away: a line, not a hump
 _GAIN_WARN_DB = -3.0  # a cut's floor this far under the air cut's: the recorder's gain changed (warned)
 _STEADY_WARN_DB = 6.0  # dB: a chatter line of a record without an air cut that grew less is warned of
-_HUMP_DB = 10.0  # a strong chatter line this little over the bins 3–4 away is a hump; its ring is read
+_HUMP_DB = 15.0  # a strong chatter line this little over the bins 3–4 away is a hump; its ring is read
 _UNHEARD_LINE_DB = 20.0  # a record whose spindle harmonics do not stand out keeps a chatter line this far out
 _MASKED_WARN = 0.95  # a stable verdict with this much of the band under the spindle harmonics' masks is warned of
 _ELSEWHERE_REL = 0.25  # nominal speeds up to this far off are checked for (the range measured)
@@ -732,12 +733,13 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     span_s : (float, float), optional
         The part of the record judged, (start, end) s: one cut of a record that holds cuts at several speeds (refused
         as a whole, field ``rpm``). Times in the result stay the record's.
-    hump_db : float, default 10.0
+    hump_db : float, default 15.0
         A strong chatter line (≥ ``dominance``) whose growth was not read and that stands less than this over the
         bins 3–4 away is a hump, not a tone: its ring is read, and where it decays as a stable cut's does (the weak
         line's rule) the hump and its aliases are left out and the part judged again (module docstring, *Cutting
-        noise*; 0: not read). A Lorentzian line decaying at 30 /s stands ~10 dB out at 0.24 s frames, a chatter's
-        tone 20–40 dB.
+        noise*; 0: not read). At 0.24 s Hann frames a Lorentzian line decaying at 20 /s (the ring's bar) stands
+        11.5 dB out, at 30 /s 8.8 dB, at 100 /s 2.5 dB (a few frames' average scatters that by several dB); a
+        chatter's tone 20–40 dB.
 
     Returns
     -------
@@ -1037,14 +1039,14 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             fr = np.interp(frame_t[sel], *track)
             f_w, f_range = float(np.median(fr)), (float(fr.min()), float(fr.max()))
             keep_w, harm_w = _harmonic_mask(freq, inband, *f_range, df)
-        out = None
+        skip = None
         if hump is not None:  # (f₀, half-width Hz): a ring's hump and its tooth-passing aliases are not candidates
             f0, hw = hump  # (their bins still count in the floor and in the line test of the lines beside them)
             off = (freq[:, None] - f0 - teeth * f_w * np.arange(-2, 3)[None, :])
-            out = np.any(np.abs(off) <= hw, axis=1)
+            skip = np.any(np.abs(off) <= hw, axis=1)
         seg = _judge(P[sel], stats, freq, keep_w, harm_w, ref, rise_db,
                      (dominance, alias_dominance if d_alias is None else d_alias), alpha, df, f_w, teeth * f_w,
-                     growth_db, f_range, out)
+                     growth_db, f_range, skip)
         opr = _once_per_rev(x[int(ta * rate):int(tb * rate)], rate, f_s)
         return CutSegment("cut", ta, tb, **seg, once_per_rev=opr)
 
@@ -1792,11 +1794,11 @@ def _leakage(p, freq, harm, f_lo, f_hi, df):
 
 
 def _judge(Pseg, stats, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s, f_t, growth_db=0.0,
-           f_range=None, out=None) -> dict:
+           f_range=None, exclude=None) -> dict:
     """The chatter test on the mean of the frames ``Pseg`` (see the module docstring); ``stats`` the pair
     (:func:`_welch_dof`, :func:`_tone_threshold`) of the frames; ``dominance`` the pair (without, with a tooth-passing
-    alias); ``f_range`` the spindle frequencies (Hz) the frames ran at when the speed was tracked; ``out`` bins that
-    are no candidates (a ring's hump), though they count in the floor and the line test."""
+    alias); ``f_range`` the spindle frequencies (Hz) the frames ran at when the speed was tracked; ``exclude`` bins
+    that are no candidates (a ring's hump), though they count in the floor and the line test."""
     n = Pseg.shape[0]
     p = Pseg.mean(axis=0)
     nu1, thr = stats
@@ -1828,8 +1830,8 @@ def _judge(Pseg, stats, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_
         line_db = 10 * np.log10(np.maximum(p, 1e-300) / np.maximum(np.convolve(q, ring, "same"), 1e-300))
     # the strongest (in power) of the significant new lines; else the most significant new line, for the record
     good = keep & new & (z > t_a)
-    if out is not None:
-        good, new = good & ~out, new & ~out
+    if exclude is not None:
+        good, new = good & ~exclude, new & ~exclude
     if good.any():
         i = int(np.argmax(np.where(good, p, -1.0)))
     else:
@@ -1862,7 +1864,8 @@ def _judge(Pseg, stats, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_
         if grown is not None:
             return dict(grown, air_gain_db=out["air_gain_db"])
     if not chatter and ref is not None:
-        locked = _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominance, f_s, f_t)
+        locked = _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominance, f_s, f_t,
+                                      exclude)
         if locked is not None:
             out = dict(locked, air_gain_db=out["air_gain_db"])
     return out
@@ -1982,7 +1985,8 @@ for chatter on a spindle harmonic, dB. A runout line on a mode of damping ζ sta
 harmonic stands tens of dB over them."""
 
 
-def _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominance, f_s, f_t) -> dict | None:
+def _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominance, f_s, f_t,
+                         exclude=None) -> dict | None:
     """Chatter on (or within the mask of) a spindle harmonic k f_s, k ≢ 0 (mod N): period doubling (flip,
     f_c = (j + ½) f_t, k ≡ N/2) of an even-toothed cutter, or a chatter whose frequency sits at (j + r/N) f_t
     (the pockets' chatter near a rotation of r/N per tooth period, which the saturated chatter can lock on).
@@ -1993,7 +1997,8 @@ def _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominan
     chatter only its own family f_c + j f_t, all of residue r). The strongest candidate is judged like a chatter
     line: ``dominance`` over the strongest spindle harmonic (or the alias ratio when k ± N or k ± 2N is a
     candidate too) and sustained. Needs N ≥ 3 (with two teeth every non-tooth harmonic has the same residue:
-    runout and flip chatter cannot be told apart) and an air cut. None when no harmonic qualifies.
+    runout and flip chatter cannot be told apart) and an air cut. None when no harmonic qualifies. ``exclude``: bins
+    that are no candidates (a ring's hump, which raises the harmonics inside it over their neighbours).
     """
     n = int(round(f_t / f_s))
     if n < 3:
@@ -2011,6 +2016,8 @@ def _on_spindle_harmonic(Pseg, p, ref, freq, harm, floor0, t_a, rise_db, dominan
     res = ks % n
     cand = {}
     for m in np.flatnonzero(res != 0):
+        if exclude is not None and exclude[idx[m]]:
+            continue
         other = (res != 0) & (res != res[m])
         below = np.flatnonzero(other[:m])
         above = m + 1 + np.flatnonzero(other[m + 1:])
