@@ -49,8 +49,8 @@ the record holds. A sample that puts the cut further below is penalised, one tha
 In a noisy shop — one whose stable cuts' records ring at the tool's modes (:func:`noisy_shop`) — a stable cut near
 its limit may be heard as chatter: its mode, driven by the cutting noise, rings at the chatter frequency. A chatter
 label without a growth reading then has P(label chatter) = p_c + π Φ((u + r)/s) p_s (``precursor``;
-:data:`PRECURSOR`), u = ln(a / a_lim): one-sided, the stable labels keep p_s, so the term only widens the band above a
-chatter label.
+:data:`PRECURSOR`), u = ln(a / a_lim): one-sided, the stable labels keep p_s, so the term acts through the chatter
+labels only — it lets the band rise above them (its lower side rises too, by the mass it lets above).
 
 The posterior is sampled by sequential Monte Carlo (Chopin 2002; Del Moral, Doucet & Jasra 2006): prior
 samples are tempered, L^β with β from 0 to 1 in steps that keep the effective sample size at half the
@@ -416,8 +416,8 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     lifts it. ``precursor`` (π, r, s), None to leave it out: a stable cut u = ln(a / a_lim) from the limit is heard as
     chatter with a further probability π Φ((u + r)/s) (:data:`PRECURSOR`) — P(label chatter) = p_c + π h p_s —
     except a chattering cut whose growth was read (a ring does not grow). One-sided: P(label stable) stays p_s (not
-    (1 − π h) p_s), so a stable label says no more than in a quiet shop and the term never lifts the band's lower
-    side."""
+    (1 − π h) p_s), so a stable label says no more than in a quiet shop; the band's lower side still rises by the
+    mass the softened chatter labels let above them."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
