@@ -370,7 +370,9 @@ its limit rings at the chatter frequency and may be heard as chatter — P(chatt
 u = ln(a / a_lim) ≤ 0 — unless the record shows the chatter grew (a ring does not). Read from the labels of `cut` on
 pocket records with 5 % force noise (Cornelius truths 40–43 at each truth's pocket speeds, 24 records per depth):
 chatter heard on 0 / 1 / 6 / 11 / 12 of 24 stable records at 0.6 / 0.8 / 0.9 / 0.95 / 0.98 × the SDM limit (a
-maximum-likelihood fit gives π ≈ 0.7, r 0.08, s 0.09; −ln L 50.9 against 51.7 for these rounder values). Off the
+maximum-likelihood fit gives π ≈ 0.7, r 0.08, s 0.09; −ln L 50.9 against 51.7 for these rounder values). Judged by
+`cut` with its hump rule the same records are heard 0 / 1 / 2 / 7 / 7 times, four new truths' 0 / 0 / 1 / 7 / 14; a
+refit to those (π 0.8, r 0.02, s 0.08) and a rate by the ring's decay were no better in the whole loop. Off the
 pocket it over-states: 1 of 48 records heard at 0.85–0.975 × on two tools at 20276 rpm, where it expects 14
 (``docs/design/shop.md``, *A noisy shop's false chatter*). :func:`update` applies it only where the stable cuts' own
 records say the shop is noisy (:func:`noisy_shop`)."""
