@@ -490,19 +490,19 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_cli_update_steps_above_stable_cuts_that_crept(tmp_path, capsys):
-    """``toolpoint update`` steps ×e^--min-step above two stable cuts that crept, and only then (six updates of 300
-    samples, ~15 s CPU: the slow tier; the rest of the CLI in ``test_cli_update_writes_files_and_report``)."""
+def test_cli_update_steps_above_stable_cuts_until_the_first_chatter(tmp_path, capsys):
+    """``toolpoint update`` steps ×e^--min-step above the highest stable cut near a speed while no cut has chattered,
+    and not after a chatter (updates of 300 samples, ~15 s CPU: the slow tier; the rest of the CLI in
+    ``test_cli_update_writes_files_and_report``)."""
     prior = tmp_path / "prior.toml"
     prior.write_text(PRIOR_TOML)
-    # the step above stable cuts (--min-step, default 0.1): at 20678 rpm (a grid speed of this prior) the risk bound
-    # alone proposes ~0.775 mm above a stable cut at 0.74 mm (+5 %). After one stable cut there, or two more than
-    # ×e^0.1 apart, that is the proposal; after two closer than ×e^0.1 (the risk bound crept), the step ×e^0.1
-    # above the highest, past the risk bound (P(chatter) 0.50 measured); --min-step 0 never steps.
+    # at 20678 rpm (a grid speed of this prior) the risk bound alone proposes ~0.775 mm above a stable cut at 0.74 mm
+    # (+5 %): the step ×e^0.1 above it (moved to a speed within 2 % by the posterior median's ratio) is proposed
+    # instead (P(chatter) 0.67 measured); after a chatter, at any speed, the risk bound's cut; --min-step 0 never steps
     base = "rpm,depth_mm,result\n20000,0.5,stable\n12000,0.3,stable\n"
     nxt = {}
-    for name, rows in (("one", "20678,0.74,stable\n"), ("far", "20678,0.62,stable\n20678,0.74,stable\n"),
-                       ("crept", "20678,0.70,stable\n20678,0.74,stable\n")):
+    for name, rows in (("one", "20678,0.74,stable\n"), ("crept", "20678,0.70,stable\n20678,0.74,stable\n"),
+                       ("chatter", "20678,0.70,stable\n20678,0.74,stable\n15000,0.9,chatter\n")):
         (tmp_path / f"{name}.csv").write_text(base + rows)
         for ms in ((), ("--min-step", "0")):
             capsys.readouterr()
@@ -511,11 +511,12 @@ def test_cli_update_steps_above_stable_cuts_that_crept(tmp_path, capsys):
                          "--samples", "300", *ms]) == 0
             nxt[name, bool(ms)] = (json.loads((o / "update.json").read_text())["next_cut"], capsys.readouterr().out)
     for key, (nc, printed) in nxt.items():
-        if key != ("crept", False):
+        if key in (("one", False), ("crept", False)):
+            assert nc["stepped"] and nc["p_chatter"] > 0.3, (key, nc)
+            assert "a step above the highest stable cut near this speed" in printed, printed
+            assert abs(nc["rpm"] / 20678 - 1) <= 0.02 and 0.74 * 1.08 < nc["depth_mm"] < 0.74 * 1.15, (key, nc)
+        else:
             assert nc["p_chatter"] <= 0.3 and not nc["stepped"] and "a step above" not in printed, (key, nc)
-    nc2, printed = nxt["crept", False]
-    assert nc2["stepped"] and nc2["p_chatter"] > 0.3 and "a step above the stable cut there" in printed, nc2
-    assert abs(nc2["rpm"] / 20678 - 1) <= 0.005 and abs(nc2["depth_mm"] / 0.74 - np.exp(0.1)) < 1e-3, nc2
 
 
 def test_modal_prior_file_errors_name_the_field(tmp_path):
@@ -605,7 +606,9 @@ def test_stable_cuts_climb_by_the_boundary_width_not_by_the_risk_quantile():
     """A truth above the prior's median (K_t / 1.4: the limit 40 % up): with the risk bound alone each stable cut
     sits at the posterior's 30 % quantile, a few % above the last one, and the band creeps (measured 2026-11-26:
     0.51 → 0.76 mm in 10 stable cuts, +1–10 % a cut, converged after 10); with ``min_step`` 0.1 (the default) a
-    cut ×e^0.1 above two stable cuts that crept is proposed, and the band closes sooner (after 8, 0.78 mm)."""
+    cut ×e^0.1 above the highest stable cut is proposed until the first chatter, and the band closes sooner
+    (2026-11-29: 0.51, 0.57, 0.63, 0.70, 0.77 mm, converged after 5; after 8 with the step only above two stable
+    cuts that crept, the rule before)."""
     pr = cornelius_2024(0.1)
     truth = pr.theta(np.zeros((1, pr.sigma.size)))[0]
     truth[3 * pr.modes] /= 1.4
@@ -620,13 +623,16 @@ def test_stable_cuts_climb_by_the_boundary_width_not_by_the_risk_quantile():
         runs[ms] = [(round(1e3 * c.depth_m, 3), c.stable) for c in r.cuts]
     assert top[0.1] >= 1.05 * top[0.0], runs
     assert conv[0.1] < conv[0.0], (conv, runs)
-    # the step comes only after a creep: no cut is ×e^0.1 above the highest stable cut before it unless the two
-    # highest stable cuts before it crept (closer than ×e^0.1)
+    # here it climbs by the step: each cut up to the first chatter at least ×e^0.1 above the highest stable cut
+    # before it (up to the median's ratio between neighbouring speeds, ≤ 2 % here), and no step after a chatter
     d = runs[0.1]
+    first_chatter = next((i for i, (_, ok) in enumerate(d) if not ok), len(d))
     for i in range(1, len(d)):
         st = sorted(a for a, ok in d[:i] if ok)
-        if st and abs(d[i][0] / st[-1] - np.exp(0.1)) < 2e-3:
-            assert len(st) >= 2 and st[-1] < st[-2] * np.exp(0.1), runs
+        if i <= first_chatter:
+            assert d[i][0] >= 0.98 * np.exp(0.1) * st[-1], runs
+        elif st:
+            assert abs(d[i][0] / st[-1] - np.exp(0.1)) >= 2e-3, runs
 
 
 def _assert_same_cut(a, b, skip=()):
@@ -666,6 +672,53 @@ def test_the_next_cut_does_not_repeat_an_outcome_the_shop_already_has():
     assert every["repeat"] and "repeats one already made" in every["description"]
     before = _next_info(*args, cuts=deep, skip_repeats=False)
     _assert_same_cut(every, before, skip=("repeat", "description"))
+
+
+def test_the_step_climbs_above_stable_cuts_until_the_first_chatter():
+    """Until a cut chatters the bracket has no upper side: above the highest stable cut near a speed (±2 %, its depth
+    moved by the posterior median's ratio between the speeds) a step ×e^min_step is a candidate where the risk bound
+    stops short of it; after any chatter, the risk bound alone. The rule before (``step_until_chatter=False``,
+    ``creep_span=0.005``) stepped only above two stable cuts at one speed (±0.5 %) that crept, and missed the creep
+    over neighbouring grid speeds that the whole loop showed (``docs/design/shop.md``)."""
+    from toolpoint.shop.update import _next_info
+
+    rng = np.random.default_rng(0)
+    grid = 19000 * 1.006 ** np.arange(21)  # 0.6 % apart
+    # the posterior piled up just above a stable cut (the truth above the prior's median): the limit at speed k
+    # 0.5 mm × e^(0.01 (k − 14)) × e^|N(0, 0.15)| — its 30 % quantile only ×1.06 up, short of the step ×1.105 — and
+    # the productive speeds (the rule's candidates) 15–20, not 14
+    slope = np.exp(0.01 * (np.arange(grid.size) - 14))
+    lim = 0.5e-3 * slope * np.exp(np.abs(0.15 * rng.standard_normal((400, 1)))
+                                  + 0.002 * rng.standard_normal((400, grid.size)))
+    j = 20
+    args = (lim, grid, j, 0.3, 0.05, 0.002)
+    kw = dict(min_step=0.1, skip_repeats=True)
+
+    def cut(k, f=1.0, stable=True):
+        return TestCut(float(grid[k]), f * 0.5e-3 * slope[k], stable)
+
+    one = (cut(14),)
+    new = _next_info(*args, cuts=one, **kw, creep_span=0.02, step_until_chatter=True)
+    k = int(np.argmin(abs(grid - new["rpm"])))
+    assert new["stepped"] and new["p_chatter"] > 0.3 and 15 <= k <= 17, new
+    # the stable cut at 14 moved to speed k by the posterior median's ratio, then ×e^0.1
+    moved = one[0].depth_m * np.median(lim[:, k]) / np.median(lim[:, 14])
+    assert new["depth_m"] == pytest.approx(moved * np.exp(0.1), rel=1e-6), (new, moved)
+    assert "until the first chatter" in new["description"]
+    # the rule before: one stable cut brings no step
+    old = _next_info(*args, cuts=one, **kw, creep_span=0.005, step_until_chatter=False)
+    assert not old["stepped"] and old["p_chatter"] <= 0.3, old
+    # a chatter anywhere: no step, whichever stable cuts crept
+    for cuts in (one, (cut(15, 0.97), cut(15))):
+        after = _next_info(*args, cuts=(*cuts, cut(0, 1.5, False)), **kw, creep_span=0.02, step_until_chatter=True)
+        assert not after["stepped"] and after["p_chatter"] <= 0.3, after
+    # two stable cuts that crept, 0.6 % apart in speed: the rule before saw no creep (±0.5 %); ±2 % sees it
+    apart = (cut(14, 0.97), cut(15))
+    narrow = _next_info(*args, cuts=apart, **kw, creep_span=0.005, step_until_chatter=False)
+    wide = _next_info(*args, cuts=apart, **kw, creep_span=0.02, step_until_chatter=False)
+    assert not narrow["stepped"] and wide["stepped"], (narrow, wide)
+    # no step at all with min_step 0
+    assert not _next_info(*args, cuts=one, skip_repeats=True, min_step=0.0, step_until_chatter=True)["stepped"]
 
 
 def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
@@ -788,18 +841,18 @@ def test_the_example_session_is_heard_as_the_true_tool_s_sdm_limit_says():
     assert prior == cornelius_2024(0.1)
     truth = json.loads((EXAMPLE_SHOP / "truth.json").read_text())
     cuts = read_test_cuts(EXAMPLE_SHOP / "test_cuts.csv", teeth=prior.cutting.teeth)
-    speeds = np.unique([c.rpm for c in cuts])
-    lim, fc = sdm_limits(prior, np.array(truth["theta"]), speeds)
     assert len(cuts) == len(truth["cuts"]) >= 3 and {c.stable for c in cuts} == {True, False}
     for c, t in zip(cuts, truth["cuts"]):
-        k = int(np.searchsorted(speeds, c.rpm))
+        # each speed on its own, as the generator asks: the SDM's search found 0.5782 mm at 20276 rpm with three
+        # speeds in one call and 0.5798 mm with that speed alone (2026-11-29), more than the 4 digits truth.json keeps
+        (lim,), (fc,) = sdm_limits(prior, np.array(truth["theta"]), np.array([c.rpm]))
         assert ("stable" if c.stable else "chatter") == t["heard_alone"] and c.warnings == ()
-        assert t["sdm_limit_mm"] == pytest.approx(1e3 * lim[k], rel=1e-3)
-        ratio = c.depth_m / lim[k]
+        assert t["sdm_limit_mm"] == pytest.approx(1e3 * lim, rel=1e-3)
+        ratio = c.depth_m / lim
         if abs(ratio - 1) > 0.05:
             assert c.stable == (ratio < 1), (c, ratio)
         if not c.stable:
-            assert c.chatter_hz == pytest.approx(fc[k], rel=0.01)
+            assert c.chatter_hz == pytest.approx(fc, rel=0.01)
 
 
 
@@ -971,7 +1024,8 @@ def test_the_example_session_is_the_cuts_update_proposed(tmp_path, capsys):
         nc = doc["next_cut"]
         assert doc["sampler"]["forward"] == "sdm"  # the default: what the README's tour and the campaigns use
         rpm, depth = (float(v) for v in rows[n + 1].split(",")[:2])
-        assert (round(nc["rpm"]), round(nc["depth_mm"], 3)) == (rpm, depth), (n, nc)
+        # the table holds the proposal to 1 rpm and 0.001 mm, update.json to 0.0001 mm (0.5695 → 0.569 in the table)
+        assert round(nc["rpm"]) == rpm and abs(nc["depth_mm"] - depth) <= 0.00055, (n, nc)
 
 
 def _prior_updates(seed0, seeds, n_speeds, truths=150):

@@ -169,7 +169,7 @@ def run(args) -> int:
           f"{1e3 * nc['depth_m']:.3f} mm for at least {nc['duration_s']:.1f} s ({nc['revolutions']} rev"
           f"{': chatter grows slowly there' if nc['duration_by_growth'] else ''}), "
           f"P(chatter) {nc['p_chatter']:.2f}"
-          f"{' (a step above the stable cut there)' if nc.get('stepped') else ''}"
+          f"{' (a step above the highest stable cut near this speed)' if nc.get('stepped') else ''}"
           f"{' (it repeats a cut already made there: none within the bound would be new)' if nc.get('repeat') else ''}"
           f"; wrote {out}/report.html")
     if rc["own_sdm_held_out"] is False:  # the check by samples the speed's choice saw: said, not hidden

@@ -77,16 +77,20 @@ cut**, two rules:
   than it is and pushed the rule to creep up from below. Above a stable cut a_s the risk bound alone creeps
   too: the posterior piles up just above a_s (the prior's density falls there when the truth is above its
   median), its ``risk`` quantile is a few % higher, and each stable cut lifts the band by that much (measured:
-  9 stable cuts from 2.50 to 3.39 mm before the chatter that closed the band). So once the risk bound has crept
-  at a speed — its two highest stable cuts there (±0.5 %) closer than e^min_step — a step of e^min_step above
-  the highest is also a candidate, whatever its P(chatter) (the proposal says ``stepped``): cuts closer than the
-  boundary's own width tell little, and a chatter one step of 2 w up is a bracket of ratio 1.105, which leaves a
-  5–95 % width of about 0.2. ``min_step`` 0.1 by default (0: never). In the whole loop (``docs/design/shop.md``)
-  a step after every stable cut (the rule before 2026-11-26) cost the Cornelius case a second chattering cut
-  (median 1 → 2, seeds 0–19) while a campaign tool with one lightly damped mode (EM28-80) needed it (median
-  8 → 5 cuts); stepping only after a creep gave 4.5 cuts, 1 chattering and 6 cuts, 1 chattering on those seeds
-  (on seeds 20–39 neither rule met the targets, with δ = 0; with the label offset above, seeds 40–59 gave 5 cuts,
-  1 chattering and 6 cuts, 1 chattering, seeds 20–39 more than 6 cuts on both: ``docs/design/shop.md``);
+  9 stable cuts from 2.50 to 3.39 mm before the chatter that closed the band). So until the first chatter, above
+  the highest stable cut a_s within ±``creep_span`` (2 %) of a speed — each cut moved to it by the posterior
+  median's ratio between the two speeds, since the rule wanders over neighbouring grid speeds — a step of
+  e^min_step × a_s is also a candidate where the risk bound stops short of it, whatever its P(chatter) (the
+  proposal says ``stepped``): the bracket has no upper side yet, cuts closer than the boundary's own width tell
+  little, and a chatter one step of 2 w up is a bracket of ratio 1.105, which leaves a 5–95 % width of about 0.2.
+  After the first chatter the risk bound alone narrows the bracket. ``min_step`` 0.1 by default (0: never). In the
+  whole loop (``docs/design/shop.md``, 2026-11-29, 20 truths a case, 6 cuts) this rule took EM28-80 (one lightly damped
+  mode) from 9 to 13 of 20 truths within 6 cuts (chattering median 1 both), EM12-60 from 5 to 6 and the Cornelius
+  case from 14 to 15 (noise-free; 9 to 10 with 5 % cutting noise, chattering median 1.5 → 2), for 126 chattering
+  cuts of 480 against 105 and the recommended depth above the truth after 0.031 of the updates against 0.021
+  (claimed: 0.05); the rule before
+  (``step_until_chatter=False``, ``creep_span=0.005``: a step only once the two highest stable cuts at a speed,
+  ±0.5 %, crept closer than e^min_step) missed the creep over neighbouring speeds and lost a cut to each creep.
   A candidate whose heard outcome an earlier cut at its speed already gave (no deeper than a stable one, no
   shallower than a chattering one) is not proposed (``skip_repeats``);
 * ``"risk"``: the most productive cut (max n · a) whose P(chatter) ≤ ``risk`` (default 0.1) — the depth
@@ -663,7 +667,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            min_step: float | None = None, sdm_train: int = 0, miss_rate: float = 0.0,
            label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
            cut_duration_s: float = 1.0, risk_after_chatter: float | None = None,
-           skip_repeats: bool = True, audible_margin: float = 0.0, max_cut_duration_s: float = 5.0,
+           skip_repeats: bool = True, step_until_chatter: bool = True, creep_span: float = 0.02,
+           audible_margin: float = 0.0, max_cut_duration_s: float = 5.0,
            growth_error: tuple | None = GROWTH_ERROR, ring_error: tuple | None = RING_ERROR,
            precursor: tuple | None = PRECURSOR) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
@@ -803,17 +808,26 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         (``docs/design/shop.md``). Where every candidate repeats, the rule proposes as without it. False: as before
         2026-11-28.
     min_step : float, optional
-        ``"info"`` rule: once the two highest stable cuts at a speed are closer than e^min_step (the risk bound
-        crept), a cut e^min_step above the highest is a candidate even where it exceeds ``risk`` (default 0.1 =
+        ``"info"`` rule: a cut e^min_step above the highest stable cut near a speed is a candidate even where it
+        exceeds ``risk``, when the risk bound stops short of it — until the first chatter
+        (``step_until_chatter``), or once two stable cuts crept closer than e^min_step (default 0.1 =
         2 × ``boundary_width`` for ``"info"``; 0: never; the ``"risk"`` rule has no step: module docstring).
+    step_until_chatter : bool, default True
+        ``"info"`` rule: offer the step after any stable cut while no cut has chattered, and never after; False:
+        only once the two highest stable cuts near a speed crept closer than e^min_step, chatter or not (the
+        rule before 2026-11-29; ``docs/design/shop.md``).
+    creep_span : float, default 0.02
+        ``"info"`` rule: the stable cuts within ±creep_span (relative speed) of a candidate speed count for its
+        step, each depth moved to that speed by the posterior median's ratio between the two (0.005 before
+        2026-11-29: a creep over neighbouring grid speeds, 0.5 % apart, went unseen).
     risk_after_chatter : float, optional
         The bound on P(chatter) of the next cut once any cut has chattered (≤ ``risk``; default: ``risk``
         throughout). The first chatter gives the bracket its upper side; a lower bound after it spends fewer
         tools on the rest, and buys that with a wider band: on EM16-50 in the whole loop (10 truths, 6 cuts) 0.1
         brought the chattering cuts from a median of 2 to 1 (0.10 of the cuts after the first chatter chattered,
         against 0.25–0.30), and the band at the recommended speed from 0.23–0.27 to 0.32–0.33 wide; 0 of 10 truths
-        converged against 2–3 (``docs/design/shop.md``). A step above stable cuts that crept (``min_step``) is
-        still proposed past it.
+        converged against 2–3 (``docs/design/shop.md``; measured with the step of ``step_until_chatter=False``,
+        which is still proposed past it: the default proposes no step after a chatter).
 
     Returns
     -------
@@ -851,6 +865,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         min_step = 0.1 if rule == "info" else 0.0
     if not 0 <= min_step <= 0.5:
         raise InputError(f"must be in [0, 0.5] (a log step), got {min_step}", field="min_step")
+    if not 0 <= creep_span <= 0.1:
+        raise InputError(f"must be in [0, 0.1] (relative speed), got {creep_span}", field="creep_span")
     try:
         off_mu, off_sd = (float(v) for v in label_offset)
     except (TypeError, ValueError):
@@ -1003,7 +1019,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
             return off_pick[:, None] + growth_offset(prior, th_pick, grid[ks], fc, g_pick, duration(ks)[0])
 
         nxt = _next_info(lim, grid, j, bound, boundary_width, label_noise, chatter_cost, cuts, min_step, miss_rate,
-                         offset, skip_repeats)
+                         offset, skip_repeats, creep_span, step_until_chatter)
     if forward == "sdm":
         # the recommended depth checked by the own SDM limits of posterior samples that the choice of its speed did
         # not see: the lobe samples' tail is light at the speed where they look most productive (their own 5 %
@@ -1419,12 +1435,20 @@ def _wquantile_width(vals_sorted, w):
     return np.log(hi / lo)
 
 
+def _median_ratio(q50, grid, k, rpm) -> float:
+    """q50 at grid[k] over q50 at ``rpm`` (interpolated): moves a cut's depth to a neighbouring speed (1 where either
+    median is not finite)."""
+    r = q50[k] / np.interp(rpm, grid, q50)
+    return float(r) if np.isfinite(r) and r > 0 else 1.0
+
+
 def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), min_step=0.0, miss_rate=0.0,
-               offset=None, skip_repeats=False):
+               offset=None, skip_repeats=False, creep_span=0.005, step_until_chatter=False):
     """The ``"info"`` rule: min expected relative band width at the recommended speed, P(chatter) ≤ risk —
-    or a step of ``min_step`` (log) above the highest stable cut at that speed (±0.5 %), when the two highest
-    stable cuts there are closer than that (the risk bound crept) and it stops short of the step (module
-    docstring). ``skip_repeats``: no candidate whose outcome an earlier cut at its speed already gave.
+    or a step of ``min_step`` (log) above the highest stable cut near that speed (±``creep_span``, depths moved
+    by the posterior median's ratio), where the risk bound stops short of it: while no cut has chattered
+    (``step_until_chatter``), else once the two highest there crept closer than the step (module docstring).
+    ``skip_repeats``: no candidate whose outcome an earlier cut at its speed already gave.
     ``offset(ks) -> (S, len(ks))``: each sample's label offset at the speeds grid[ks] (the outcome heard is that of
     a_lim e^δ; the risk is the cut's own, at a_lim)."""
     from scipy.special import ndtr
@@ -1454,12 +1478,19 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
             a_hi = min((c.depth_m for c in near if not c.stable), default=np.inf)
             depths = depths[(depths > a_lo) & (depths < a_hi)]
         n_capped = depths.size
-        st = sorted(c.depth_m for c in near if c.stable)
+        # the cuts within ±creep_span of this speed, each moved to it by the posterior median's ratio between the two
+        # speeds: the rule wanders over neighbouring grid speeds (0.5 % apart), and a creep there went unseen
+        around = [(c, c.depth_m * _median_ratio(q50, grid, k, c.rpm)) for c in cuts
+                  if abs(c.rpm / grid[k] - 1) <= creep_span]
+        st = sorted(a for c, a in around if c.stable)
         a_s = st[-1] if st else None
-        crept = len(st) >= 2 and st[-1] < st[-2] * math.exp(min_step)
+        if step_until_chatter:  # no upper side to the bracket yet: climb at least a step a cut
+            crept = bool(st) and all(c.stable for c in cuts)
+        else:
+            crept = len(st) >= 2 and st[-1] < st[-2] * math.exp(min_step)
         if min_step > 0 and a_s is not None and crept and (not depths.size or depths[-1] < a_s * math.exp(min_step)):
             step = a_s * math.exp(min_step)
-            if not any(not c.stable and c.depth_m <= step for c in near):  # not past a chatter already heard
+            if not any(not c.stable and a <= step for c, a in around):  # not past a chatter already heard
                 depths = np.r_[depths, step]
         if not depths.size:
             continue
@@ -1477,7 +1508,8 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
             cand.append((float(e + chatter_cost * (1 - pst)), -float(grid[k] * d), int(k), float(d), float(1 - pst),
                          i >= n_capped))
     if not cand:  # every candidate repeats a known outcome (skip_repeats): as without the skip, and said
-        out = _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost, cuts, min_step, miss_rate, offset)
+        out = _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost, cuts, min_step, miss_rate, offset,
+                         creep_span=creep_span, step_until_chatter=step_until_chatter)
         out["description"] += " (every such cut repeats one already made at its speed: this one too)"
         return dict(out, repeat=True)
     cand = [c for c in cand if c[4] <= risk + 1e-9 or c[5]] or cand
@@ -1487,6 +1519,8 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
             "expected_log_width": e, "log_width_now": now, "stepped": bool(stepped), "repeat": False,
             "description": "the cut that most reduces the expected relative 5–95 % width of the limit at the "
                            f"recommended speed, among productive speeds, with P(chatter) ≤ {risk:g}"
-                           + (f" or, where two stable cuts crept, a step of ×{math.exp(min_step):.3f} above the highest"
-                              if min_step > 0 else "")
+                           + ((f" or, until the first chatter, a step of ×{math.exp(min_step):.3f} above the "
+                               "highest stable cut near its speed" if step_until_chatter else
+                               f" or, where two stable cuts crept, a step of ×{math.exp(min_step):.3f} above the "
+                               "highest") if min_step > 0 else "")
                            + (" (this one: the step)" if stepped else "")}
