@@ -717,6 +717,11 @@ def test_the_step_climbs_above_stable_cuts_until_the_first_chatter():
     narrow = _next_info(*args, cuts=apart, **kw, creep_span=0.005, step_until_chatter=False)
     wide = _next_info(*args, cuts=apart, **kw, creep_span=0.02, step_until_chatter=False)
     assert not narrow["stepped"] and wide["stepped"], (narrow, wide)
+    # a span past 10 % of the speed is no neighbourhood: refused, naming the field, before any sampling
+    for bad in (-0.01, 0.2):
+        with pytest.raises(InputError, match="creep_span") as exc:
+            update(cornelius_2024(0.1), one, rng=np.random.default_rng(0), creep_span=bad)
+        assert exc.value.field == "creep_span"
     # no step at all with min_step 0
     assert not _next_info(*args, cuts=one, skip_repeats=True, min_step=0.0, step_until_chatter=True)["stepped"]
 

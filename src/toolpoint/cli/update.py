@@ -60,8 +60,8 @@ def register(sub) -> None:
                    help="largest P(chatter) of the next cut once a cut has chattered (≤ --risk; default: --risk): "
                    "fewer chattering cuts, a wider band (docs/design/shop.md)")
     p.add_argument("--min-step",
-                   help="info rule: once two stable cuts at a speed are closer than e^STEP, a cut e^STEP above the "
-                   "highest may be proposed even past --risk, so stable cuts do not creep (default 0.1 = 2 × the "
+                   help="info rule: until the first chatter, a cut e^STEP above the highest stable cut near a speed "
+                   "(±2 %%) may be proposed even past --risk, so stable cuts do not creep (default 0.1 = 2 × the "
                    "boundary width; 0: never: docs/design/shop.md)")
     p.add_argument("--label-offset", metavar="MEAN,SD",
                    help="ln of how far above the stability limit your cuts' chatter is first heard (mean, standard "
