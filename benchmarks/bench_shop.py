@@ -495,7 +495,7 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
     for case in cases:
         prior = priors[case]
         for shop_name in shops:
-            conv, chat, cpu, fails, runs = [], [], [], 0, []
+            conv, chat, over, cpu, fails, runs = [], [], [], [], 0, []
             for seed in range(seed_start, seed_start + seeds):
                 # a sound file's full scale is 1; an accelerometer's record is in m/s²
                 det = detector if sensor == "microphone" else {"full_scale": None, **(detector or {})}
@@ -512,14 +512,23 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                 conv.append(r.converged_after if r.converged_after is not None else np.inf)
                 made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
                 chat.append(sum(not c.stable for c in made))
+                # each cut's depth over the truth's limit at its speed (SDM for the time-domain shops, one speed a
+                # call as the truth's generator asks): a label of chatter below 1 is the detector's false chatter,
+                # a depth above 1 chatters physically whatever it was heard as
+                rel = [c.depth_m / float(np.ravel(truth(r.theta_true, [c.rpm]))[0]) if truth else
+                       c.depth_m / float(limit_at_speeds(prior, r.theta_true[None, :], [c.rpm])[0][0, 0])
+                       for c in r.cuts]
+                over.append(sum(x > 1 for x in rel[:len(made)]))
                 cpu.extend(r.update_cpu_s)
                 fails += r.converged_after is None
                 if verbose:
-                    print(f"   seed {seed}: converged after {r.converged_after}, {chat[-1]} chattering; cuts "
+                    print(f"   seed {seed}: converged after {r.converged_after}, {chat[-1]} chattering;"
+                          + f" {over[-1]} above the true limit; cuts "
                           + " ".join(f"{c.rpm:.0f}/{1e3 * c.depth_m:.2f}{'s' if c.stable else 'C'}"
+                                     + f"<{x:.3f}>"
                                      + ("" if c.duration_s is None else f"({c.duration_s:.1f}s)")
                                      + ("" if c.growth_per_s is None else f"[σ {c.growth_per_s:.3g}/s]")
-                                     for c in r.cuts)
+                                     for c, x in zip(r.cuts, rel))
                           + f"; width {np.round(r.width, 2).tolist()}; coverage {np.round(r.coverage, 2).tolist()}"
                           + ("; truth below the recommended depth after "
                              + ",".join(str(n) for n, b in enumerate(r.below_recommended) if b)
@@ -529,7 +538,8 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
             p90 = np.sort(conv)[int(np.ceil(0.9 * conv.size)) - 1]  # inf where a tenth did not converge
             print(f"{prior.name[:40]:40s} shop {shop_name:5s}: cuts to converge median {np.median(conv):.1f} "
                   f"(p90 {p90:.1f}), converged {seeds - fails}/{seeds} within {max_cuts}; "
-                  f"chattering cuts median {np.median(chat):.1f} (max {max(chat)}); CPU per update median "
+                  f"chattering cuts median {np.median(chat):.1f} (max {max(chat)}), above the true limit median "
+                  f"{np.median(over):.1f} (max {max(over)}); CPU per update median "
                   f"{np.median(cpu):.1f} s, max {max(cpu):.1f} s", flush=True)
             if not stop:  # calibration after n cuts, over all the truths (none selected by a stop)
                 for n in range(max_cuts + 1):

@@ -458,6 +458,10 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o4"),
                  "--min-step", "0.1", "--rule", "risk"]) == 2
     assert "min_step" in capsys.readouterr().err and not (tmp_path / "o4").exists()
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o6"),
+                 "--step-only-after-creep", "--rule", "risk"]) == 2
+    assert "--step-only-after-creep: only with --rule info" in capsys.readouterr().err
+    assert not (tmp_path / "o6").exists()
     # --label-offset MEAN,SD: the labels' boundary e^δ above the limit. The default (0.035, 0.035) puts the band at
     # the cut speed below that of 0,0 (labels = the limit), and parameters.csv reports δ's prior and posterior
     rows = {r.split(",")[0]: r.split(",") for r in (out / "parameters.csv").read_text().splitlines()}
@@ -504,14 +508,18 @@ def test_cli_update_steps_above_stable_cuts_until_the_first_chatter(tmp_path, ca
     for name, rows in (("one", "20678,0.74,stable\n"), ("crept", "20678,0.70,stable\n20678,0.74,stable\n"),
                        ("chatter", "20678,0.70,stable\n20678,0.74,stable\n15000,0.9,chatter\n")):
         (tmp_path / f"{name}.csv").write_text(base + rows)
-        for ms in ((), ("--min-step", "0")):
+        for ms in ((), ("--min-step", "0"), ("--step-only-after-creep",)):
             capsys.readouterr()
             o = tmp_path / f"{name}{len(ms)}"
             assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(tmp_path / f"{name}.csv"), "--out", str(o),
                          "--samples", "300", *ms]) == 0
-            nxt[name, bool(ms)] = (json.loads((o / "update.json").read_text())["next_cut"], capsys.readouterr().out)
+            nxt[name, ms[:1]] = (json.loads((o / "update.json").read_text())["next_cut"], capsys.readouterr().out)
+    # --step-only-after-creep (the rule before): a step only once two stable cuts crept closer than the step, and
+    # then whether a cut chattered elsewhere or not
+    stepping = (("one", ()), ("crept", ()), ("crept", ("--step-only-after-creep",)),
+                ("chatter", ("--step-only-after-creep",)))
     for key, (nc, printed) in nxt.items():
-        if key in (("one", False), ("crept", False)):
+        if key in stepping:
             assert nc["stepped"] and nc["p_chatter"] > 0.3, (key, nc)
             assert "a step above the highest stable cut near this speed" in printed, printed
             assert abs(nc["rpm"] / 20678 - 1) <= 0.02 and 0.74 * 1.08 < nc["depth_mm"] < 0.74 * 1.15, (key, nc)

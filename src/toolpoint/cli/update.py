@@ -63,6 +63,10 @@ def register(sub) -> None:
                    help="info rule: until the first chatter, a cut e^STEP above the highest stable cut near a speed "
                    "(±2 %%) may be proposed even past --risk, so stable cuts do not creep (default 0.1 = 2 × the "
                    "boundary width; 0: never: docs/design/shop.md)")
+    p.add_argument("--step-only-after-creep", action="store_true",
+                   help="info rule: step only once the two highest stable cuts near a speed crept closer than "
+                   "e^--min-step, chatter or not (the rule before 2026-11-29): fewer chattering cuts, a slower climb "
+                   "(docs/design/shop.md, *The step until the first chatter*)")
     p.add_argument("--label-offset", metavar="MEAN,SD",
                    help="ln of how far above the stability limit your cuts' chatter is first heard (mean, standard "
                    "deviation; default 0.035,0.035: the chatter detector measured 0.004 on one tool and 0.070 on "
@@ -105,6 +109,11 @@ def run(args) -> int:
     min_step = None if args.min_step is None else check_number(args.min_step, "--min-step", minimum=0, maximum=0.5,
                                                                why="a log step: ×1.65")
     offset = {}
+    if args.step_only_after_creep:
+        if args.rule != "info":
+            raise InputError("only with --rule info (the risk rule never steps)", file="command line",
+                             field="--step-only-after-creep")
+        offset["step_until_chatter"] = False
     if args.label_offset is not None:
         offset["label_offset"] = _pair(args.label_offset, "--label-offset", "MEAN,SD", (-0.2, 0.5), (0, 0.5))
     if args.label_growth is not None:
