@@ -64,9 +64,9 @@ def register(sub) -> None:
                    "(±2 %%) may be proposed even past --risk, so stable cuts do not creep (default 0.1 = 2 × the "
                    "boundary width; 0: never: docs/design/shop.md)")
     p.add_argument("--step-only-after-creep", action="store_true",
-                   help="info rule: step only once the two highest stable cuts near a speed crept closer than "
-                   "e^--min-step, chatter or not (the rule before 2026-11-29): fewer chattering cuts, a slower climb "
-                   "(docs/design/shop.md, *The step until the first chatter*)")
+                   help="info rule: step only once the two highest stable cuts near a speed (±2 %%) crept closer "
+                   "than e^--min-step, chatter or not (the trigger before 2026-11-29): fewer chattering cuts, a "
+                   "slower climb (docs/design/shop.md, *The step until the first chatter*)")
     p.add_argument("--label-offset", metavar="MEAN,SD",
                    help="ln of how far above the stability limit your cuts' chatter is first heard (mean, standard "
                    "deviation; default 0.035,0.035: the chatter detector measured 0.004 on one tool and 0.070 on "
