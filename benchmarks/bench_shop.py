@@ -513,7 +513,7 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                 made = r.cuts if r.converged_after is None else r.cuts[:r.converged_after]
                 chat.append(sum(not c.stable for c in made))
                 # each cut's depth over the truth's limit at its speed (SDM for the time-domain shops, one speed a
-                # call: 0.27 % off the whole grid's search the coverage uses at one speed measured, stability.md): a
+                # call; alone a speed read 0.27 % above itself asked with neighbours, docs/design/stability.md): a
                 # label of chatter below 1 is the detector's false chatter, a depth above 1 chatters physically
                 # whatever it was heard as
                 rel = [c.depth_m / float(np.ravel(truth(r.theta_true, [c.rpm]))[0]) if truth else
