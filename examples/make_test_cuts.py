@@ -16,7 +16,7 @@ semi-discretisation (SDM) limit at each cut's speed, which the tests judge the r
 """
 
 import json
-from dataclasses import replace
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +25,7 @@ import soundfile as sf
 from toolpoint.shop.campaign import microphone_record, simulated_shop
 from toolpoint.shop.model import sdm_limits
 from toolpoint.shop.prior import read_modal_prior
-from toolpoint.shop.update import update
+from toolpoint.shop.update import read_test_cuts, update
 from toolpoint.simulation import sensor_signal
 
 HERE = Path(__file__).resolve().parent / "shop"
@@ -50,24 +50,15 @@ def main(out: Path = HERE) -> None:
 
     shop = simulated_shop(prior, rate=RATE, record=keep)
     cuts = []
-    for _ in range(CUTS):
-        # the cut `toolpoint update --forward sdm` proposes from the table so far (its --seed 0), as the table
-        # writes it (rpm to 1, depth to 0.001 mm): the tour's first update prints the table's first row
-        made = [replace(c, rpm=float(round(c.rpm)), depth_m=round(c.depth_m, 6)) for c in cuts]
-        nc = update(prior, made, rng=np.random.default_rng(0), forward="sdm").next_cut
-        cuts.append(shop(theta, float(round(nc["rpm"])), round(nc["depth_m"], 6), rng))
-    air = np.zeros(int(AIR_S * RATE))
-    parts, rows, t = [air], [], AIR_S
-    for c, v in zip(cuts, heard):
-        rows.append((c, t - 0.5 * AIR_S, t + v.size / RATE + 0.5 * AIR_S))
-        parts += [v, air]
-        t += v.size / RATE + AIR_S
-    x = np.concatenate(parts)
-    x = x + 0.05 * min(float(np.std(v)) for v in heard) * rng.standard_normal(x.size)
-    sf.write(out / "session.flac", 0.8 * x / np.abs(x).max(), int(RATE), subtype="PCM_16")
-    lines = ["rpm,depth_mm,result,record,start_s,end_s"]
-    lines += [f"{c.rpm:.0f},{1e3 * c.depth_m:.3f},,session.flac,{a:.2f},{b:.2f}" for c, a, b in rows]
-    (out / "test_cuts.csv").write_text("\n".join(lines) + "\n")
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(CUTS):
+            # the cut `toolpoint update` proposes (its defaults: --forward sdm, --seed 0) from the table so far, read as
+            # the command reads it: the session of the cuts so far, each part analysed by `cut` (its duration in the
+            # record, not the simulation's: 0.751 against 0.743 s moved the third proposal a grid speed)
+            made = read_test_cuts(_write(Path(tmp), cuts, heard), teeth=prior.cutting.teeth) if cuts else []
+            nc = update(prior, made, rng=np.random.default_rng(0), forward="sdm").next_cut
+            cuts.append(shop(theta, float(round(nc["rpm"])), round(nc["depth_m"], 6), rng))
+    _write(out, cuts, heard)
     lim = [float(sdm_limits(prior, theta, np.array([round(c.rpm)]))[0][0]) for c in cuts]
     (out / "truth.json").write_text(json.dumps({
         "note": "synthetic: the true tool of examples/make_test_cuts.py (seed %d) and its SDM limit at each cut" % SEED,
@@ -79,7 +70,26 @@ def main(out: Path = HERE) -> None:
         print(f"{c.rpm:.0f} rpm {1e3 * c.depth_m:.3f} mm: {'stable' if c.stable else 'chatter'} "
               f"(SDM limit {1e3 * a:.3f} mm, ratio {c.depth_m / a:.3f})")
     print(f"wrote {out / 'session.flac'} ({(out / 'session.flac').stat().st_size / 1e3:.0f} kB, "
-          f"{x.size / RATE:.1f} s), test_cuts.csv, truth.json")
+          f"{sf.info(out / 'session.flac').duration:.1f} s), test_cuts.csv, truth.json")
+
+
+def _write(out: Path, cuts, heard) -> Path:
+    """``session.flac`` of the cuts (each between 1.5 s of air) and ``test_cuts.csv`` naming their parts; the room
+    noise from its own seed, so that a session of the first cuts is the whole session's beginning but for the gain."""
+    air = np.zeros(int(AIR_S * RATE))
+    parts, rows, t = [air], [], AIR_S
+    for c, v in zip(cuts, heard):
+        rows.append((c, t - 0.5 * AIR_S, t + v.size / RATE + 0.5 * AIR_S))
+        parts += [v, air]
+        t += v.size / RATE + AIR_S
+    x = np.concatenate(parts)
+    x = x + 0.05 * min(float(np.std(v)) for v in heard[:len(cuts)]) * np.random.default_rng(
+        SEED + 1000).standard_normal(x.size)
+    sf.write(out / "session.flac", 0.8 * x / np.abs(x).max(), int(RATE), subtype="PCM_16")
+    lines = ["rpm,depth_mm,result,record,start_s,end_s"]
+    lines += [f"{c.rpm:.0f},{1e3 * c.depth_m:.3f},,session.flac,{a:.2f},{b:.2f}" for c, a, b in rows]
+    (out / "test_cuts.csv").write_text("\n".join(lines) + "\n")
+    return out / "test_cuts.csv"
 
 
 if __name__ == "__main__":

@@ -195,7 +195,8 @@ def run(args) -> int:
     if (pc := precursor_doc(post)) is not None and any(not c.stable and c.growth_per_s is None for c in cuts):
         print("noisy shop: " + precursor_note(pc))  # said where a chatter label is read differently
     pocket = pocket_note({"rpm": rc["rpm"], "limit_p05_mm": 1e3 * rc["limit_p05_m"],
-                          "own_sdm_p05_mm": None if rc["own_sdm_p05_m"] is None else 1e3 * rc["own_sdm_p05_m"]})
+                          "own_sdm_p05_mm": None if rc["own_sdm_p05_m"] is None else 1e3 * rc["own_sdm_p05_m"],
+                          "lobes_own_sdm": post.own_sdm_ess is not None})
     if pocket is not None:
         print("note: " + pocket)
     for c in cuts:  # a label that rests on a doubtful record: said where the user looks

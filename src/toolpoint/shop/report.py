@@ -9,7 +9,8 @@ In the output folder (written atomically, all or none of each file):
 * ``update.json`` — recommended point, next test cut (rule, rpm, depth_mm, duration_s, P(chatter)), the test
   cuts (each with its record and part, where the table named one), ``precursor`` (a noisy shop's false chatter
   the likelihood allowed for, and the stable cut whose ring said the shop is noisy; null in a quiet shop), the
-  forward model and sampler diagnostics (method, ESS per tempering step, acceptance, CPU s);
+  forward model and sampler diagnostics (method, ESS per tempering step, acceptance, the lobe samples' ESS by
+  their own SDM limits, CPU s);
 * ``lobes.png`` — prior and posterior bands, the P(stable) map, the test cuts, the next cut;
 * ``report.html`` — one self-contained page (figure embedded) of all of the above.
 """
@@ -101,7 +102,9 @@ def _doc(post: Posterior) -> dict:
                         # forward="sdm": held-out posterior samples' own SDM 5 % limit here (the depth: the lower)
                         "own_sdm_p05_mm": (None if rc["own_sdm_p05_m"] is None
                                            else round(1e3 * rc["own_sdm_p05_m"], 4)),
-                        "own_sdm_held_out": rc["own_sdm_held_out"]},
+                        "own_sdm_held_out": rc["own_sdm_held_out"],
+                        # the band's samples weighted by their own SDM limits at the cut speeds (update's own_sdm)
+                        "lobes_own_sdm": post.own_sdm_ess is not None},
         "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},
         "cuts": [{"rpm": c.rpm, "depth_mm": round(1e3 * c.depth_m, 6), "result": "stable" if c.stable else "chatter",
                   "chatter_hz": c.chatter_hz, "duration_s": c.duration_s, "growth_per_s": c.growth_per_s,
@@ -116,6 +119,9 @@ def _doc(post: Posterior) -> dict:
         "sampler": {"method": post.method, "forward": post.forward, "samples": int(post.z.shape[0]),
                     "ess": [round(e, 1) for e in post.ess],
                     "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
+                    # the lobe samples' weights by their own SDM limits at the cut speeds (update's own_sdm)
+                    "own_sdm_ess": None if post.own_sdm_ess is None else round(post.own_sdm_ess, 1),
+                    "lobe_samples": None if post.lobe_z is None else int(post.lobe_z.shape[0]),
                     "cpu_s": round(post.cpu_s, 2)},
     }
 
@@ -171,13 +177,19 @@ def pocket_note(rc: dict) -> str | None:
     limit there (``rc``: the report's ``recommended``, mm), else None. The band's SDM correction rests on a few
     reference samples' ratio, and at a pocket's peak that ratio varies from sample to sample: on the tap prior of the
     README (0 cuts, 13166 rpm) 26 % of 150 truths drawn from the prior lay below the band's 5 % line and 4 % below the
-    recommended depth (docs/design/shop.md, *Limits*)."""
+    recommended depth (docs/design/shop.md, *Limits*). Where the band's samples were weighted by their own SDM limits
+    at the cut speeds (``rc["lobes_own_sdm"]``, :func:`~toolpoint.shop.update.update`'s ``own_sdm``) and the held-out
+    samples were not, the line says that instead: the gap is then the two samples' difference, not the references'."""
     band, own = rc.get("limit_p05_mm"), rc.get("own_sdm_p05_mm")
     if band is None or own is None or not band > 1.05 * own:
         return None
-    return (f"at {rc['rpm']:.0f} rpm the band's 5 % limit ({band:.3f} mm) lies {100 * (band / own - 1):.0f} % above "
-            f"the posterior samples' own SDM 5 % limit ({own:.3f} mm): the band is optimistic at this pocket (its SDM "
-            "correction rests on a few reference samples); the recommended depth is the lower")
+    head = (f"at {rc['rpm']:.0f} rpm the band's 5 % limit ({band:.3f} mm) lies {100 * (band / own - 1):.0f} % above "
+            f"the held-out posterior samples' own SDM 5 % limit ({own:.3f} mm): ")
+    if rc.get("lobes_own_sdm"):
+        return head + ("the band's samples were weighted by their own SDM limits at the cut speeds, the held-out ones "
+                       "were not; the recommended depth is the lower, the more cautious")
+    return head + ("the band is optimistic at this pocket (its SDM correction rests on a few reference samples); the "
+                   "recommended depth is the lower")
 
 
 def away_note(cuts) -> str:
@@ -267,5 +279,8 @@ def _html(post, doc, rows, png) -> str:
         f"<th>prior 95</th><th>post 5</th><th>post 50</th><th>post 95</th></tr>{par_rows}</table>"
         f"<p>Forward model: {e(s['forward'])}. Sampler: {e(s['method'])}, {s['samples']} samples, ESS per step "
         f"{e(str(s['ess']))}, acceptance "
-        f"{s['acceptance']}, {s['cpu_s']} s CPU. Files: lobes.csv, p_stable.csv, parameters.csv, update.json.</p>"
+        f"{s['acceptance']}"
+        + (f"; the {s['lobe_samples']} lobe samples weighted by their own SDM limits at the cut speeds, ESS "
+           f"{s['own_sdm_ess']}" if s.get("own_sdm_ess") is not None else "")
+        + f", {s['cpu_s']} s CPU. Files: lobes.csv, p_stable.csv, parameters.csv, update.json.</p>"
         "</body></html>")
