@@ -607,7 +607,8 @@ class Posterior:
         Index of the stable cut whose ring said the shop is noisy (:func:`noisy_shop`).
     own_sdm_ess : float or None
         Effective sample size of the lobe samples' weights by their own SDM limits at the cut speeds
-        (:func:`update`'s ``own_sdm``), of ``lobe_samples``; None where they were not weighted.
+        (:func:`update`'s ``own_sdm``), of ``lobe_samples``; None where they were not weighted, 0 where no weight
+        was finite (the lobe samples left unweighted).
     lobe_z : ndarray, shape (m, P + 2), optional
         The lobe samples (rows of ``z``, as ``z``'s columns), resampled by those weights where they were weighted
         (rows repeat): the samples whose limits make ``limit_q_m``.
@@ -855,6 +856,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         check (held-out samples' own limits at its speed) is not weighted: it stays the more cautious figure.
         Measured in the whole loop: ``docs/design/shop.md`` (*Own SDM limits at the cut speeds*). False: as before
         2026-11-30.
+
     Returns
     -------
     Posterior
@@ -1367,9 +1369,11 @@ def _sdm_own_log_ratio(prior, z, u, f, lr_guess, zoa=None, near: dict | None = N
 def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width, rng):
     """The lobe samples (rows ``pick`` of ``z``, lobes ``lim``) weighted by the cuts' likelihood with their own SDM
     limits at the cut speeds over that of the last sampling (``kw``: the references' mean ratio, their spread in the
-    boundary width), resampled, and each one's lobes moved to its own limit at the cut speeds (the residual carried
-    to the grid over ±a few %, :func:`_carry`). ``lr_now`` (m, C): the ratio each lobe sample's lobes carry at the
-    cuts. Returns the new ``pick`` and ``lim`` (rows repeat) and the weights' effective sample size.
+    boundary width), resampled, and each one's lobes moved to its own limit at the cut speeds (the residual put on
+    the grid by :func:`_interp_near`). ``lr_now`` (m, C): the ratio each lobe sample's lobes carry at the cuts.
+    Returns the new ``pick`` and ``lim`` (rows repeat) and the weights' effective sample size — 0 where no weight is
+    finite (no sample can explain the cuts with its own limits; the likelihood's floors make that unreachable), the
+    lobe samples then left as they were.
 
     Why: each lobe sample carries one reference's SDM/ZOA ratio, and the references' ratios at a speed spread by
     ln sd 0.05–0.19 on EM16-50, so the band at a cut speed could not be narrower than that spread however the cuts
@@ -1395,6 +1399,8 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
                                                  log_ratio=own[:, inv]))
           - log_likelihood(prior, th, cuts, **dict(kw, **extra)))
     lw = np.where(np.isfinite(lw), lw, -np.inf)
+    if not np.isfinite(lw).any():
+        return pick, lim, 0.0
     w = np.exp(lw - lw.max())
     idx = _systematic(w / w.sum(), rng)
     lim = lim[idx] * np.exp(_interp_near(own[idx] - lr_now[idx][:, first], grid, u))
