@@ -976,9 +976,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 # corrected samples' own SDM limits at the cut speeds (sdm_train of them) give the ratio there,
                 # its mean in the likelihood and its spread in the boundary width, and the posterior is sampled
                 # a third time; each lobe sample keeps one reference's ratio, moved to that mean near the cuts
-                u, inv = np.unique(rpm_c, return_inverse=True)
-                first = np.zeros(u.size, int)
-                first[inv[::-1]] = np.arange(rpm_c.size)[::-1]
+                u, inv, first = _cut_speeds(rpm_c)
                 lr_ref_u = lr_c[:, first]  # (R, U)
                 z_tr = z[rng.choice(n_samples, min(int(sdm_train), n_samples), replace=False), :P]
                 lr_tr = _sdm_own_log_ratio(prior, z_tr, u, f, lr_ref_u.mean(axis=0))  # (T, U)
@@ -1380,10 +1378,7 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
     fell — and the sampled posterior matched the cuts only through the references' mean (of one truth's
     posterior samples 37–62 % had their own limit below a stable cut; ``docs/design/shop.md``)."""
     P = prior.sigma.size
-    rpm_c = np.array([c.rpm for c in cuts])
-    u, inv = np.unique(rpm_c, return_inverse=True)
-    first = np.zeros(u.size, int)
-    first[inv[::-1]] = np.arange(rpm_c.size)[::-1]
+    u, inv, first = _cut_speeds(np.array([c.rpm for c in cuts]))
     zp = z[pick]
     # two halvings: a bracket 0.05 wide in ln a, interpolated in ρ — against the full search on 120 of EM16-50
     # truth 49's lobe samples at its three cut speeds: ln error sd 0.0044 with two, three or four halvings (the
@@ -1407,14 +1402,27 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
     return pick[idx], lim, _ess(lw)
 
 
+def _cut_speeds(rpm_c):
+    """The distinct cut speeds u (sorted), each cut's index into u, and the first cut at each speed."""
+    u, inv = np.unique(rpm_c, return_inverse=True)
+    first = np.zeros(u.size, int)
+    first[inv[::-1]] = np.arange(rpm_c.size)[::-1]
+    return u, inv, first
+
+
 def _interp_near(resid, grid, u, kernel=0.02):
-    """Residuals at the sorted speeds u (·, U) on the grid (·, G): linear in speed between neighbouring speeds of u,
-    faded by exp(−½ (d / ``kernel``)²), d the relative distance to the nearest of u — each residual itself at its
-    own speed (where :func:`_carry` averages speeds closer than its kernel), 0 a few ``kernel`` away."""
+    """Residuals at the sorted speeds u (·, U) on the grid (·, G): linear in speed between neighbouring speeds of u
+    (held at the end values beyond them, as ``np.interp``), faded by exp(−½ (d / ``kernel``)²), d the relative
+    distance to the nearest of u — each residual itself at its own speed (where :func:`_carry` averages speeds
+    closer than its kernel), 0 a few ``kernel`` away. One interpolation for all rows."""
+    resid = np.atleast_2d(resid)
     d = np.min(np.abs(grid[:, None] / u[None, :] - 1), axis=1)
     fade = np.exp(-0.5 * (d / kernel) ** 2)
-    lin = np.stack([np.interp(grid, u, r) for r in np.atleast_2d(resid)])
-    return lin * fade[None, :]
+    if u.size == 1:
+        return resid[:, :1] * fade[None, :]
+    k = np.clip(np.searchsorted(u, grid) - 1, 0, u.size - 2)
+    t = np.clip((grid - u[k]) / (u[k + 1] - u[k]), 0.0, 1.0)
+    return (resid[:, k] * (1 - t) + resid[:, k + 1] * t) * fade[None, :]
 
 
 def _own_limits(prior, z, f, grid, lim, k, lobe_samples=True):
