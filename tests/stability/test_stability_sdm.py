@@ -1,5 +1,7 @@
 """First-order semi-discretisation (Insperger & Stépán 2002/2004) of milling stability."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from scipy.linalg import expm
@@ -11,6 +13,7 @@ from toolpoint.stability import (
     ModalModel,
     average_directional_matrix,
     sdm_limit_near,
+    sdm_limit_near_many,
     sdm_lobes,
     sdm_spectral_radius,
     zoa_lobes,
@@ -172,6 +175,33 @@ def test_limit_near_a_guess_finds_the_searched_limit(ri):
     assert not ok.any() and np.all(lim < ref) and lim == pytest.approx(ref * 0.2 * np.exp(0.4))
     with pytest.raises(InputError, match="guesses"):
         sdm_limit_near(MODE, None, cut(ri), rpm=rpm, depth_m=ref[:1])
+
+
+def test_limit_near_for_many_models_finds_each_models_limit():
+    """``sdm_limit_near_many`` evaluates the points of many models together (different frequencies, dampings,
+    stiffnesses and K_t): each model's limits land on its own :func:`sdm_lobes` upward search (rtol 1e-5) within
+    the final bracket (h/4 = 5 % in ln a with two halvings, interpolated in ρ: < 1 % measured), skipped guesses
+    are NaN and unbracketed, and a model twice as stiff (mass doubled at the same frequency and damping ratio)
+    has twice the limit, as the equation of motion scaled by k requires."""
+    rng = np.random.default_rng(7)
+    rpm = np.array([6000.0, 9000.0, 10000.0, 14000.0])
+    models = [ModalModel([922.0 * (1 + 0.05 * j)], [0.011 * (1 + 0.2 * j)], [0.03993 * (1 + 0.3 * j)])
+              for j in range(4)]
+    cuts = [cut(0.05), cut(0.05), replace(cut(0.05), tangential_coeff=5e8), cut(0.05)]
+    ref = np.array([sdm_lobes(mm, None, c, rpm=rpm, rtol=1e-5).depth_m for mm, c in zip(models, cuts)])
+    guess = ref * np.exp(rng.normal(0, 0.15, ref.shape))
+    guess[1, 2] = np.nan
+    lim, ok = sdm_limit_near_many([(mm, None, c) for mm, c in zip(models, cuts)], rpm=rpm, depth_m=guess,
+                                  bisections=2)
+    v = np.isfinite(guess)
+    assert ok[v].all() and not ok[1, 2] and np.isnan(lim[1, 2])
+    assert lim[v] == pytest.approx(ref[v], rel=0.01)
+    stiff = ModalModel([922.0], [0.011], [2 * 0.03993])
+    two, _ = sdm_limit_near_many([(models[0], None, cut(0.05)), (stiff, None, cut(0.05))], rpm=rpm,
+                                 depth_m=np.array([ref[0], 2 * ref[0]]), bisections=12)
+    assert two[1] == pytest.approx(2 * two[0], rel=1e-3)
+    with pytest.raises(InputError, match="one row"):
+        sdm_limit_near_many([(models[0], None, cut(0.05))], rpm=rpm, depth_m=guess)
 
 
 def test_old_loose_keywords_are_refused():

@@ -851,8 +851,9 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         at the cut speeds, linearly between neighbouring cut speeds and fading over ±2 % beyond them. Without it
         the band at a cut speed is no narrower than the spread of the references' ratios there (ln sd 0.05–0.19 on
         EM16-50: one truth's band at a cut speed 0.33–0.57 wide over three seeds for the same cuts), and the
-        samples agree with the cuts only through the references' mean. It costs one ``sdm_limit_near`` per lobe
-        sample over the cut speeds (1.6 s CPU for 120 samples at three speeds on EM16-50). The recommended depth's
+        samples agree with the cuts only through the references' mean. It costs one search per lobe sample over
+        the cut speeds, all samples together (:func:`~toolpoint.stability.sdm_limit_near_many`: 1.2 s CPU for 120
+        samples at three speeds on EM16-50, against 1.9–2.1 s one sample at a time). The recommended depth's
         check (held-out samples' own limits at its speed) is not weighted: it stays the more cautious figure.
         Measured in the whole loop: ``docs/design/shop.md`` (*Own SDM limits at the cut speeds*). False: as before
         2026-11-30.
@@ -1156,8 +1157,8 @@ def _sdm_log_ratio(prior, theta, rpm_cuts, grid, f):
     their own zero-order limit times the first sample's ratio (a bracket of ±2 % in ln a, stepped out at most
     three times, halved once: the limit within about 0.5 %), and searched upwards like the first where that
     found no bracket. On EM16-50 (three modes) this halves the references' time at a ratio within 0.3 % of the
-    full search (``docs/design/shop.md``)."""
-    from ..stability import sdm_limit_near
+    full search (``docs/design/shop.md``). The others' searches run together (``sdm_limit_near_many``)."""
+    from ..stability import sdm_limit_near_many
 
     zg = _limits(prior, theta, f, grid)
     zc = limit_at_speeds(prior, theta, rpm_cuts, f)[0] if rpm_cuts.size else np.zeros((theta.shape[0], 0))
@@ -1171,27 +1172,24 @@ def _sdm_log_ratio(prior, theta, rpm_cuts, grid, f):
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(np.isfinite(s / z) & (s > 0), np.log(s / z), 0.0)
 
-    lr_u = None
-    for i, t in enumerate(theta):
-        if lr_u is None:
-            # as deep as the pockets go: with sdm_lobes' own range a pocket past 100 × the minimum limit was inf,
-            # its ratio dropped to 0 and the correction lost exactly where the cuts are (EM28-80)
-            s = sdm_limits(prior, t, speeds, chatter=False)[0]
-            lr_u = log_ratio(s, z_u[0])
-        else:
-            guess = z_u[i] * np.exp(lr_u)
-            s = np.full(speeds.size, np.nan)
-            ok = np.isfinite(guess) & (guess > 0)
-            if ok.any():
-                mm, cut = prior.tool(t)
-                near, bracketed = sdm_limit_near(mm, mm, cut, rpm=speeds[ok], depth_m=guess[ok], log_step=0.02,
-                                                 max_steps=3, bisections=1, chatter_hz=fc_u[i, ok])
-                s[np.flatnonzero(ok)[bracketed]] = near[bracketed]
-            redo = np.isnan(s)
-            if redo.any():
-                s[redo] = sdm_limits(prior, t, speeds[redo], chatter=False)[0]
-        out_g[i] = log_ratio(s[inv_g], zg[i])
-        out_c[i] = log_ratio(s[inv_c], zc[i])
+    # the first: as deep as the pockets go (with sdm_lobes' own range a pocket past 100 × the minimum limit was
+    # inf, its ratio dropped to 0 and the correction lost exactly where the cuts are: EM28-80)
+    s_all = np.full((theta.shape[0], speeds.size), np.nan)
+    s_all[0] = sdm_limits(prior, theta[0], speeds, chatter=False)[0]
+    lr_u = log_ratio(s_all[0], z_u[0])
+    if theta.shape[0] > 1:  # the others together, from the first's ratio
+        guess = z_u[1:] * np.exp(lr_u)[None, :]
+        tools = [(mm, mm, cut) for mm, cut in map(prior.tool, theta[1:])]
+        near, bracketed = sdm_limit_near_many(tools, rpm=speeds, depth_m=guess, log_step=0.02, max_steps=3,
+                                              bisections=1, chatter_hz=fc_u[1:])
+        s_all[1:][bracketed] = near[bracketed]
+    for i in range(1, theta.shape[0]):
+        redo = np.isnan(s_all[i])  # no guess, or no bracket within the steps: searched upwards
+        if redo.any():
+            s_all[i, redo] = sdm_limits(prior, theta[i], speeds[redo], chatter=False)[0]
+    for i in range(theta.shape[0]):
+        out_g[i] = log_ratio(s_all[i, inv_g], zg[i])
+        out_c[i] = log_ratio(s_all[i, inv_c], zc[i])
     return out_c, out_g
 
 
@@ -1348,18 +1346,14 @@ def _sdm_own_log_ratio(prior, z, u, f, lr_guess, zoa=None, near: dict | None = N
     (:func:`~toolpoint.stability.sdm_limit_near`, from its zero-order limit times e^lr_guess); 0 where no lobe
     reaches the speed. ``zoa``: the samples' ``limit_at_speeds`` at u, when the caller has it. ``near``: options of
     ``sdm_limit_near`` (its defaults otherwise)."""
-    from ..stability import sdm_limit_near
+    from ..stability import sdm_limit_near_many
 
     th = prior.theta(z)
     a_zoa, fc = limit_at_speeds(prior, th, u, f) if zoa is None else zoa  # (S, U)
     guess = a_zoa * np.exp(np.broadcast_to(lr_guess, a_zoa.shape))
-    own = np.full(a_zoa.shape, np.nan)
-    for i in range(th.shape[0]):  # one model per sample: vectorised over its speeds
-        ok = np.isfinite(guess[i]) & (guess[i] > 0)
-        if ok.any():
-            mm, cut = prior.tool(th[i])
-            own[i, ok], _ = sdm_limit_near(mm, mm, cut, rpm=u[ok], depth_m=guess[i, ok], chatter_hz=fc[i, ok],
-                                           **(near or {}))
+    tools = [(mm, mm, cut) for mm, cut in map(prior.tool, th)]
+    # all samples' models together (the same search as one sdm_limit_near per sample; skipped guesses give NaN)
+    own, _ = sdm_limit_near_many(tools, rpm=u, depth_m=guess, chatter_hz=fc, **(near or {}))
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(np.isfinite(own / a_zoa) & (own > 0), np.log(own / a_zoa), 0.0)
 
@@ -1470,8 +1464,9 @@ def _first_cut_own(prior, z, f, grid, lim, nxt, bound):
     productive — where it is likely too high. Measured (2026-11-27; 8–10 seeds, 100 truths from the prior each):
     first cuts that claimed P(chatter) 0.28 chattered for 0.37 of the truths on the example tool and 0.34 on
     EM16-50 (0.29 on the Cornelius case); with this check 0.28–0.30 claimed, 0.27–0.28 realised (``docs/design/
-    shop.md``). It costs one ``sdm_limit_near`` per lobe sample at one speed: 3.2 s CPU on EM16-50 (of a
-    17 s prior update; 2026-11-27, one BLAS controller per process)."""
+    shop.md``). It costs one search per lobe sample at one speed, all samples together
+    (:func:`~toolpoint.stability.sdm_limit_near_many`): on EM16-50 1.9–2.3 s CPU of an 11.3–11.8 s prior update,
+    against 3.4–3.6 s of 14.8–15.1 s one sample at a time (2026-11-30, two ``rng`` seeds, the same proposals)."""
     own = _own_limits(prior, z, f, grid, lim, int(np.argmin(np.abs(grid - nxt["rpm"]))))
     d = nxt["depth_m"]
     p = float(np.mean(own <= d))

@@ -5,8 +5,9 @@
 * :func:`sdm_lobes` — semi-discretisation (Insperger & Stépán 2002/2004) of a
   state-space model of the tool point (:class:`StateSpaceModel`: real or
   complex modes, cross terms); needed at low radial immersion.
-* :func:`sdm_limit_near` — the SDM limit near a guess per speed (many models,
-  few speeds each); :func:`sdm_spectral_radius` — ρ at (speed, depth) points.
+* :func:`sdm_limit_near` — the SDM limit near a guess per speed;
+  :func:`sdm_limit_near_many` the same for many models (a prior's samples)
+  at once; :func:`sdm_spectral_radius` — ρ at (speed, depth) points.
 * :func:`from_modal_fit` builds the SDM's model from common-pole modal fits
   (:func:`toolpoint.dynamics.modal.fit_frfs`: complex modes, cross FRFs);
   :class:`ModalModel` holds real modes per direction given by hand.
@@ -21,7 +22,7 @@ Geometry and sign conventions: :mod:`toolpoint.stability.milling`.
 from .cutting import CuttingConditions
 from .cutting import immersion_angles
 from .milling import Lobe, LobeResult, Pocket, average_directional_matrix, directional_coefficients
-from .sdm import sdm_limit_near, sdm_lobes, sdm_spectral_radius
+from .sdm import sdm_limit_near, sdm_limit_near_many, sdm_lobes, sdm_spectral_radius
 from .statespace import ModalModel, StateSpaceModel, from_modal_fit
 from .zoa import zoa_lobes
 
@@ -37,6 +38,7 @@ __all__ = [
     "from_modal_fit",
     "immersion_angles",
     "sdm_limit_near",
+    "sdm_limit_near_many",
     "sdm_lobes",
     "sdm_spectral_radius",
     "zoa_lobes",

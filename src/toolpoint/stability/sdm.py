@@ -80,7 +80,8 @@ from .cutting import CuttingConditions, check_cutting
 from .milling import Lobe, LobeResult, check_rpm, interval_directional_matrix
 from .statespace import StateSpaceModel
 
-__all__ = ["sdm_lobes", "sdm_spectral_radius", "as_state_space", "expm_batch", "STEPS_PER_WAVE", "NODES_PER_WAVE"]
+__all__ = ["sdm_lobes", "sdm_limit_near", "sdm_limit_near_many", "sdm_spectral_radius", "as_state_space",
+           "expm_batch", "STEPS_PER_WAVE", "NODES_PER_WAVE"]
 
 STEPS_PER_WAVE = 24
 """Default steps of the cut per chatter wave at ``accuracy=1`` (module docstring)."""
@@ -270,19 +271,20 @@ class _System:
         Γ0 = ∫₀^Δt e^{A(Δt−s)} ds B, Γ1 = ∫₀^Δt e^{A(Δt−s)} (s/Δt) ds B, Δt = t_c/m, from one
         exponential of the Van Loan block [[AΔt, BΔt, 0], [0, 0, I], [0, 0, 0]] per speed.
         """
-        n, p = self.n, self.Bin.shape[1]
+        n, p = self.n, self.Bin.shape[-1]
         t_cut, t_free = self.cut_time(rpm)
         dt = t_cut / m
         X = np.zeros((rpm.size, n + 2 * p, n + 2 * p))
-        X[:, :n, :n] = self.A0 * dt[:, None, None]
+        X[:, :n, :n] = self.A0 * dt[:, None, None]  # A0 (n, n), or (B, n, n) for a stack of models
         # Input columns scaled to the norm of the state block (exact, undone below): the exponential's
         # cost grows with the log of the block's norm.
-        c = max(np.abs(self.Bin).sum(axis=0).max() / max(np.abs(self.A0).sum(axis=0).max(), 1e-300), 1e-300)
+        c = np.maximum(np.abs(self.Bin).sum(axis=-2).max(axis=-1)
+                       / np.maximum(np.abs(self.A0).sum(axis=-2).max(axis=-1), 1e-300), 1e-300)[..., None, None]
         X[:, :n, n: n + p] = (self.Bin / c) * dt[:, None, None]
         X[:, n: n + p, n + p:] = np.eye(p)
         Ex = expm_batch(X)
         G1 = Ex[:, :n, n + p:] * c
-        return Ex[:, :n, :n], Ex[:, :n, n: n + p] * c - G1, G1, expm_batch(self.A0[None] * t_free[:, None, None])
+        return Ex[:, :n, :n], Ex[:, :n, n: n + p] * c - G1, G1, expm_batch(self.A0 * t_free[:, None, None])
 
     def monodromy(self, rpm, depth, m: int, s: int = 1, cut_end: bool = False, maps=None):
         """Floquet transition matrices Φ, shape (B, D, D), for paired 1-D arrays rpm, depth.
@@ -305,15 +307,18 @@ class _System:
         B = rpm.size
         P, G0, G1, Pfree = self.step_maps(rpm, m) if maps is None else maps
         a = depth[:, None, None, None]
-        U0 = a * np.einsum("bnp,ipd->bind", G0, H)  # (B, m, n, d): a(Γ0 − Γ1)H_i
-        U1 = a * np.einsum("bnp,ipd->bind", G1, H)  # aΓ1H_i
+        # H (m, p, d) of one model, or (B, m, p, d) of a stack of models (then C is (B, d, n))
+        sub = "bnp,ipd->bind" if H.ndim == 3 else "bnp,bipd->bind"
+        U0 = a * np.einsum(sub, G0, H)  # (B, m, n, d): a(Γ0 − Γ1)H_i
+        U1 = a * np.einsum(sub, G1, H)  # aΓ1H_i
+        C = self.C if self.C.ndim == 2 else self.C[:, None]  # broadcast over the steps
         # z_{i+1} = M_i z_i + E0_i r'_i + E1_i r'_{i+1} with S_i = I − W_i C, W_i = U1_i K_i:
         # M_i = S_i (P − U0_i C) = P − U0_i C − W_i (C P − C U0_i C), E0_i = S_i U0_i, E1_i = S_i U1_i = W_i.
-        CU0, CU1 = self.C @ U0, self.C @ U1  # (B, m, d, d)
+        CU0, CU1 = C @ U0, C @ U1  # (B, m, d, d)
         K = np.linalg.inv(np.eye(d) + CU1)
         W = U1 @ K
-        right = np.concatenate([np.broadcast_to(self.C, CU0.shape[:2] + self.C.shape),
-                                (self.C @ P)[:, None] - CU0 @ self.C], axis=2)  # (B, m, 2d, n)
+        right = np.concatenate([np.broadcast_to(C, CU0.shape[:2] + self.C.shape[-2:]),
+                                (self.C @ P)[:, None] - CU0 @ C], axis=2)  # (B, m, 2d, n)
         M = P[:, None] - np.concatenate([U0, W], axis=3) @ right
         E0, E1 = U0 - W @ CU0, W
         D = n + q1 * d
@@ -456,6 +461,66 @@ class _System:
         return mm, s
 
 
+class _Stack:
+    """Many models of one structure (the same n, d, forces, teeth and cut span; e.g. a prior's samples), whose
+    spectral radii are computed for points of different models together: the step loop of
+    :meth:`_System.monodromy` then runs once per chunk of points, not once per model."""
+
+    def __init__(self, systems):
+        self.systems = list(systems)
+        first = self.systems[0]
+        self.n, self.d, self.p = first.n, first.d, first.Bin.shape[1]
+        for sy in self.systems:
+            if (sy.n, sy.d, sy.Bin.shape[1], sy.teeth) != (self.n, self.d, self.p, first.teeth) or not np.isclose(
+                    sy.cut_angle, first.cut_angle, rtol=1e-12, atol=0.0):
+                raise ValueError("_Stack: models of different structure or cut geometry")
+        self.A0 = np.stack([sy.A0 for sy in self.systems])
+        self.C = np.stack([sy.C for sy in self.systems])
+        self.Bin = np.stack([sy.Bin for sy in self.systems])
+        self.f_max = np.array([sy.f_max for sy in self.systems])
+        self._H = {}
+
+    def directional(self, m: int) -> np.ndarray:
+        """(K, m, p, d): each model's H_i (:meth:`_System.directional`)."""
+        if m not in self._H:
+            self._H[m] = np.stack([sy.directional(m) for sy in self.systems])
+        return self._H[m]
+
+    def view(self, k, m: int) -> "_System":
+        """A :class:`_System` of the points' models ``k`` (B,) for ``m`` steps: A0, C, B and H with a leading
+        axis B (the discretisation's interpolation weights shared: they depend on m and s only)."""
+        first = self.systems[0]
+        v = object.__new__(_System)
+        v.__dict__.update(teeth=first.teeth, cut_angle=first.cut_angle, n=self.n, d=self.d, _L=first._L,
+                          A0=self.A0[k], C=self.C[k], Bin=self.Bin[k], _H={m: self.directional(m)[k]})
+        return v
+
+    def multipliers(self, k, rpm, depth, m, s):
+        """As :meth:`_System.multipliers`, point j on model ``k[j]``."""
+        k = np.asarray(k, int).reshape(-1)
+        rpm = np.asarray(rpm, float).reshape(-1)
+        depth = np.asarray(depth, float).reshape(-1)
+        m = np.broadcast_to(np.asarray(m, int), rpm.shape)
+        s = np.broadcast_to(np.asarray(s, int), rpm.shape)
+        crit = np.empty(rpm.size, complex)
+        n, d = self.n, self.d
+        with single_thread_blas():
+            key = m * 1000 + s
+            for kk in np.unique(key):
+                mm, ss = divmod(int(kk), 1000)
+                idx = np.flatnonzero(key == kk)
+                D = n + (mm // ss + 1) * d
+                # as _System.multipliers, plus each point's own H
+                per_point = mm * n * (n + 2 * (INTERP_DEGREE + 2) * d) + n * D + mm * self.p * d
+                chunk = max(1, _CHUNK_FLOATS // max(per_point, D * D))
+                for c in range(0, idx.size, chunk):
+                    j = idx[c: c + chunk]
+                    v = self.view(k[j], mm)
+                    ev = np.linalg.eigvals(v.monodromy(rpm[j], depth[j], mm, ss))
+                    crit[j] = ev[np.arange(ev.shape[0]), np.argmax(np.abs(ev), axis=1)]
+        return np.abs(crit), crit
+
+
 # ------------------------------------------------------------------ public API
 def as_state_space(modes_x, modes_y=None) -> StateSpaceModel:
     """The tool-point model the SDM works on, from what the caller gave.
@@ -547,17 +612,7 @@ def sdm_spectral_radius(
 
 
 def sdm_limit_near(
-    modes_x,
-    modes_y=None,
-    cutting: CuttingConditions | None = None,
-    *,
-    rpm,
-    depth_m,
-    log_step: float = 0.2,
-    max_steps: int = 5,
-    bisections: int = 4,
-    accuracy: float = 1.0,
-    chatter_hz=None,
+    modes_x, modes_y=None, cutting: CuttingConditions | None = None, *, rpm, depth_m, chatter_hz=None, **search
 ) -> tuple[np.ndarray, np.ndarray]:
     """The SDM limit near a guess at each speed: a bracket stepped out from the guess, then bisected.
 
@@ -578,19 +633,17 @@ def sdm_limit_near(
         Spindle speeds, rpm.
     depth_m : array_like, shape (U,)
         The guesses, m (> 0, finite).
-    log_step : float
-        h, the step in ln a while bracketing.
-    max_steps : int
-        Largest number of steps; a limit farther than e^{±h·max_steps} from the guess is reported at that
-        bound, unbracketed.
-    bisections : int
-        Halvings of the bracket: its final width is h / 2^bisections in ln a (0.0125 by default).
-    accuracy : float
-        Resolution factor of the discretisation (:func:`sdm_lobes`).
     chatter_hz : array_like, optional
         Zero-order chatter frequencies at the speeds, Hz (scalar or (U,)): the discretisation resolves
         ``1.1 ×`` the highest of them and of the natural frequencies, as :func:`sdm_lobes` does over its grid
         (default: computed by the zero-order method at these speeds).
+    **search
+        ``log_step`` (float, default 0.2): h, the step in ln a while bracketing.
+        ``max_steps`` (int, default 5): largest number of steps; a limit farther than e^{±h·max_steps} from
+        the guess is reported at that bound, unbracketed.
+        ``bisections`` (int, default 4): halvings of the bracket; its final width is h / 2^bisections in ln a
+        (0.0125 by default).
+        ``accuracy`` (float, default 1): resolution factor of the discretisation (:func:`sdm_lobes`).
 
     Returns
     -------
@@ -610,27 +663,26 @@ def sdm_limit_near(
     >>> round(float(lim[0]) * 1e3, 2), bool(ok[0])
     (4.09, True)
     """
-    cut = check_cutting(cutting)
-    sysm = _System(as_state_space(modes_x, modes_y), cut)
-    acc = _check_accuracy(accuracy)
     r = np.asarray(rpm, float).reshape(-1)
     a0 = np.asarray(depth_m, float).reshape(-1)
     if r.shape != a0.shape or np.any(~np.isfinite(r) | (r <= 0)) or np.any(~np.isfinite(a0) | (a0 <= 0)):
         raise InputError("need as many finite guesses > 0 m as speeds > 0 rpm", field="rpm/depth_m")
+    fc = None if chatter_hz is None else np.broadcast_to(np.asarray(chatter_hz, float), r.shape)[None]
+    lim, ok = sdm_limit_near_many([(modes_x, modes_y, cutting)], rpm=r, depth_m=a0[None], chatter_hz=fc, **search)
+    return lim[0], ok[0]
+
+
+def _near_options(log_step: float = 0.2, max_steps: int = 5, bisections: int = 4, accuracy: float = 1.0):
+    """The search options of :func:`sdm_limit_near` (their defaults' one home), checked."""
     if not 0 < log_step <= 1 or int(max_steps) != max_steps or max_steps < 1 or not 0 <= bisections <= 20:
         raise InputError("need 0 < log_step ≤ 1, max_steps ≥ 1 and 0 ≤ bisections ≤ 20",
                          field="log_step/max_steps/bisections")
-    if chatter_hz is None:
-        u = np.unique(r)
-        chatter_hz = _zoa_seed(sysm, u, *_zoa_grid(sysm)).chatter_hz
-    fc = np.asarray(chatter_hz, float)
-    f_wave = WAVE_MARGIN * max(sysm.f_max, float(np.nanmax(fc)) if np.any(np.isfinite(fc)) else 0.0)
-    mm, ss = sysm.resolution(r, None, acc, int(round(M_MAX * max(acc, 1.0))), f_wave)
+    return float(log_step), int(max_steps), int(bisections), _check_accuracy(accuracy)
 
-    def rho(idx, x):  # ρ at speeds idx, depths e^x
-        return sysm.multipliers(r[idx], np.exp(x), mm[idx], ss[idx])[0]
 
-    all_ = np.arange(r.size)
+def _near(rho, a0, log_step, max_steps, bisections):
+    """:func:`sdm_limit_near`'s search from guesses ``a0`` (m), ``rho(idx, ln a)`` the spectral radii of points idx."""
+    all_ = np.arange(a0.size)
     lo_x = np.log(a0)
     lo_r = rho(all_, lo_x)
     hi_x, hi_r = lo_x.copy(), lo_r.copy()
@@ -645,7 +697,7 @@ def sdm_limit_near(
         lo_x[open_], lo_r[open_] = hi_x[open_], hi_r[open_]
         hi_x[open_], hi_r[open_] = x, rr
         open_ = open_[(rr < 1) == up[open_]]
-    bracketed = np.ones(r.size, bool)
+    bracketed = np.ones(a0.size, bool)
     bracketed[open_] = False
     # order each bracket (s: stable end, c: chatter end)
     s_x, s_r = np.where(up, lo_x, hi_x), np.where(up, lo_r, hi_r)
@@ -663,6 +715,95 @@ def sdm_limit_near(
         t = np.clip((1 - s_r) / (c_r - s_r), 0.0, 1.0)
     est = np.where(bracketed, s_x + np.where(np.isfinite(t), t, 0.5) * (c_x - s_x), hi_x)
     return np.exp(est), bracketed
+
+
+def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, **search) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`sdm_limit_near` for many models at once (e.g. samples of a prior), each at its own guesses.
+
+    Each model's search is that of :func:`sdm_limit_near` over its valid points (its own discretisation, from
+    its highest natural and chatter frequency); models of one structure (the same number of states, moving
+    directions and forces, teeth and cut span) are evaluated together, so that the discretisation's step loop
+    runs once per chunk of points of many models rather than once per model (on 120 three-mode models at three
+    speeds each, 1.3 s CPU against 2.0 s for the loop of one search per model it replaced, the same limits to the
+    bit; 2026-11-30).
+
+    Parameters
+    ----------
+    tools : sequence of (modes_x, modes_y, cutting)
+        K models, each as :func:`sdm_spectral_radius` takes them.
+    rpm : array_like, shape (U,) or (K, U)
+        Spindle speeds, rpm (> 0).
+    depth_m : array_like, shape (K, U)
+        The guesses, m; points whose guess is not finite and > 0 are skipped.
+    chatter_hz : array_like, shape (K, U), optional
+        Zero-order chatter frequencies, Hz (default: each model's zero-order method at its speeds).
+    **search
+        ``log_step``, ``max_steps``, ``bisections``, ``accuracy``: as :func:`sdm_limit_near`.
+
+    Returns
+    -------
+    limit_m : ndarray, shape (K, U)
+        Estimated limits, m (NaN at skipped points).
+    bracketed : ndarray of bool, shape (K, U)
+        ``False`` where no verdict change was found within the steps, and at skipped points.
+
+    Examples
+    --------
+    Insperger & Stépán's benchmark and the same tool with twice the modal mass at the same frequency and
+    damping ratio — twice the stiffness, so twice the limit:
+
+    >>> from toolpoint.stability import CuttingConditions, ModalModel
+    >>> cut = CuttingConditions(teeth=2, tangential_coeff=6e8, radial_ratio=1/3, radial_immersion=0.05)
+    >>> tools = [(ModalModel([922.0], [0.011], [0.03993]), None, cut),
+    ...          (ModalModel([922.0], [0.011], [2 * 0.03993]), None, cut)]
+    >>> lim, ok = sdm_limit_near_many(tools, rpm=[10000.0], depth_m=[[3e-3], [6e-3]])
+    >>> np.round(lim[:, 0] * 1e3, 2).tolist(), ok[:, 0].tolist()
+    ([4.09, 8.18], [True, True])
+    """
+    log_step, max_steps, bisections, acc = _near_options(**search)
+    systems = [_System(as_state_space(mx, my), check_cutting(c)) for mx, my, c in tools]
+    K = len(systems)
+    a0 = np.asarray(depth_m, float)
+    if K == 0 or a0.ndim != 2 or a0.shape[0] != K:
+        raise InputError(f"need one row of guesses per model ({K}), got shape {a0.shape}", field="depth_m")
+    r = np.broadcast_to(np.asarray(rpm, float), a0.shape)
+    if np.any(~np.isfinite(r) | (r <= 0)):
+        raise InputError("speeds must be finite and > 0 rpm", field="rpm")
+    ok = np.isfinite(a0) & (a0 > 0)
+    if chatter_hz is None:
+        fc = np.full(a0.shape, np.nan)
+        for i, sy in enumerate(systems):  # the zero-order seed of each model (callers usually have it)
+            if ok[i].any():
+                u, inv = np.unique(r[i, ok[i]], return_inverse=True)
+                fc[i, ok[i]] = _zoa_seed(sy, u, *_zoa_grid(sy)).chatter_hz[inv]
+    else:
+        fc = np.broadcast_to(np.asarray(chatter_hz, float), a0.shape)
+    limit, bracketed = np.full(a0.shape, np.nan), np.zeros(a0.shape, bool)
+    mmax = int(round(M_MAX * max(acc, 1.0)))
+    groups = {}
+    for i, sy in enumerate(systems):  # models the discretisation can stack
+        if ok[i].any():
+            groups.setdefault((sy.n, sy.d, sy.Bin.shape[1], sy.teeth, float(sy.cut_angle)), []).append(i)
+    for members in groups.values():
+        st = _Stack([systems[i] for i in members])
+        kk, jj = np.nonzero(ok[members])  # points: model (in the stack), speed
+        rows = np.asarray(members)[kk]
+        fcm = np.where(ok[members], fc[members], np.nan)
+        with np.errstate(invalid="ignore"):
+            f_fc = np.nanmax(np.where(np.isfinite(fcm), fcm, -np.inf), axis=1)
+        f_wave = WAVE_MARGIN * np.maximum(st.f_max, f_fc)  # per model, as sdm_limit_near over its points
+        mm = np.empty(kk.size, int)
+        ss = np.empty(kk.size, int)
+        for q, i in enumerate(members):
+            sel = kk == q
+            mm[sel], ss[sel] = systems[i].resolution(r[i, jj[sel]], None, acc, mmax, float(f_wave[q]))
+        rp = r[rows, jj]
+
+        def rho(idx, x, st=st, kk=kk, rp=rp, mm=mm, ss=ss):  # ρ at points idx, depths e^x
+            return st.multipliers(kk[idx], rp[idx], np.exp(x), mm[idx], ss[idx])[0]
+
+        limit[rows, jj], bracketed[rows, jj] = _near(rho, a0[rows, jj], log_step, max_steps, bisections)
+    return limit, bracketed
 
 
 def _zoa_minimum(sysm: _System, freq_hz: np.ndarray, phi: np.ndarray) -> float:
