@@ -496,8 +496,9 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
 @pytest.mark.slow
 def test_cli_update_steps_above_stable_cuts_until_the_first_chatter(tmp_path, capsys):
     """``toolpoint update`` steps ×e^--min-step above the highest stable cut near a speed while no cut has chattered,
-    and not after a chatter (updates of 300 samples, ~15 s CPU: the slow tier; the rest of the CLI in
-    ``test_cli_update_writes_files_and_report``)."""
+    and not after a chatter (``--step-until-near-chatter``: not after a chatter near that speed; with
+    ``--step-only-after-creep`` it is refused, exit 2). Updates of 300 samples, ~15 s CPU: the slow tier; the
+    rest of the CLI in ``test_cli_update_writes_files_and_report``."""
     prior = tmp_path / "prior.toml"
     prior.write_text(PRIOR_TOML)
     # at 20678 rpm (a grid speed of this prior) the risk bound alone proposes ~0.775 mm above a stable cut at 0.74 mm
@@ -508,16 +509,18 @@ def test_cli_update_steps_above_stable_cuts_until_the_first_chatter(tmp_path, ca
     for name, rows in (("one", "20678,0.74,stable\n"), ("crept", "20678,0.70,stable\n20678,0.74,stable\n"),
                        ("chatter", "20678,0.70,stable\n20678,0.74,stable\n15000,0.9,chatter\n")):
         (tmp_path / f"{name}.csv").write_text(base + rows)
-        for ms in ((), ("--min-step", "0"), ("--step-only-after-creep",)):
+        for ms in ((), ("--min-step", "0"), ("--step-only-after-creep",), ("--step-until-near-chatter",)):
             capsys.readouterr()
-            o = tmp_path / f"{name}{len(ms)}"
+            o = tmp_path / f"{name}{len(ms)}{ms[:1]}"
             assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(tmp_path / f"{name}.csv"), "--out", str(o),
                          "--samples", "300", *ms]) == 0
             nxt[name, ms[:1]] = (json.loads((o / "update.json").read_text())["next_cut"], capsys.readouterr().out)
     # --step-only-after-creep (the rule before): a step only once two stable cuts crept closer than the step, and
     # then whether a cut chattered elsewhere or not
+    # --step-until-near-chatter: a chatter 27 % away in speed leaves the step
     stepping = (("one", ()), ("crept", ()), ("crept", ("--step-only-after-creep",)),
-                ("chatter", ("--step-only-after-creep",)))
+                ("chatter", ("--step-only-after-creep",)), ("one", ("--step-until-near-chatter",)),
+                ("crept", ("--step-until-near-chatter",)), ("chatter", ("--step-until-near-chatter",)))
     for key, (nc, printed) in nxt.items():
         if key in stepping:
             assert nc["stepped"] and nc["p_chatter"] > 0.3, (key, nc)
@@ -525,6 +528,12 @@ def test_cli_update_steps_above_stable_cuts_until_the_first_chatter(tmp_path, ca
             assert abs(nc["rpm"] / 20678 - 1) <= 0.02 and 0.74 * 1.08 < nc["depth_mm"] < 0.74 * 1.15, (key, nc)
         else:
             assert nc["p_chatter"] <= 0.3 and not nc["stepped"] and "a step above" not in printed, (key, nc)
+    capsys.readouterr()
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(tmp_path / "one.csv"), "--out",
+                 str(tmp_path / "both"), "--step-until-near-chatter", "--step-only-after-creep"]) == 2
+    err = capsys.readouterr().err
+    assert "--step-until-near-chatter" in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "both").exists()
 
 
 def test_modal_prior_file_errors_name_the_field(tmp_path):
@@ -720,6 +729,13 @@ def test_the_step_climbs_above_stable_cuts_until_the_first_chatter():
     for cuts in (one, (cut(15, 0.97), cut(15))):
         after = _next_info(*args, cuts=(*cuts, cut(0, 1.5, False)), **kw, creep_span=0.02, step_until_chatter=True)
         assert not after["stepped"] and after["p_chatter"] <= 0.3, after
+    # "near": a chatter 8–10 % away in speed gives these speeds no upper side, so the step stays; one within
+    # ±2 % of the stepped speed takes it away
+    far = _next_info(*args, cuts=(*one, cut(0, 1.5, False)), **kw, creep_span=0.02, step_until_chatter="near")
+    assert far["stepped"] and "chatters near its speed" in far["description"], far
+    assert far["rpm"] == new["rpm"] and far["depth_m"] == pytest.approx(new["depth_m"]), (far, new)
+    close = _next_info(*args, cuts=(*one, cut(k, 1.5, False)), **kw, creep_span=0.02, step_until_chatter="near")
+    assert not close["stepped"] and close["p_chatter"] <= 0.3, close
     # two stable cuts that crept, 0.6 % apart in speed: the rule before saw no creep (±0.5 %); ±2 % sees it
     apart = (cut(14, 0.97), cut(15))
     narrow = _next_info(*args, cuts=apart, **kw, creep_span=0.005, step_until_chatter=False)
@@ -730,6 +746,9 @@ def test_the_step_climbs_above_stable_cuts_until_the_first_chatter():
         with pytest.raises(InputError, match="creep_span") as exc:
             update(cornelius_2024(0.1), one, rng=np.random.default_rng(0), creep_span=bad)
         assert exc.value.field == "creep_span"
+    with pytest.raises(InputError, match="'near'") as exc:
+        update(cornelius_2024(0.1), one, rng=np.random.default_rng(0), step_until_chatter="elsewhere")
+    assert exc.value.field == "step_until_chatter"
     # no step at all with min_step 0
     assert not _next_info(*args, cuts=one, skip_repeats=True, min_step=0.0, step_until_chatter=True)["stepped"]
 

@@ -67,6 +67,10 @@ def register(sub) -> None:
                    help="info rule: step only once the two highest stable cuts near a speed (±2 %%) crept closer "
                    "than e^--min-step, chatter or not (the trigger before 2026-11-29): fewer chattering cuts, a "
                    "slower climb (docs/design/shop.md, *The step until the first chatter*)")
+    p.add_argument("--step-until-near-chatter", action="store_true",
+                   help="info rule: keep the step above stable cuts near a speed until a cut within ±2 %% of it "
+                   "chatters (not any cut): fewer cuts, more chattering ones (docs/design/shop.md, *The step after "
+                   "a chatter elsewhere*)")
     p.add_argument("--label-offset", metavar="MEAN,SD",
                    help="ln of how far above the stability limit your cuts' chatter is first heard (mean, standard "
                    "deviation; default 0.035,0.035: the chatter detector measured 0.004 on one tool and 0.070 on "
@@ -114,6 +118,11 @@ def run(args) -> int:
             raise InputError("only with --rule info (the risk rule never steps)", file="command line",
                              field="--step-only-after-creep")
         offset["step_until_chatter"] = False
+    if args.step_until_near_chatter:
+        if args.rule != "info" or args.step_only_after_creep:
+            raise InputError("only with --rule info and without --step-only-after-creep", file="command line",
+                             field="--step-until-near-chatter")
+        offset["step_until_chatter"] = "near"
     if args.label_offset is not None:
         offset["label_offset"] = _pair(args.label_offset, "--label-offset", "MEAN,SD", (-0.2, 0.5), (0, 0.5))
     if args.label_growth is not None:
