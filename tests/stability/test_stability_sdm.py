@@ -202,6 +202,9 @@ def test_limit_near_for_many_models_finds_each_models_limit():
     assert two[1] == pytest.approx(2 * two[0], rel=1e-3)
     with pytest.raises(InputError, match="one row"):
         sdm_limit_near_many([(models[0], None, cut(0.05))], rpm=rpm, depth_m=guess)
+    with pytest.raises(InputError, match="one frequency per point") as exc:
+        sdm_limit_near(MODE, None, cut(0.05), rpm=rpm, depth_m=ref[0], chatter_hz=[900.0, 950.0])
+    assert exc.value.field == "chatter_hz"
 
 
 def test_old_loose_keywords_are_refused():

@@ -667,9 +667,18 @@ def sdm_limit_near(
     a0 = np.asarray(depth_m, float).reshape(-1)
     if r.shape != a0.shape or np.any(~np.isfinite(r) | (r <= 0)) or np.any(~np.isfinite(a0) | (a0 <= 0)):
         raise InputError("need as many finite guesses > 0 m as speeds > 0 rpm", field="rpm/depth_m")
-    fc = None if chatter_hz is None else np.broadcast_to(np.asarray(chatter_hz, float), r.shape)[None]
+    fc = None if chatter_hz is None else _per_point(chatter_hz, r.shape)[None]
     lim, ok = sdm_limit_near_many([(modes_x, modes_y, cutting)], rpm=r, depth_m=a0[None], chatter_hz=fc, **search)
     return lim[0], ok[0]
+
+
+def _per_point(chatter_hz, shape) -> np.ndarray:
+    """``chatter_hz`` (Hz) broadcast to the points' shape, or refused naming the field."""
+    try:
+        return np.broadcast_to(np.asarray(chatter_hz, float), shape)
+    except ValueError:
+        raise InputError(f"needs one frequency per point {shape} (or one for all), got shape "
+                         f"{np.shape(chatter_hz)}", field="chatter_hz") from None
 
 
 def _near_options(log_step: float = 0.2, max_steps: int = 5, bisections: int = 4, accuracy: float = 1.0):
@@ -777,7 +786,7 @@ def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, **search) -> tu
                 u, inv = np.unique(r[i, ok[i]], return_inverse=True)
                 fc[i, ok[i]] = _zoa_seed(sy, u, *_zoa_grid(sy)).chatter_hz[inv]
     else:
-        fc = np.broadcast_to(np.asarray(chatter_hz, float), a0.shape)
+        fc = _per_point(chatter_hz, a0.shape)
     limit, bracketed = np.full(a0.shape, np.nan), np.zeros(a0.shape, bool)
     mmax = int(round(M_MAX * max(acc, 1.0)))
     groups = {}
