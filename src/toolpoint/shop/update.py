@@ -1351,9 +1351,9 @@ def _sdm_ring_x(prior, theta, cuts, lr_c, f, ring_sd: float = RING_ERROR[0]):
 
 def _sdm_own_log_ratio(prior, z, u, f, lr_guess, zoa=None, near: dict | None = None):
     """ln(a_SDM / a_ZOA) of each sample (S, U) at the speeds u: its own SDM limit
-    (:func:`~toolpoint.stability.sdm_limit_near`, from its zero-order limit times e^lr_guess); 0 where no lobe
-    reaches the speed. ``zoa``: the samples' ``limit_at_speeds`` at u, when the caller has it. ``near``: options of
-    ``sdm_limit_near`` (its defaults otherwise)."""
+    (:func:`~toolpoint.stability.sdm_limit_near_many`: every sample's search in one call, from its zero-order limit
+    times e^lr_guess); 0 where no lobe reaches the speed. ``zoa``: the samples' ``limit_at_speeds`` at u, when the
+    caller has it. ``near``: search options of ``sdm_limit_near`` (its defaults otherwise)."""
     from ..stability import sdm_limit_near_many
 
     th = prior.theta(z)
