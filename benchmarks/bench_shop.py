@@ -1,7 +1,7 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands] [--shops zoa,noisy,sim]
+        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard] [--shops zoa,noisy,sim]
         [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
@@ -39,13 +39,19 @@ CPU time (time.process_time), not wall time: the machine is shared.
    share of speeds where the truth lies in the band (≈ 0.90 when calibrated) and the share of truths for which it
    is ≥ 0.90 — the most a campaign's coverage test can pass at one update when the posterior is exact (a
    posterior given the cuts holds a truth drawn from the prior like the prior holds it, on average over truths).
+   First the label offset's floor: the 5–95 % range of δ + min(G / (κ t), 0.5) under ``update``'s priors, for
+   growth rates κ and cut durations t — the narrowest band that heard labels bracketing the limit at one speed leave.
 5. ``sdm-bands``: the ``forward="sdm"`` band against the truth's own SDM limit at a cut speed and at a random
    speed (Cornelius σ 0.12, 40 truths, three cuts each, lobe grids of 41 and 21 speeds).
+6. ``heard``: what decides whether the whole loop's shop hears a cut past the limit as chatter — the label against
+   the zero-order κ x, the SDM's secant κ x and the SDM's own growth at the cut's depth, each times the cut's duration,
+   fitted as P(heard) = Φ((ln(g t) − ln G) / s) (truths from the prior, cuts 0–25 % past the SDM limit, 0.9–4 s).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import platform
 import sys
@@ -602,6 +608,24 @@ def bench_ceiling(cases, library_prior=None):
 
         out, tool = library_prior.rsplit(":", 1)
         priors["library"] = prior_from_library(out, tool)
+    # the label offset's own floor: however the cuts bracket the heard boundary at one speed, the limit lies the
+    # offset δ + min(G / (κ t), 0.5) below it (update's label_offset and label_growth priors), so the band there is
+    # at least as wide as that offset's 5–95 % range
+    import inspect
+
+    from toolpoint.shop.update import _GROWTH_CAP, update
+
+    dflt = inspect.signature(update).parameters
+    (mu, sd), (g_med, g_sd) = dflt["label_offset"].default, dflt["label_growth"].default
+    rng = np.random.default_rng(0)
+    d = mu + sd * rng.standard_normal(200_000)
+    gg = g_med * np.exp(g_sd * rng.standard_normal(200_000))
+    print(f"label offset δ ~ N({mu}, {sd}²), ln G ~ N(ln {g_med}, {g_sd}²): the 5–95 % width (ln) of "
+          "δ + min(G / (κ t), 0.5), the narrowest band a bracket of heard labels at one speed leaves")
+    for kap in (25.0, 30.0, 40.0, 100.0, 500.0):
+        w = [np.subtract(*np.quantile(d + np.minimum(gg / (kap * t), _GROWTH_CAP), [0.95, 0.05]))
+             for t in (0.85, 2.0, 3.0, 5.0)]
+        print(f"   κ {kap:5.0f} /s: cuts of 0.85 / 2 / 3 / 5 s: " + " / ".join(f"{v:.3f}" for v in w), flush=True)
     for case in cases:
         pr = priors[case]
         f, g = pr.freq_grid(), _default_grid(pr)
@@ -614,6 +638,82 @@ def bench_ceiling(cases, library_prior=None):
             print(f"{pr.name[:40]:40s} band of {m:4d} samples: mean coverage {cov.mean():.3f}, truths with "
                   f"coverage ≥ 0.90: {(cov >= 0.9).mean():.3f}, coverage 10/25/50 % "
                   f"{np.round(np.quantile(cov, [0.1, 0.25, 0.5]), 2).tolist()}", flush=True)
+
+
+def bench_heard(cases, library_prior=None, truths=12, seed_start=60):
+    """What decides whether the whole loop's shop hears a cut past the limit as chatter: the label against three
+    measures of how much chatter grew within the cut, ln(g t) — the zero-order κ times x = ln(a / a_SDM) (what
+    ``update``'s label growth G / (κ t) assumes), the SDM's secant κ_SDM = ln ρ(1.05 a_SDM) / (T ln 1.05) times x, and
+    the SDM's own growth at the cut's depth σ = ln ρ(a) / T (ρ the spectral radius per tooth period T) —, each fitted
+    by P(heard) = ε + (1 − 2ε) Φ((ln(g t) − ln G) / s), ε = 0.01 (maximum likelihood). Truths from the prior, three
+    speeds each in the upper half of its speed range, x ~ U(0, 0.25), the cut 250 revolutions, 2 s or 4 s long."""
+    from scipy.optimize import minimize
+    from scipy.special import log_ndtr
+
+    from toolpoint.shop.model import growth_rate
+    from toolpoint.stability import sdm_spectral_radius
+
+    print(f"\n## heard: chatter heard against its growth within the cut ({truths} truths per case, 3 cuts each)")
+    priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
+    if library_prior:
+        from toolpoint.shop.prior import prior_from_library
+
+        out, tool = library_prior.rsplit(":", 1)
+        priors["library"] = prior_from_library(out, tool)
+    for case in cases:
+        pr = priors[case]
+        shop, truth = simulated_shop(pr, record=SENSORS["microphone"]), sdm_limit(pr)
+        lo, hi = pr.rpm_range if pr.rpm_range is not None else (5000.0, 25000.0)
+        rows = []
+        c0 = time.process_time()
+        for seed in range(seed_start, seed_start + truths):
+            rng = np.random.default_rng(seed)
+            th = pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None, :])[0]
+            rpm = np.sort(rng.uniform(lo + 0.5 * (hi - lo), hi, 3))
+            a_s = np.ravel(truth(th, rpm))
+            _, fc = limit_at_speeds(pr, th[None, :], rpm)
+            kz = growth_rate(pr, th[None, :], rpm, fc)[0]
+            mm, cut = pr.tool(th)
+            period = 60.0 / (rpm * cut.teeth)
+            for i in np.flatnonzero(np.isfinite(a_s) & (a_s > 0)):
+                x = rng.uniform(0.0, 0.25)
+                dur = [None, 2.0, 4.0][rng.integers(3)]
+                c = shop(th, rpm[i], a_s[i] * math.exp(x), rng, dur)
+                r05, r_a = (float(np.ravel(sdm_spectral_radius(mm, mm, cut, rpm=[rpm[i]], depth=[d]))[0])
+                            for d in (a_s[i] * 1.05, c.depth_m))
+                # the chatter frequency read against the zero-order limiting lobe's and its tooth-passing aliases
+                alias = fc[0, i] + cut.teeth * rpm[i] / 60.0 * np.arange(-2, 3)
+                far = (float(np.min(np.abs(c.chatter_hz - alias))) / c.chatter_hz
+                       if not c.stable and c.chatter_hz is not None else np.nan)
+                rows.append((x, kz[i] * x, math.log(r05) / (period[i] * math.log(1.05)) * x,
+                             math.log(r_a) / period[i], c.duration_s, not c.stable, far))
+        R = np.array(rows, float)
+        t, heard = R[:, 4], R[:, 5].astype(bool)
+        ratio = R[:, 2] / R[:, 1]  # the SDM's secant κ over the zero-order κ at each cut
+        print(f"{pr.name[:40]}: {len(R)} cuts 0–25 % past the SDM limit, {heard.sum()} heard as chatter; "
+              f"κ_SDM / κ_ZOA at the cuts median {np.median(ratio):.2f}, 5–95 % "
+              f"{np.quantile(ratio, 0.05):.2f}–{np.quantile(ratio, 0.95):.2f}, below 0.8 for "
+              f"{np.mean(ratio < 0.8):.2f}, above 1.25 for {np.mean(ratio > 1.25):.2f}; "
+              f"{time.process_time() - c0:.0f} s CPU", flush=True)
+        far = R[np.isfinite(R[:, 6]), 6]
+        print(f"   chatter frequency against the zero-order lobe's (nearest of f_c + j f_t, |j| ≤ 2), {far.size} "
+              f"readings: within 0.5 % {np.sum(far <= 0.005)}, 2 % {np.sum(far <= 0.02)}, more than 10 % off "
+              f"{np.sum(far > 0.1)}", flush=True)
+        for name, col in (("zero-order κ x", 1), ("SDM secant κ x", 2), ("SDM σ at the depth", 3)):
+            g = R[:, col] * t
+            lg = np.log(np.where(g > 0, g, 1e-9))
+
+            def nll(p, lg=lg):
+                pc = 0.01 + 0.98 * np.exp(log_ndtr((lg - p[0]) / math.exp(p[1])))
+                return -np.sum(np.where(heard, np.log(pc), np.log1p(-pc)))
+
+            best = min((minimize(nll, [g0, math.log(0.5)], method="Nelder-Mead") for g0 in (0.0, 1.0, 2.0)),
+                       key=lambda r: r.fun)
+            print(f"   {name:20s}: G~ {math.exp(best.x[0]):.2f}, s {math.exp(best.x[1]):.2f}, −ln L {best.fun:.2f}; "
+                  + "  ".join(f"{lab} " + (" ".join(f"{v:.1f}{'C' if h else 's'}" for v, h in
+                                                   sorted(zip(g[m], heard[m]))) or "-")
+                              for lab, m in (("≤1 s:", t <= 1.5), ("2 s:", (t > 1.5) & (t <= 3)), ("4 s:", t > 3))),
+                  flush=True)
 
 
 def bench_sdm_bands(truths=40, grids=(41, 21), update_kw=None):
@@ -656,7 +756,7 @@ def main():
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", choices=("cut", "teeth", "twocut", "inside", "update", "sampler", "forward", "ceiling",
-                                       "sdm-bands"))
+                                       "sdm-bands", "heard"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -712,6 +812,8 @@ def main():
         bench_forward()
     if a.only in (None, "ceiling"):
         bench_ceiling(a.cases.split(","), a.library_prior)
+    if a.only in (None, "heard"):
+        bench_heard(a.cases.split(","), a.library_prior, 4 if a.quick else 12)
     if a.only in (None, "sampler"):
         bench_sampler()
     if a.only in (None, "sdm-bands"):

@@ -307,6 +307,31 @@ def test_a_missed_chatter_rate_weakens_stable_labels_only():
         update(pr, cut, rng=np.random.default_rng(0), forward="zoa", n_samples=50, miss_rate=1.0)
 
 
+def test_a_chatter_frequency_read_anywhere_says_nothing():
+    """``freq_outlier`` = 1: every frequency is an outlier, so a chattering cut's frequency adds a constant to every
+    sample's log-likelihood and the posterior is the one without it (the same draws: tempering sees only the
+    differences); with the default share 0.05 a frequency on one sample's lobe and far from another's favours the
+    first."""
+    pr = cornelius_2024(0.1)
+    rpm = 12000.0
+    z = np.zeros((2, pr.sigma.size))
+    z[1, :pr.modes] = 2.5  # the second sample's modes ~28 % higher: its lobes' frequencies far from the first's
+    th = pr.theta(z)
+    a0, fc = limit_at_speeds(pr, th[:1], [rpm])
+    a, f = float(a0[0, 0]), float(fc[0, 0])
+    with_f, without = [TestCut(rpm, 1.2 * a, False, f)], [TestCut(rpm, 1.2 * a, False)]
+    d = log_likelihood(pr, th, with_f, freq_outlier=1.0) - log_likelihood(pr, th, without)
+    assert d[0] == pytest.approx(d[1]) and d[0] == pytest.approx(-math.log(f))
+    d5 = log_likelihood(pr, th, with_f, freq_outlier=0.05) - log_likelihood(pr, th, without)
+    assert d5[0] > d5[1] + 2.0
+    kw = dict(forward="zoa", n_samples=300, lobe_samples=100, rpm_grid=[rpm])
+    q1 = update(pr, with_f, rng=np.random.default_rng(3), freq_outlier=1.0, **kw).limit_q_m
+    q0 = update(pr, without, rng=np.random.default_rng(3), **kw).limit_q_m
+    np.testing.assert_allclose(q1, q0, rtol=1e-9)
+    for field, bad in (("freq_outlier", 0.0), ("freq_outlier", 1.5), ("freq_sigma", 0.0)):
+        with pytest.raises(InputError, match=field):
+            update(pr, with_f, rng=np.random.default_rng(0), **{field: bad}, **kw)
+
 def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):
     p = tmp_path / "cuts.csv"
     p.write_text("rpm,depth_mm,result\n12000,1.0,stable\n12000,0.5,chatter\n15000,0.4,stable\n")
