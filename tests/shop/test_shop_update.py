@@ -332,6 +332,48 @@ def test_a_chatter_frequency_read_anywhere_says_nothing():
         with pytest.raises(InputError, match=field):
             update(pr, with_f, rng=np.random.default_rng(0), **{field: bad}, **kw)
 
+def test_the_label_growth_read_from_each_samples_own_sdm():
+    """``growth_by="sdm"``: each lobe sample's κ at a cut is the secant ln ρ(a) / (T ln(a / a_SDM)) from its own
+    SDM limit to the cut's depth — checked against ``sdm_spectral_radius`` and ``sdm_limits`` of the same
+    sample —; in the likelihood a slower κ moves the heard boundary further above the limit (a stable label 5 %
+    past it is likelier), a NaN κ leaves the zero-order one; ``update`` refuses another value, or ``"sdm"`` without the
+    own SDM searches, naming the field."""
+    from toolpoint.shop.update import _sdm_own_log_ratio
+    from toolpoint.stability import sdm_spectral_radius
+
+    pr = cornelius_2024(0.1)
+    z = np.random.default_rng(4).standard_normal((3, pr.sigma.size))
+    th = pr.theta(z)
+    u = np.array([12000.0, 15000.0])
+    a_z = limit_at_speeds(pr, th, u)[0]
+    cuts = [TestCut(12000.0, 1.1 * a_z[0, 0], False), TestCut(12000.0, 0.7 * a_z[0, 0], True),
+            TestCut(15000.0, 1.01 * a_z[0, 1], True)]
+    lr, kap = _sdm_own_log_ratio(pr, z, u, pr.freq_grid(), np.zeros(2), near=dict(bisections=6), cuts=cuts)
+    assert kap.shape == (3, 3) and np.isfinite(kap).all() and (kap > 0).all()
+    checked = 0
+    for i in range(3):
+        mm, c = pr.tool(th[i])
+        own = a_z[i] * np.exp(lr[i])
+        for k in range(2):  # the own limit: stable 1 % below, chatter 1 % above (the SDM itself)
+            lo, hi = (float(np.ravel(sdm_spectral_radius(mm, mm, c, rpm=[u[k]], depth=[own[k] * e]))[0])
+                      for e in (0.99, 1.01))
+            assert lo < 1 < hi
+        for j, cut in enumerate(cuts[:2]):  # far enough from the limit for the secant
+            k = int(np.searchsorted(u, cut.rpm))
+            x = math.log(cut.depth_m / own[k])
+            if abs(x) >= 0.03:
+                rho = float(np.ravel(sdm_spectral_radius(mm, mm, c, rpm=[cut.rpm], depth=[cut.depth_m]))[0])
+                assert kap[i, j] == pytest.approx(math.log(rho) / (60.0 / (c.teeth * cut.rpm) * x), rel=0.05)
+                checked += 1
+    assert checked >= 4
+    one = [TestCut(12000.0, 1.05 * a_z[0, 0], True)]
+    kw = dict(label_offset=0.0, label_growth=2.5)
+    slow, fast, none = (log_likelihood(pr, th[:1], one, kappa=np.array([[k]]), **kw) for k in (20.0, 2000.0, np.nan))
+    assert slow[0] > fast[0] and none[0] == pytest.approx(log_likelihood(pr, th[:1], one, **kw)[0])
+    for bad in (dict(growth_by="time"), dict(growth_by="sdm", forward="zoa"), dict(growth_by="sdm", own_sdm=False)):
+        with pytest.raises(InputError, match="growth_by"):
+            update(pr, one, rng=np.random.default_rng(0), **bad)
+
 def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):
     p = tmp_path / "cuts.csv"
     p.write_text("rpm,depth_mm,result\n12000,1.0,stable\n12000,0.5,chatter\n15000,0.4,stable\n")

@@ -207,6 +207,34 @@ def test_limit_near_for_many_models_finds_each_models_limit():
     assert exc.value.field == "chatter_hz"
 
 
+def test_limit_near_for_many_models_says_how_fast_chatter_grows():
+    """``extras``: ρ at asked depths is ``sdm_spectral_radius``'s for each model (the stacked evaluation against the
+    one-model path), and the growth rate just past each limit is the central difference of ln ρ / T over ±0.5 % of
+    it (T the tooth period) within 3 %, the same for a model twice as stiff (the same dynamics at twice the depth)."""
+    rpm = np.array([6000.0, 10000.0])
+    stiff = ModalModel([922.0], [0.011], [2 * 0.03993])
+    tools = [(MODE, None, cut(0.05)), (stiff, None, cut(0.05))]
+    ref = sdm_lobes(MODE, None, cut(0.05), rpm=rpm, rtol=1e-5).depth_m
+    at = np.stack([np.stack([ref * 0.8, ref * 1.2], axis=1), np.stack([ref * 1.6, np.full(2, np.nan)], axis=1)])
+    lim, ok, ex = sdm_limit_near_many(tools, rpm=rpm, depth_m=np.array([ref, 2 * ref]), bisections=4,
+                                      rho_at=at, extras=True)
+    assert ok.all()
+    for i, (mm, _, c) in enumerate(tools):
+        for k in range(2):
+            for j in range(2):
+                if np.isfinite(at[i, k, j]):
+                    want = float(np.ravel(sdm_spectral_radius(mm, None, c, rpm=[rpm[k]], depth=[at[i, k, j]]))[0])
+                    assert ex["rho_at"][i, k, j] == pytest.approx(want, rel=1e-9)
+                else:
+                    assert np.isnan(ex["rho_at"][i, k, j])
+            lo, hi = (float(np.ravel(sdm_spectral_radius(mm, None, c, rpm=[rpm[k]], depth=[lim[i, k] * e]))[0])
+                      for e in (np.exp(-0.005), np.exp(0.005)))
+            fd = (np.log(hi) - np.log(lo)) / 0.01 / (60.0 / (2 * rpm[k]))
+            assert ex["growth_per_s"][i, k] == pytest.approx(fd, rel=0.03)
+    assert ex["growth_per_s"][1] == pytest.approx(ex["growth_per_s"][0], rel=0.03)
+    with pytest.raises(InputError, match="rho_at"):
+        sdm_limit_near_many(tools, rpm=rpm, depth_m=np.array([ref, 2 * ref]), rho_at=at[:, :1], extras=True)
+
 def test_old_loose_keywords_are_refused():
     with pytest.raises(TypeError, match="teeth"):
         sdm_lobes(MODE, None, teeth=2, kt=6e8, kr=1 / 3, radial_immersion=0.05, rpm=[9000.0], m=20)

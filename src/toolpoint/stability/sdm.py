@@ -723,10 +723,13 @@ def _near(rho, a0, log_step, max_steps, bisections):
     with np.errstate(divide="ignore", invalid="ignore"):
         t = np.clip((1 - s_r) / (c_r - s_r), 0.0, 1.0)
     est = np.where(bracketed, s_x + np.where(np.isfinite(t), t, 0.5) * (c_x - s_x), hi_x)
-    return np.exp(est), bracketed
+    with np.errstate(divide="ignore", invalid="ignore"):  # d ln ρ / d ln a across the last bracket
+        slope = np.where(bracketed & (s_r > 0) & (c_r > 0), (np.log(c_r) - np.log(s_r)) / (c_x - s_x), np.nan)
+    return np.exp(est), bracketed, slope
 
 
-def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, **search) -> tuple[np.ndarray, np.ndarray]:
+def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, rho_at=None, extras: bool = False,
+                        **search) -> tuple:
     """:func:`sdm_limit_near` for many models at once (e.g. samples of a prior), each at its own guesses.
 
     Each model's search is that of :func:`sdm_limit_near` over its valid points (its own discretisation, from
@@ -746,6 +749,13 @@ def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, **search) -> tu
         The guesses, m; points whose guess is not finite and > 0 are skipped.
     chatter_hz : array_like, shape (K, U), optional
         Zero-order chatter frequencies, Hz (default: each model's zero-order method at its speeds).
+    rho_at : array_like, shape (K, U, J), optional
+        Depths, m, at which each point's spectral radius per tooth period is also wanted (NaN: none); with
+        ``extras``.
+    extras : bool, default False
+        Also return a dict: ``"growth_per_s"`` (K, U), how fast chatter grows just past each limit, κ = d ln ρ /
+        d ln a / T (1/s, T the tooth period; the slope across the search's last bracket, NaN where unbracketed),
+        and ``"rho_at"`` (K, U, J), ρ at ``rho_at``'s depths (None without them).
     **search
         ``log_step``, ``max_steps``, ``bisections``, ``accuracy``: as :func:`sdm_limit_near`.
 
@@ -755,6 +765,8 @@ def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, **search) -> tu
         Estimated limits, m (NaN at skipped points).
     bracketed : ndarray of bool, shape (K, U)
         ``False`` where no verdict change was found within the steps, and at skipped points.
+    extras : dict
+        With ``extras=True`` only (above).
 
     Examples
     --------
@@ -788,6 +800,11 @@ def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, **search) -> tu
     else:
         fc = _per_point(chatter_hz, a0.shape)
     limit, bracketed = np.full(a0.shape, np.nan), np.zeros(a0.shape, bool)
+    slope = np.full(a0.shape, np.nan)
+    at = None if rho_at is None else np.asarray(rho_at, float)
+    if at is not None and (at.ndim != 3 or at.shape[:2] != a0.shape):
+        raise InputError(f"need shape ({a0.shape[0]}, {a0.shape[1]}, J), got {at.shape}", field="rho_at")
+    rho_at = None if at is None else np.full(at.shape, np.nan)
     mmax = int(round(M_MAX * max(acc, 1.0)))
     groups = {}
     for i, sy in enumerate(systems):  # models the discretisation can stack
@@ -811,8 +828,18 @@ def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, **search) -> tu
         def rho(idx, x, st=st, kk=kk, rp=rp, mm=mm, ss=ss):  # ρ at points idx, depths e^x
             return st.multipliers(kk[idx], rp[idx], np.exp(x), mm[idx], ss[idx])[0]
 
-        limit[rows, jj], bracketed[rows, jj] = _near(rho, a0[rows, jj], log_step, max_steps, bisections)
-    return limit, bracketed
+        limit[rows, jj], bracketed[rows, jj], slope[rows, jj] = _near(rho, a0[rows, jj], log_step, max_steps,
+                                                                      bisections)
+        if at is not None:  # ρ at the asked depths of each point, all of them in one call
+            jj_at = np.nonzero(np.isfinite(at[rows, jj]) & (at[rows, jj] > 0))
+            if jj_at[0].size:
+                p, q = jj_at
+                rho_at[rows[p], jj[p], q] = rho(p, np.log(at[rows[p], jj[p], q]))
+    if not extras:
+        return limit, bracketed
+    with np.errstate(divide="ignore", invalid="ignore"):
+        growth = slope * np.array([sy.teeth for sy in systems], float)[:, None] * r / 60.0  # per tooth period → /s
+    return limit, bracketed, {"growth_per_s": growth, "rho_at": rho_at}
 
 
 def _zoa_minimum(sysm: _System, freq_hz: np.ndarray, phi: np.ndarray) -> float:
