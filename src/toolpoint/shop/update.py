@@ -708,10 +708,11 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         Metropolis moves per tempering step.
     boundary_width, label_noise, freq_sigma, freq_outlier
         The likelihood's w, ε, σ_f and ε_f (the share of chatter frequencies read anywhere; 1: the frequency says
-        nothing). Measured on EM12-60's whole loop (2026-11-30; ``docs/design/shop.md``, *The chatter frequency
-        against the zero-order lobe's*): a quarter of the chattering cuts' frequencies lay more than 2 % from the
-        zero-order limiting lobe's and its aliases (the SDM's limiting lobe was another mode), and σ_f = 0.005 with
-        ε_f = 0.25 converged no more often than the defaults.
+        nothing). Measured (2026-11-30; ``docs/design/shop.md``, *Tried, not adopted: a sharper chatter-frequency
+        term*): 26 of 32 chattering cuts' frequencies on EM12-60 and on EM16-50 lay within 0.5 % of the zero-order
+        limiting lobe's or an alias, 5 and 4 more than 2 % off (the SDM's chatter on another mode;
+        ``benchmarks/bench_shop.py --only heard``); in EM12-60's whole loop σ_f = 0.005 with ε_f = 0.25 converged
+        no more often than the defaults.
     rule : {"info", "risk"}, default "info"
         How the next test cut is chosen (module docstring).
     risk : float, optional
