@@ -802,6 +802,8 @@ def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, rho_at=None, ex
     limit, bracketed = np.full(a0.shape, np.nan), np.zeros(a0.shape, bool)
     slope = np.full(a0.shape, np.nan)
     at = None if rho_at is None else np.asarray(rho_at, float)
+    if at is not None and not extras:  # its radii would be computed and dropped
+        raise InputError("rho_at needs extras=True (the radii are returned in the extras)", field="rho_at")
     if at is not None and (at.ndim != 3 or at.shape[:2] != a0.shape):
         raise InputError(f"need shape ({a0.shape[0]}, {a0.shape[1]}, J), got {at.shape}", field="rho_at")
     rho_at = None if at is None else np.full(at.shape, np.nan)
