@@ -374,6 +374,48 @@ def test_the_label_growth_read_from_each_samples_own_sdm():
         with pytest.raises(InputError, match="growth_by"):
             update(pr, one, rng=np.random.default_rng(0), **bad)
 
+def test_the_sampling_reads_the_label_growth_from_the_references_sdm():
+    """``growth_by="sdm"`` in the sampling: the references' κ at each cut is G / (t x_b), x_b where their SDM growth
+    ln ρ / T first reaches G / t — checked against ``sdm_spectral_radius`` at the SDM limit bisected on it directly;
+    with one reference the ratio is that reference's own. ``update`` then runs through with it."""
+    from toolpoint.shop.model import growth_rate
+    from toolpoint.shop.update import _sdm_kappa_log_ratio, _sdm_log_ratio
+    from toolpoint.stability import sdm_spectral_radius
+
+    pr = cornelius_2024(0.1)
+    f = pr.freq_grid()
+    th = pr.theta(np.random.default_rng(4).standard_normal((2, pr.sigma.size)))
+    u = np.array([9000.0, 12000.0, 15000.0])
+    g, t = 2.5, 0.1  # G / t = 25 /s: heard ≈ 0.1 past the limit on κ ≈ 300 /s
+    checked = 0
+    for i in range(2):
+        one = th[i:i + 1]
+        a_z, fc = limit_at_speeds(pr, one, u, f)
+        cuts = [TestCut(r, a_z[0, k], True, duration_s=t) for k, r in enumerate(u)]
+        lr_c = _sdm_log_ratio(pr, one, u, np.array([10000.0]), f)[0]
+        klr, x_sd = _sdm_kappa_log_ratio(pr, one, cuts, lr_c, f, g, 1.0)
+        assert np.all(x_sd == 0.0)  # one reference: no spread
+        kz = growth_rate(pr, one, u, fc)[0]
+        mm, c = pr.tool(one[0])
+        for k in range(u.size):
+            assert np.isfinite(klr[k])
+            rho = lambda a: float(np.ravel(sdm_spectral_radius(mm, mm, c, rpm=[u[k]], depth=[a]))[0])  # noqa: E731
+            lo, hi = 0.5 * a_z[0, k], 2.0 * a_z[0, k]
+            assert rho(lo) < 1 < rho(hi)
+            for _ in range(40):  # the SDM limit, bisected on ρ itself
+                mid = math.sqrt(lo * hi)
+                lo, hi = (mid, hi) if rho(mid) < 1 else (lo, mid)
+            x_b = min(g / (t * kz[k] * math.exp(klr[k])), 0.5)
+            sigma = math.log(rho(lo * math.exp(x_b))) * c.teeth * u[k] / 60.0
+            assert sigma == pytest.approx(g / t, rel=0.1)
+            checked += 1
+    assert checked == 6
+    post = update(pr, [TestCut(12000.0, 1.2 * a_z[0, 1], False, duration_s=0.5),
+                       TestCut(12000.0, 0.8 * a_z[0, 1], True, duration_s=0.5)],
+                  rng=np.random.default_rng(1), n_samples=200, lobe_samples=80, sdm_refs=2, growth_by="sdm")
+    assert np.isfinite(post.recommended["depth_m"])
+
+
 def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):
     p = tmp_path / "cuts.csv"
     p.write_text("rpm,depth_mm,result\n12000,1.0,stable\n12000,0.5,chatter\n15000,0.4,stable\n")

@@ -394,7 +394,8 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
                    freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None,
                    miss_rate: float = 0.0, label_offset=0.0, label_growth=0.0,
                    cut_duration_s: float = 1.0, growth_error=None, growth_x=None, ring_x=None,
-                   ring_outlier: float = RING_ERROR[1], precursor=None, kappa=None) -> np.ndarray:
+                   ring_outlier: float = RING_ERROR[1], precursor=None, kappa=None,
+                   kappa_log_ratio=None) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
     ``log_ratio`` (per cut, optional): ln of a factor on the zero-order limit at the cut's speed (the SDM
@@ -404,7 +405,9 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     sample, (S,)): the labels' boundary is a_lim e^δ — chatter is heard only δ (ln) above the limit.
     ``label_growth`` G (scalar or (S,)): the boundary moves up by a further min(G / (κ t), 0.5) per cut, κ the
     sample's chatter growth rate at the cut (:func:`~toolpoint.shop.model.growth_rate`), t the cut's
-    ``duration_s`` (else ``cut_duration_s``): chatter is heard once it has grown by e^G. ``growth_error`` (b, s₊,
+    ``duration_s`` (else ``cut_duration_s``): chatter is heard once it has grown by e^G; ``kappa_log_ratio`` (C,)
+    multiplies κ by e^r (the SDM's growth at the references, :func:`update`'s ``growth_by="sdm"``), ``kappa`` (S, C)
+    replaces it where finite (each sample's own SDM growth). ``growth_error`` (b, s₊,
     s₋, o), None to leave it out: each chattering cut's measured growth σ_m (``TestCut.growth_per_s``) as a distance
     past the limit, x_m = σ_m / (b κ) (κ the sample's :func:`~toolpoint.shop.model.growth_rate`), against the
     sample's x = ln(a / a_lim) (a_lim with ``log_ratio``'s correction): x_m − x split-normal with sd
@@ -434,7 +437,7 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     g = np.reshape(np.asarray(label_growth, float), (-1, 1))
     if np.any(g > 0):
         dur = np.array([cut_duration_s if c.duration_s is None else c.duration_s for c in cuts], float)
-        offset = offset + growth_offset(prior, theta, rpm, f_c, g, dur, kappa)
+        offset = offset + growth_offset(prior, theta, rpm, f_c, g, dur, kappa, kappa_log_ratio)
     with np.errstate(divide="ignore"):
         x = (np.log(a_lim) + lr + offset - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
     x = np.where(np.isfinite(x), x, 50.0)  # no lobe reaches the speed: stable at any depth in the grid
@@ -544,12 +547,17 @@ _GROWTH_LR_MAX = 0.1  # |ln(a_SDM / a_ZOA)| at a cut beyond which its growth rat
 _GROWTH_CAP = 0.5  # ln: a chatter that cannot grow audibly within the cut leaves the label uninformative, not wild
 
 
-def growth_offset(prior: ModalPrior, theta, rpm, chatter_hz, growth, duration_s, kappa=None) -> np.ndarray:
+def growth_offset(prior: ModalPrior, theta, rpm, chatter_hz, growth, duration_s, kappa=None,
+                  kappa_log_ratio=None) -> np.ndarray:
     """min(G / (κ t), 0.5): how far (ln) above the limit a chatter that must grow by e^G within t seconds is heard,
-    κ the growth rate (:func:`~toolpoint.shop.model.growth_rate`) of each sample (S, R), or ``kappa`` (S, R) where
-    that is finite (the SDM's); 0.5 where κ ≤ 0, 0 where no lobe reaches the speed (the sample is stable there
-    anyway)."""
+    κ the growth rate (:func:`~toolpoint.shop.model.growth_rate`) of each sample (S, R) times e^``kappa_log_ratio``
+    (R,) where that is finite (the references' SDM/ZOA growth ratio, :func:`_sdm_kappa_log_ratio`), or ``kappa``
+    (S, R) where that is finite (the sample's own SDM growth); 0.5 where κ ≤ 0, 0 where no lobe reaches the speed
+    (the sample is stable there anyway)."""
     kap = growth_rate(prior, theta, rpm, chatter_hz)
+    if kappa_log_ratio is not None:
+        klr = np.asarray(kappa_log_ratio, float)[None, :]
+        kap = kap * np.exp(np.where(np.isfinite(klr), klr, 0.0))
     if kappa is not None:
         kappa = np.asarray(kappa, float)
         kap = np.where(np.isfinite(kappa), kappa, kap)
@@ -880,15 +888,19 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         Measured in the whole loop: ``docs/design/shop.md`` (*Own SDM limits at the cut speeds*). False: as before
         2026-11-30.
     growth_by : {"zoa", "sdm"}, default "zoa"
-        With ``own_sdm``: the κ of the label growth G / (κ t) in the lobe samples' weights. ``"zoa"``: the
-        zero-order lobe's (:func:`~toolpoint.shop.model.growth_rate`), as in the sampling. ``"sdm"``: each lobe
-        sample's own SDM growth at each cut, the secant ln ρ(a) / (T ln(a / a_SDM)) from its own limit to the cut's
-        depth (the search's slope within 2 % of the limit) — the heard labels follow the SDM's growth where the
-        zero-order lobe is not the SDM's (``benchmarks/bench_shop.py --only heard``; ``docs/design/shop.md``,
-        *Chatter past the limit is heard by the SDM's own growth*). One more spectral radius per lobe sample and
-        cut. Needs ``forward="sdm"`` and ``own_sdm``. Measured (EM12-60, truths 40–59, whole loop): as many
-        campaigns converged (8 of 20) and the recommended depth lay above the truth after 17 of 120 updates against
-        10 — the sampling still explains the cuts with the zero-order κ —, so not the default.
+        The κ of the label growth G / (κ t). ``"zoa"``: the zero-order lobe's
+        (:func:`~toolpoint.shop.model.growth_rate`). ``"sdm"``: the SDM's growth, which the heard labels follow where
+        the zero-order lobe is not the SDM's (``benchmarks/bench_shop.py --only heard``; ``docs/design/shop.md``,
+        *Chatter past the limit is heard by the SDM's own growth*) — in the sampling after the SDM correction, each
+        sample's zero-order κ times the references' mean ratio κ_SDM / κ_ZOA at each cut, κ_SDM the secant to where
+        their SDM growth ln ρ / T reaches G̃ / t (:func:`_sdm_kappa_log_ratio`; the references' sd of that offset
+        added to the boundary width); in the own reweighting each lobe sample's own secant ln ρ(a) / (T ln(a /
+        a_SDM)) from its own limit to the cut's depth (the search's slope within 2 % of the limit). One SDM growth
+        curve per reference and cut, one more spectral radius per lobe sample and cut. Needs ``forward="sdm"`` and
+        ``own_sdm``. Measured in the whole loop (``docs/design/shop.md``, *The SDM's growth in the sampling too*):
+        EM12-60 truths 40–59 converged within 6 cuts for 10–11 of 20 against 8, but the recommended depth lay
+        above the truth after 15–22 of 120 updates against 10, and the band held the truth at 0.878–0.889 of the
+        speeds after 6 cuts against 0.933 — more often right, less often safe —, so not the default.
 
     Returns
     -------
@@ -1009,9 +1021,15 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                                                                   float(growth_error[0]))
             if ring_error is not None:
                 rx = _sdm_ring_x(prior, prior.theta(ref), cuts, lr_c, f, float(ring_error[0]))
-            ring_kw = {} if rx is None else dict(ring_x=rx[:2], ring_outlier=float(ring_error[1]))
+            sdm_kw = {} if rx is None else dict(ring_x=rx[:2], ring_outlier=float(ring_error[1]))
+            if growth_by == "sdm" and g_med > 0:
+                # the label growth's κ: the references' SDM growth; how far their heard offsets spread joins the
+                # boundary width, as their limits' spread does (a sample's own κ is not known in the sampling)
+                sdm_kw["kappa_log_ratio"], x_sd = _sdm_kappa_log_ratio(prior, prior.theta(ref), cuts, lr_c, f, g_med,
+                                                                       cut_duration_s)
+                spread = np.hypot(spread, x_sd)
             kw2 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + spread ** 2),
-                       log_ratio=lr_c.mean(axis=0), growth_error=growth_error, growth_x=gx, **ring_kw)
+                       log_ratio=lr_c.mean(axis=0), growth_error=growth_error, growth_x=gx, **sdm_kw)
             z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw2, method, n_moves, rng,
                         ess_hist, acc)
             log_ratio_grid = lr_g
@@ -1028,7 +1046,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 mean_u = lr_tr.mean(axis=0)
                 sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
                 kw3 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + sd_u[inv] ** 2),
-                           log_ratio=mean_u[inv], growth_error=growth_error, growth_x=gx, **ring_kw)
+                           log_ratio=mean_u[inv], growth_error=growth_error, growth_x=gx, **sdm_kw)
                 z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw3, method, n_moves,
                             rng, ess_hist, acc)
                 log_ratio_grid = lr_g + _carry(mean_u[None, :] - lr_ref_u, grid, u)
@@ -1279,6 +1297,45 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
             v = got[np.isfinite(got[:, j]), j]
             xm[r], xsd[r] = float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else 0.0
     return xm, xsd
+
+
+def _sdm_kappa_log_ratio(prior, theta, cuts, lr_c, f, growth: float, cut_duration_s: float):
+    """ln(κ_SDM / κ_ZOA) at each cut (C,), the mean over the reference samples (rows of ``theta``), and the
+    references' sd of the heard offset min(x_b, 0.5) there (C,; 0 with fewer than two readings): κ_ZOA the
+    reference's zero-order growth rate (:func:`~toolpoint.shop.model.growth_rate`), κ_SDM = (G / t) / x_b its SDM's
+    secant to the depth where chatter is first heard, x_b the x at which the reference's SDM growth σ(x) = ln ρ(a_SDM
+    e^x) / T (:func:`_sdm_curves`, over x ∈ [−0.06, 1], from its own zero crossing) reaches G / t, G ``growth`` (the
+    label growth's prior median), t the cut's duration (else ``cut_duration_s``): with it, a sample like the
+    reference hears chatter where the SDM says it has grown by e^G. Where σ does not reach G / t within x = 1, the
+    secant to x = 1 (the offset's cap is reached anyway); nan where no reference reads the cut (no SDM limit near
+    the search's, no zero-order growth), the zero-order κ is then used.
+
+    Why: at EM12-60's pockets and flip lobes another lobe limits and grows than the zero-order one, whose κ was
+    0.58–17× off the SDM's secant at a twentieth of the cuts each way; heard labels followed the SDM's growth
+    (``benchmarks/bench_shop.py --only heard``)."""
+    C = len(cuts)
+    rpm = np.array([c.rpm for c in cuts])
+    dur = np.array([cut_duration_s if c.duration_s is None else c.duration_s for c in cuts], float)
+    a_z, f_c = limit_at_speeds(prior, theta, rpm, f)  # (R, C)
+    a_s = a_z * np.exp(np.asarray(lr_c, float))
+    kz = growth_rate(prior, theta, rpm, f_c)
+    ft = prior.cutting.teeth * rpm / 60.0
+    level = growth / dur
+    got = np.full((theta.shape[0], C), np.nan)
+    xb = np.full((theta.shape[0], C), np.nan)
+    for i, t in enumerate(theta):
+        ok = np.isfinite(a_s[i]) & (a_s[i] > 0) & np.isfinite(kz[i]) & (kz[i] > 0)
+        for j, q in _sdm_curves(prior, t, rpm, a_s[i], ft, ok, _GROWTH_X):
+            if q[0] >= 0 or q[-1] <= 0:  # no SDM limit within the curve's span
+                continue
+            x0 = _cross(q, 0.0)
+            k_sdm = level[j] / (_cross(q, level[j]) - x0) if q[-1] >= level[j] else q[-1] / (_GROWTH_X[-1] - x0)
+            got[i, j] = math.log(k_sdm / kz[i, j])
+            xb[i, j] = min(level[j] / k_sdm, _GROWTH_CAP)
+    n = np.sum(np.isfinite(got), axis=0)
+    mean = np.where(n > 0, np.nansum(got, axis=0) / np.maximum(n, 1), np.nan)
+    sd = np.array([float(np.std(v[np.isfinite(v)], ddof=1)) if np.isfinite(v).sum() > 1 else 0.0 for v in xb.T])
+    return mean, sd
 
 
 def _ring_readable(c) -> bool:
