@@ -377,7 +377,8 @@ def test_the_label_growth_read_from_each_samples_own_sdm():
 def test_the_sampling_reads_the_label_growth_from_the_references_sdm():
     """``growth_by="sdm"`` in the sampling: the references' κ at each cut is G / (t x_b), x_b where their SDM growth
     ln ρ / T first reaches G / t — checked against ``sdm_spectral_radius`` at the SDM limit bisected on it directly;
-    with one reference the ratio is that reference's own. ``update`` then runs through with it."""
+    with one reference the ratio is that reference's own. With several, the labels' likelihood is the mean of each
+    reference's (a mixture), which differs from that of their mean ratio. ``update`` then runs through with it."""
     from toolpoint.shop.model import growth_rate
     from toolpoint.shop.update import _sdm_kappa_log_ratio, _sdm_log_ratio
     from toolpoint.stability import sdm_spectral_radius
@@ -393,8 +394,9 @@ def test_the_sampling_reads_the_label_growth_from_the_references_sdm():
         a_z, fc = limit_at_speeds(pr, one, u, f)
         cuts = [TestCut(r, a_z[0, k], True, duration_s=t) for k, r in enumerate(u)]
         lr_c = _sdm_log_ratio(pr, one, u, np.array([10000.0]), f)[0]
-        klr, x_sd = _sdm_kappa_log_ratio(pr, one, cuts, lr_c, f, g, 1.0)
-        assert np.all(x_sd == 0.0)  # one reference: no spread
+        klr = _sdm_kappa_log_ratio(pr, one, cuts, lr_c, f, g, 1.0)
+        assert klr.shape == (1, u.size)
+        klr = klr[0]
         kz = growth_rate(pr, one, u, fc)[0]
         mm, c = pr.tool(one[0])
         for k in range(u.size):
@@ -410,6 +412,15 @@ def test_the_sampling_reads_the_label_growth_from_the_references_sdm():
             assert sigma == pytest.approx(g / t, rel=0.1)
             checked += 1
     assert checked == 6
+    # two references of two kinds: the labels' likelihood is the mean of each one's, not that of their mean ratio
+    cuts = [TestCut(12000.0, 1.08 * a_z[0, 1], True, duration_s=0.85),
+            TestCut(15000.0, 1.3 * a_z[0, 2], False, duration_s=0.85)]
+    kinds = np.array([[-0.5, -0.5], [2.5, 2.5]])
+    kw = dict(label_offset=0.0, label_growth=2.5)
+    each = np.stack([log_likelihood(pr, th, cuts, kappa_log_ratio=k, **kw) for k in kinds])  # (2, S)
+    mixed = log_likelihood(pr, th, cuts, kappa_log_ratio=kinds, **kw)
+    np.testing.assert_allclose(mixed, np.log(np.exp(each).mean(axis=0)), rtol=1e-12)
+    assert not np.allclose(mixed, log_likelihood(pr, th, cuts, kappa_log_ratio=kinds.mean(axis=0), **kw))
     post = update(pr, [TestCut(12000.0, 1.2 * a_z[0, 1], False, duration_s=0.5),
                        TestCut(12000.0, 0.8 * a_z[0, 1], True, duration_s=0.5)],
                   rng=np.random.default_rng(1), n_samples=200, lobe_samples=80, sdm_refs=2, growth_by="sdm")

@@ -115,7 +115,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.special import log_ndtr
+from scipy.special import log_ndtr, logsumexp
 
 from ..errors import InputError
 from ..stability.zoa_batch import zoa_limits
@@ -406,8 +406,9 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     ``label_growth`` G (scalar or (S,)): the boundary moves up by a further min(G / (κ t), 0.5) per cut, κ the
     sample's chatter growth rate at the cut (:func:`~toolpoint.shop.model.growth_rate`), t the cut's
     ``duration_s`` (else ``cut_duration_s``): chatter is heard once it has grown by e^G; ``kappa_log_ratio`` (C,)
-    multiplies κ by e^r (the SDM's growth at the references, :func:`update`'s ``growth_by="sdm"``), ``kappa`` (S, C)
-    replaces it where finite (each sample's own SDM growth). ``growth_error`` (b, s₊,
+    multiplies κ by e^r, or (Q, C) by each of Q references' e^r (:func:`update`'s ``growth_by="sdm"``: the SDM's
+    growth at the references), the labels' likelihood then the mean over the references of each one's product over
+    the cuts; ``kappa`` (S, C) replaces κ where finite (each sample's own SDM growth). ``growth_error`` (b, s₊,
     s₋, o), None to leave it out: each chattering cut's measured growth σ_m (``TestCut.growth_per_s``) as a distance
     past the limit, x_m = σ_m / (b κ) (κ the sample's :func:`~toolpoint.shop.model.growth_rate`), against the
     sample's x = ln(a / a_lim) (a_lim with ``log_ratio``'s correction): x_m − x split-normal with sd
@@ -433,13 +434,16 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     a_lim, f_c = limit_at_speeds(prior, theta, rpm, freq_hz)
     # one factor per cut (C,), or per sample and cut (S, C): each sample's own SDM limit (update's own_sdm)
     lr = np.zeros((1, len(cuts))) if log_ratio is None else np.atleast_2d(np.asarray(log_ratio, float))
-    offset = np.reshape(np.asarray(label_offset, float), (-1, 1))
+    # kappa_log_ratio (Q, C): the labels' likelihood a mixture over Q references' growth, one axis more (S, Q, C)
     g = np.reshape(np.asarray(label_growth, float), (-1, 1))
+    mix = kappa_log_ratio is not None and np.ndim(kappa_log_ratio) == 2 and np.any(g > 0)
+    ex = (lambda v: v[:, None, :]) if mix else (lambda v: v)  # noqa: E731
+    offset = np.reshape(np.asarray(label_offset, float), (-1, 1, 1) if mix else (-1, 1))
     if np.any(g > 0):
         dur = np.array([cut_duration_s if c.duration_s is None else c.duration_s for c in cuts], float)
         offset = offset + growth_offset(prior, theta, rpm, f_c, g, dur, kappa, kappa_log_ratio)
     with np.errstate(divide="ignore"):
-        x = (np.log(a_lim) + lr + offset - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
+        x = (ex(np.log(a_lim) + lr) + offset - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
     x = np.where(np.isfinite(x), x, 50.0)  # no lobe reaches the speed: stable at any depth in the grid
     eps = label_noise
     ls = np.logaddexp(np.log(eps), np.log1p(-2 * eps) + log_ndtr(x))  # ln P(stable)
@@ -451,7 +455,7 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         pi, reach, spread = (float(v) for v in precursor)
         with np.errstate(divide="ignore", invalid="ignore"):
             u = np.log(depth)[None, :] - np.log(a_lim) - lr
-        u = np.where(np.isfinite(u), u, -np.inf)  # no lobe reaches the speed: stable, and no ring to hear
+        u = ex(np.where(np.isfinite(u), u, -np.inf))  # no lobe reaches the speed: stable, and no ring to hear
         lh = math.log(pi) + log_ndtr((u + reach) / spread)  # ln(π h)
         on = np.array([_rate(c) is None for c in cuts])[None, :]  # a growth read: chatter that grew, not a ring
         # one-sided: a chatter label says less, a stable label no more than in a quiet shop — with its factor
@@ -459,7 +463,9 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         # noise, recommended depth above the truth after 4 and 6 cuts): π varies from shop to shop, and a wrong
         # one may not lift the recommended depth
         lc = np.where(on, np.logaddexp(lc, ls + lh), lc)
-    ll = np.where(stable[None, :], ls, lc).sum(axis=1)
+    ll = np.where(stable[None, :], ls, lc).sum(axis=-1)
+    if mix:  # one reference's growth for all of a sample's cuts, the references equally likely
+        ll = logsumexp(ll, axis=1) - math.log(ll.shape[1])
     N = prior.cutting.teeth
     for r, c in enumerate(cuts):
         if c.stable or c.chatter_hz is None:
@@ -551,20 +557,25 @@ def growth_offset(prior: ModalPrior, theta, rpm, chatter_hz, growth, duration_s,
                   kappa_log_ratio=None) -> np.ndarray:
     """min(G / (κ t), 0.5): how far (ln) above the limit a chatter that must grow by e^G within t seconds is heard,
     κ the growth rate (:func:`~toolpoint.shop.model.growth_rate`) of each sample (S, R) times e^``kappa_log_ratio``
-    (R,) where that is finite (the references' SDM/ZOA growth ratio, :func:`_sdm_kappa_log_ratio`), or ``kappa``
-    (S, R) where that is finite (the sample's own SDM growth); 0.5 where κ ≤ 0, 0 where no lobe reaches the speed
-    (the sample is stable there anyway)."""
+    where that is finite — (R,), or (Q, R) for Q references' SDM/ZOA growth ratios (:func:`_sdm_kappa_log_ratio`),
+    then the result is (S, Q, R) — or ``kappa`` (S, R) where that is finite (the sample's own SDM growth); 0.5 where
+    κ ≤ 0, 0 where no lobe reaches the speed (the sample is stable there anyway)."""
     kap = growth_rate(prior, theta, rpm, chatter_hz)
+    fin = np.isfinite(np.asarray(chatter_hz, float))
+    mix = kappa_log_ratio is not None and np.ndim(kappa_log_ratio) == 2
     if kappa_log_ratio is not None:
-        klr = np.asarray(kappa_log_ratio, float)[None, :]
-        kap = kap * np.exp(np.where(np.isfinite(klr), klr, 0.0))
+        klr = np.asarray(kappa_log_ratio, float)
+        klr = np.exp(np.where(np.isfinite(klr), klr, 0.0))
+        kap = kap[:, None, :] * klr[None] if mix else kap * klr[None, :]
     if kappa is not None:
         kappa = np.asarray(kappa, float)
+        kappa = kappa[:, None, :] if mix else kappa
         kap = np.where(np.isfinite(kappa), kappa, kap)
+    shape = (-1, 1, 1) if mix else (-1, 1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        d = np.reshape(growth, (-1, 1)) / (kap * np.reshape(duration_s, (1, -1)))
+        d = np.reshape(growth, shape) / (kap * np.reshape(duration_s, (1,) * (len(shape) - 1) + (-1,)))
     d = np.where(kap > 0, np.minimum(d, _GROWTH_CAP), _GROWTH_CAP)
-    return np.where(np.isfinite(np.asarray(chatter_hz, float)), d, 0.0)
+    return np.where(fin[:, None, :] if mix else fin, d, 0.0)
 
 
 @dataclass(frozen=True)
@@ -892,15 +903,16 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         (:func:`~toolpoint.shop.model.growth_rate`). ``"sdm"``: the SDM's growth, which the heard labels follow where
         the zero-order lobe is not the SDM's (``benchmarks/bench_shop.py --only heard``; ``docs/design/shop.md``,
         *Chatter past the limit is heard by the SDM's own growth*) — in the sampling after the SDM correction, each
-        sample's zero-order κ times the references' mean ratio κ_SDM / κ_ZOA at each cut, κ_SDM the secant to where
-        their SDM growth ln ρ / T reaches G̃ / t (:func:`_sdm_kappa_log_ratio`; the references' sd of that offset
-        added to the boundary width); in the own reweighting each lobe sample's own secant ln ρ(a) / (T ln(a /
-        a_SDM)) from its own limit to the cut's depth (the search's slope within 2 % of the limit). One SDM growth
-        curve per reference and cut, one more spectral radius per lobe sample and cut. Needs ``forward="sdm"`` and
+        sample's zero-order κ times a reference's ratio κ_SDM / κ_ZOA at each cut, κ_SDM the secant to where its
+        SDM growth ln ρ / T reaches G̃ / t (:func:`_sdm_kappa_log_ratio`), the labels' likelihood a mixture over
+        the references; in the own reweighting each lobe sample's own secant ln ρ(a) / (T ln(a / a_SDM)) from its
+        own limit to the cut's depth (the search's slope within 2 % of the limit). One SDM growth curve per
+        reference and cut, one more spectral radius per lobe sample and cut. Needs ``forward="sdm"`` and
         ``own_sdm``. Measured in the whole loop (``docs/design/shop.md``, *The SDM's growth in the sampling too*):
-        EM12-60 truths 40–59 converged within 6 cuts for 10–11 of 20 against 8, but the recommended depth lay
-        above the truth after 15–22 of 120 updates against 10, and the band held the truth at 0.878–0.889 of the
-        speeds after 6 cuts against 0.933 — more often right, less often safe —, so not the default.
+        on EM12-60, truths 40–59, 6 of 20 converged within 6 cuts against 8, the recommended depth lay above the
+        truth after 18 of 120 updates against 10 and the band held the truth at 0.871 of the speeds after 6 cuts
+        against 0.933 (the references' mean ratio instead: 10–11 of 20, 15–22 of 120); on EM28-80 14 of 20
+        against 13, 6 of 120 against 7. Not the default.
 
     Returns
     -------
@@ -1023,11 +1035,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 rx = _sdm_ring_x(prior, prior.theta(ref), cuts, lr_c, f, float(ring_error[0]))
             sdm_kw = {} if rx is None else dict(ring_x=rx[:2], ring_outlier=float(ring_error[1]))
             if growth_by == "sdm" and g_med > 0:
-                # the label growth's κ: the references' SDM growth; how far their heard offsets spread joins the
-                # boundary width, as their limits' spread does (a sample's own κ is not known in the sampling)
-                sdm_kw["kappa_log_ratio"], x_sd = _sdm_kappa_log_ratio(prior, prior.theta(ref), cuts, lr_c, f, g_med,
-                                                                       cut_duration_s)
-                spread = np.hypot(spread, x_sd)
+                # the label growth's κ: the references' SDM growth, their mixture (a sample's own is not known in
+                # the sampling)
+                sdm_kw["kappa_log_ratio"] = _sdm_kappa_log_ratio(prior, prior.theta(ref), cuts, lr_c, f, g_med,
+                                                                 cut_duration_s)
             kw2 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + spread ** 2),
                        log_ratio=lr_c.mean(axis=0), growth_error=growth_error, growth_x=gx, **sdm_kw)
             z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw2, method, n_moves, rng,
@@ -1300,15 +1311,17 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
 
 
 def _sdm_kappa_log_ratio(prior, theta, cuts, lr_c, f, growth: float, cut_duration_s: float):
-    """ln(κ_SDM / κ_ZOA) at each cut (C,), the mean over the reference samples (rows of ``theta``), and the
-    references' sd of the heard offset min(x_b, 0.5) there (C,; 0 with fewer than two readings): κ_ZOA the
+    """ln(κ_SDM / κ_ZOA) of each reference sample (rows of ``theta``) at each cut, (R, C): κ_ZOA the
     reference's zero-order growth rate (:func:`~toolpoint.shop.model.growth_rate`), κ_SDM = (G / t) / x_b its SDM's
     secant to the depth where chatter is first heard, x_b the x at which the reference's SDM growth σ(x) = ln ρ(a_SDM
     e^x) / T (:func:`_sdm_curves`, over x ∈ [−0.06, 1], from its own zero crossing) reaches G / t, G ``growth`` (the
     label growth's prior median), t the cut's duration (else ``cut_duration_s``): with it, a sample like the
     reference hears chatter where the SDM says it has grown by e^G. Where σ does not reach G / t within x = 1, the
     secant to x = 1 (the offset's cap is reached anyway); nan where no reference reads the cut (no SDM limit near
-    the search's, no zero-order growth), the zero-order κ is then used.
+    the search's, no zero-order growth), the zero-order κ is then used. :func:`log_likelihood` takes the labels'
+    likelihood as a mixture over the references (one reference's ratios for all of a sample's cuts): at a speed where
+    the samples fall into kinds that grow at e^−0.5 and e^2.5 × the zero-order κ (EM12-60 near 18000 rpm), the
+    references' mean fitted neither kind.
 
     Why: at EM12-60's pockets and flip lobes another lobe limits and grows than the zero-order one, whose κ was
     0.58–17× off the SDM's secant at a twentieth of the cuts each way; heard labels followed the SDM's growth
@@ -1322,7 +1335,6 @@ def _sdm_kappa_log_ratio(prior, theta, cuts, lr_c, f, growth: float, cut_duratio
     ft = prior.cutting.teeth * rpm / 60.0
     level = growth / dur
     got = np.full((theta.shape[0], C), np.nan)
-    xb = np.full((theta.shape[0], C), np.nan)
     for i, t in enumerate(theta):
         ok = np.isfinite(a_s[i]) & (a_s[i] > 0) & np.isfinite(kz[i]) & (kz[i] > 0)
         for j, q in _sdm_curves(prior, t, rpm, a_s[i], ft, ok, _GROWTH_X):
@@ -1331,11 +1343,7 @@ def _sdm_kappa_log_ratio(prior, theta, cuts, lr_c, f, growth: float, cut_duratio
             x0 = _cross(q, 0.0)
             k_sdm = level[j] / (_cross(q, level[j]) - x0) if q[-1] >= level[j] else q[-1] / (_GROWTH_X[-1] - x0)
             got[i, j] = math.log(k_sdm / kz[i, j])
-            xb[i, j] = min(level[j] / k_sdm, _GROWTH_CAP)
-    n = np.sum(np.isfinite(got), axis=0)
-    mean = np.where(n > 0, np.nansum(got, axis=0) / np.maximum(n, 1), np.nan)
-    sd = np.array([float(np.std(v[np.isfinite(v)], ddof=1)) if np.isfinite(v).sum() > 1 else 0.0 for v in xb.T])
-    return mean, sd
+    return got
 
 
 def _ring_readable(c) -> bool:
