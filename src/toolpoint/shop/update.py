@@ -1320,8 +1320,8 @@ def _sdm_kappa_log_ratio(prior, theta, cuts, lr_c, f, growth: float, cut_duratio
     secant to x = 1 (the offset's cap is reached anyway); nan where no reference reads the cut (no SDM limit near
     the search's, no zero-order growth), the zero-order κ is then used. :func:`log_likelihood` takes the labels'
     likelihood as a mixture over the references (one reference's ratios for all of a sample's cuts): at a speed where
-    the samples fall into kinds that grow at e^−0.5 and e^2.5 × the zero-order κ (EM12-60 near 18000 rpm), the
-    references' mean fitted neither kind.
+    the samples fall into kinds that grow at e^−0.65…−0.2 and at e^2.1…2.8 × the zero-order κ (EM12-60 at 17769 and
+    17970 rpm, two truths and 8 prior samples; ``docs/design/shop.md``), the references' mean fitted neither kind.
 
     Why: at EM12-60's pockets and flip lobes another lobe limits and grows than the zero-order one, whose κ was
     0.58–17× off the SDM's secant at a twentieth of the cuts each way; heard labels followed the SDM's growth
