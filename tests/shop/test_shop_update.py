@@ -374,7 +374,7 @@ def test_the_label_growth_read_from_each_samples_own_sdm():
         with pytest.raises(InputError, match="growth_by"):
             update(pr, one, rng=np.random.default_rng(0), **bad)
 
-def test_the_sampling_reads_the_label_growth_from_the_references_sdm():
+def test_the_sampling_reads_the_label_growth_from_the_references_sdm(monkeypatch):
     """``growth_by="sdm"`` in the sampling: the references' κ at each cut is G / (t x_b), x_b where their SDM growth
     ln ρ / T first reaches G / t — checked against ``sdm_spectral_radius`` at the SDM limit bisected on it directly;
     with one reference the ratio is that reference's own. With several, the labels' likelihood is the mean of each
@@ -421,10 +421,23 @@ def test_the_sampling_reads_the_label_growth_from_the_references_sdm():
     mixed = log_likelihood(pr, th, cuts, kappa_log_ratio=kinds, **kw)
     np.testing.assert_allclose(mixed, np.log(np.exp(each).mean(axis=0)), rtol=1e-12)
     assert not np.allclose(mixed, log_likelihood(pr, th, cuts, kappa_log_ratio=kinds.mean(axis=0), **kw))
+    # update hands the references' ratios, one row per reference, to the sampling's likelihood
+    import toolpoint.shop.update as upd
+
+    seen = []
+    real_ll = upd.log_likelihood
+
+    def spy(*a, **k):
+        if k.get("kappa_log_ratio") is not None:
+            seen.append(np.shape(k["kappa_log_ratio"]))
+        return real_ll(*a, **k)
+
+    monkeypatch.setattr(upd, "log_likelihood", spy)
     post = update(pr, [TestCut(12000.0, 1.2 * a_z[0, 1], False, duration_s=0.5),
                        TestCut(12000.0, 0.8 * a_z[0, 1], True, duration_s=0.5)],
                   rng=np.random.default_rng(1), n_samples=200, lobe_samples=80, sdm_refs=2, growth_by="sdm")
     assert np.isfinite(post.recommended["depth_m"])
+    assert seen and set(seen) == {(2, 2)}
 
 
 def test_contradictory_table_is_refused_naming_lines(tmp_path, capsys):

@@ -571,9 +571,9 @@ def growth_offset(prior: ModalPrior, theta, rpm, chatter_hz, growth, duration_s,
         kappa = np.asarray(kappa, float)
         kappa = kappa[:, None, :] if mix else kappa
         kap = np.where(np.isfinite(kappa), kappa, kap)
-    shape = (-1, 1, 1) if mix else (-1, 1)
+    g_shape, t_shape = ((-1, 1, 1), (1, 1, -1)) if mix else ((-1, 1), (1, -1))
     with np.errstate(divide="ignore", invalid="ignore"):
-        d = np.reshape(growth, shape) / (kap * np.reshape(duration_s, (1,) * (len(shape) - 1) + (-1,)))
+        d = np.reshape(growth, g_shape) / (kap * np.reshape(duration_s, t_shape))
     d = np.where(kap > 0, np.minimum(d, _GROWTH_CAP), _GROWTH_CAP)
     return np.where(fin[:, None, :] if mix else fin, d, 0.0)
 
