@@ -154,9 +154,9 @@ def test_the_sdm_s_own_growth_reads_the_distance_past_a_pocket_s_limit():
     rate is read by the SDM's own growth curve at reference samples near the truth: a cut 12 % past the truth's SDM
     limit, with the SDM's own σ there (ln ρ / T, at a depth off the curve's grid), reads x within 0.02, where the
     zero-order κ would say 0.09 (27 % short), measured from the curve's own zero crossing; a rate past the curve's
-    reach, or a curve already unstable at its start, is no reading; and in the likelihood the term favours the
-    samples that put the cut x_m past their limit."""
-    from toolpoint.shop.update import _sdm_growth_x
+    reach, or a curve already unstable at its start, is no reading, nor is a rate heard on a line that no reference
+    grows there; and in the likelihood the term favours the samples that put the cut x_m past their limit."""
+    from toolpoint.shop.update import _fold_hz, _sdm_growth_x
     from toolpoint.stability.sdm import sdm_spectral_radius
 
     pr = cornelius_2024(0.1)
@@ -188,6 +188,24 @@ def test_the_sdm_s_own_growth_reads_the_distance_past_a_pocket_s_limit():
     assert abs(xm0[0] - x) < 0.02, xm0
     xm1, _ = _sdm_growth_x(pr, ref, cuts[:1], np.full((4, 1), 1.5), pr.freq_grid())
     assert np.isnan(xm1[0])
+    # a reference reads a rate only where what grows on its curve at the reading is the chatter heard (the heard
+    # frequency folded by the tooth-passing frequency, _fold_hz, against ±arg μ f_t / 2π of its critical multiplier
+    # there). The line heard: the SDM's chatter frequency at the truth's limit, computed apart (sdm_limits: the
+    # strongest line of the critical eigen-solution, not the multiplier's angle) — then the reading is the same as
+    # with no frequency stated, also for its alias one f_t up; a line of the tool's other mode (1747 Hz, its fold
+    # 66 Hz off) is another mode's chatter, which no reference grows there: no reading. (EM12-60's truth 48
+    # chattered at 1648 Hz, an alias of its 762 Hz mode, growing at 7.4 /s 0.46 past its limit; its references grew
+    # another line there and read 0.01, and the band after that cut, 2.58–3.02 mm, missed the truth's 1.85 mm.)
+    f_s = sdm_limits(pr, th[0], [rpm])[1][0]
+    mu0 = complex(sdm_spectral_radius(mm, mm, cut, rpm=rpm, depth=a_s * 1.001, multiplier=True))
+    assert abs(float(_fold_hz(f_s, ft)) - abs(np.angle(mu0)) / (2 * np.pi) * ft) < 0.002 * f_s  # the two agree
+    # past the limit the line moves (by 16 Hz, 1.1 %, at x = 0.12 here): within the 3 % the gate allows
+    other = 1747.0
+    assert abs(float(_fold_hz(other, ft)) - float(_fold_hz(f_s, ft))) > 0.03 * other
+    heard = [TestCut(rpm, a_s * math.exp(x), False, hz, growth_per_s=sig) for hz in (f_s, f_s + ft, other)]
+    xh, sdh = _sdm_growth_x(pr, ref, heard, np.repeat(lr, 3, axis=1), pr.freq_grid())
+    assert xh[0] == xm[0] and xh[1] == xm[0], (xh, xm)
+    assert np.isnan(xh[2]) and np.isnan(sdh[2])
     # in the likelihood: the term (with the rate − without) is largest for the samples that put the cut x_m past
     # their (corrected) limit, and falls off on either side
     ths = pr.sample(200, np.random.default_rng(6)).theta

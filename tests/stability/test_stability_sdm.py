@@ -47,6 +47,25 @@ def test_zero_depth_is_free_vibration():
     assert rho == pytest.approx(np.exp(-0.011 * 2 * np.pi * 922.0 * T), rel=1e-10)
 
 
+def test_the_critical_multiplier_says_the_frequency_that_grows():
+    """``multiplier=True``: μ with |μ| = ρ, and at zero depth μ = e^{λT} of the least damped mode — its angle the
+    damped natural frequency modulo the tooth-passing frequency (closed form, two modes in x: 922 Hz at ζ 1.1 % and
+    1500 Hz at ζ 5 %, the first the critical one)."""
+    two = ModalModel([922.0, 1500.0], [0.011, 0.05], [0.03993, 0.03])
+    rpm = np.array([3000.0, 9000.0, 20000.0])
+    mu = sdm_spectral_radius(two, None, cut(0.3), rpm=rpm, depth=0.0, multiplier=True)
+    T = 60.0 / (2 * rpm)
+    wd = 2 * np.pi * 922.0 * np.sqrt(1 - 0.011 ** 2)
+    assert np.abs(mu) == pytest.approx(np.exp(-0.011 * 2 * np.pi * 922.0 * T), rel=1e-10)
+    # the angle as the distance of ω_d T to the nearest multiple of 2π (μ and its conjugate are both multipliers)
+    want = np.abs((wd * T + np.pi) % (2 * np.pi) - np.pi)
+    assert np.abs(np.angle(mu)) == pytest.approx(want, abs=1e-8)
+    a = np.array([1e-4, 5e-4, 2e-3])  # and under cutting |μ| is the spectral radius
+    rho = sdm_spectral_radius(two, None, cut(0.3), rpm=rpm, depth=a)
+    assert np.abs(sdm_spectral_radius(two, None, cut(0.3), rpm=rpm, depth=a, multiplier=True)) == \
+        pytest.approx(rho, rel=1e-12)
+
+
 @pytest.mark.parametrize("ri", [1.0, 0.05])
 def test_default_is_within_one_percent_of_the_converged_limit(ri):
     """Default settings against the converged first-order SDM (Richardson extrapolation of

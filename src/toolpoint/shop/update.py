@@ -549,6 +549,7 @@ def _rate(cut) -> float | None:
 _RING_HZ_REL = 0.1  # a ring more than 10 % from the references' chatter frequency (and its aliases) is not read
 _RING_LN_SD_MAX = 0.5  # nor one read to worse than this ln sd (as `cut` calls a line a ring: detect._rings)
 
+_GROWTH_HZ_REL = 0.03  # a reference's growing line more than this (relative) from the heard one does not read it
 _GROWTH_LR_MAX = 0.1  # |ln(a_SDM / a_ZOA)| at a cut beyond which its growth rate is not read (log_likelihood)
 _GROWTH_CAP = 0.5  # ln: a chatter that cannot grow audibly within the cut leaves the label uninformative, not wild
 
@@ -828,8 +829,9 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         says how far past it the cut was. With ``forward="sdm"`` the rates enter once the SDM correction is known,
         and x_m is read from the SDM's own growth curves σ(x) = ln ρ(a_SDM e^x) / T at the references, not from
         the zero-order κ (``_sdm_growth_x``: at a pocket or a flip lobe another lobe limits and grows, and κ x
-        was 0.04–2.2× the SDM's rate there); the references' spread joins the error. None: the rates are not
-        used.
+        was 0.04–2.2× the SDM's rate there); the references' spread joins the error. A reference whose growing line
+        at the reading is not the cut's chatter frequency (folded by the tooth-passing frequency, 3 %) does not read
+        it: its curve is another mode's. None: the rates are not used.
     ring_error : (float, float) or None, default :data:`RING_ERROR`
         How a stable cut's ring (``TestCut.ring_per_s``: how fast the line it rings at decays,
         :func:`toolpoint.shop.growth.ring_decay`) enters, with ``forward="sdm"``: (ln sd of a reading slower than
@@ -1276,9 +1278,14 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
     spectral radius per tooth period, a_SDM ≈ a_ZOA e^``lr_c`` the reference's limit there, as its search found it
     to ~0.5 %), made monotone (its running maximum), over x ∈ [−0.06, 1]; x_m = x(σ_m / ``bias``) − x(0), from the
     curve's own zero crossing (the limit exactly; the search's 0.5 % would be worth κ · 0.005 ≈ 2.5 /s on the
-    Cornelius tool, a quarter of a reading 2 % past). (mean, sd) over the references, each (C,); nan where a cut has
-    no reading, or fewer than two references bracket it (one, of one reference; the reading past x = 1, or the
-    curve not crossing zero within the grid: no SDM limit near the search's).
+    Cornelius tool, a quarter of a reading 2 % past). A reference reads a cut that states its chatter frequency only
+    where what grows on its curve at the reading is that line: the critical multiplier's ±arg μ f_t / 2π within 3 %
+    of the heard frequency, both folded by the tooth-passing frequency f_t (:func:`_fold_hz`) — else its curve is
+    another mode's growth (EM12-60's truth 48 chattered at 1648 Hz, an alias of its 762 Hz mode, at 7.4 /s 0.46 past
+    its limit; its four references grew a line 170–200 Hz off there and read 0.01, and the band after that cut missed
+    the truth). (mean, sd) over the references, each (C,); nan where a cut has no reading, or fewer than two
+    references bracket it (one, of one reference; the reading past x = 1, the curve not crossing zero within the
+    grid: no SDM limit near the search's; or another line growing there).
 
     Why not κ x: the zero-order κ (:func:`~toolpoint.shop.model.growth_rate`) is the zero-order lobe's slope at its
     limit, and where the SDM's limit lies more than 10 % from it (a pocket, a flip lobe) another lobe limits and
@@ -1294,11 +1301,17 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
     a_z = limit_at_speeds(prior, theta, rpm, f)[0]  # (R, U)
     a_s = a_z * np.exp(np.asarray(lr_c, float)[:, use])
     ft = prior.cutting.teeth * rpm / 60.0
+    hz = np.array([np.nan if cuts[r].chatter_hz is None else cuts[r].chatter_hz for r in use], float)
+    heard = _fold_hz(hz, ft)  # nan where the cut states no chatter frequency: every reference reads it
     got = np.full((theta.shape[0], len(use)), np.nan)
     for i, t in enumerate(theta):
         ok = np.isfinite(a_s[i]) & (a_s[i] > 0)
-        for j, q in _sdm_curves(prior, t, rpm, a_s[i], ft, ok, _GROWTH_X):
+        for j, q, phi in _sdm_curves(prior, t, rpm, a_s[i], ft, ok, _GROWTH_X, fold=True):
             if q[0] >= 0 or q[-1] < sig_m[j]:
+                continue
+            # what grows at the reading on this reference's curve must be the line heard: else it is another
+            # mode's growth, and the curve says nothing of how far past the limit the heard chatter was
+            if abs(phi[int(np.argmax(q >= sig_m[j]))] - heard[j]) > _GROWTH_HZ_REL * hz[j]:
                 continue
             got[i, j] = _cross(q, sig_m[j]) - _cross(q, 0.0)
     n = np.sum(np.isfinite(got), axis=0)
@@ -1371,18 +1384,33 @@ def ring_left_out(cuts, r: int) -> str | None:
     return None
 
 
-def _sdm_curves(prior, theta, rpm, a_sdm, ft, ok, grid):
+def _sdm_curves(prior, theta, rpm, a_sdm, ft, ok, grid, fold: bool = False):
     """(j, σ(x)) for each speed rpm[j] where ``ok``: the sample's SDM σ(x) = ln ρ(a_sdm e^x) · f_t (1/s) over the
-    ln offsets ``grid``, made monotone (its running maximum: the first x a level is reached)."""
+    ln offsets ``grid``, made monotone (its running maximum: the first x a level is reached). With ``fold``: (j, σ(x),
+    φ(x)), φ the frequency of what grows there, folded into [0, f_t / 2] (Hz: ±arg μ f_t / 2π of the critical
+    multiplier μ where the running maximum was reached; :func:`_fold_hz` folds a heard frequency alike)."""
     from ..stability.sdm import sdm_spectral_radius
 
     if not ok.any():
         return []
     mm, cut = prior.tool(theta)
-    rho = sdm_spectral_radius(mm, mm, cut, rpm=rpm[ok][None, :],
-                              depth=a_sdm[ok][None, :] * np.exp(grid)[:, None])  # (X, U')
-    sig = np.maximum.accumulate(np.log(np.maximum(rho, 1e-300)) * ft[ok][None, :], axis=0)
-    return list(zip(np.flatnonzero(ok), sig.T))
+    mu = sdm_spectral_radius(mm, mm, cut, rpm=rpm[ok][None, :], depth=a_sdm[ok][None, :] * np.exp(grid)[:, None],
+                             multiplier=fold)  # (X, U')
+    raw = np.log(np.maximum(np.abs(mu), 1e-300)) * ft[ok][None, :]
+    sig = np.maximum.accumulate(raw, axis=0)
+    if not fold:
+        return list(zip(np.flatnonzero(ok), sig.T))
+    # where each running maximum was reached: the last x at which the raw curve equals it
+    at = np.maximum.accumulate(np.where(raw >= sig, np.arange(grid.size)[:, None], 0), axis=0)
+    phi = np.abs(np.angle(np.take_along_axis(mu, at, axis=0))) / (2 * np.pi) * ft[ok][None, :]
+    return list(zip(np.flatnonzero(ok), sig.T, phi.T))
+
+
+def _fold_hz(f_hz, ft):
+    """A frequency (Hz) folded into [0, f_t / 2] by the tooth-passing frequency f_t: f + k f_t and −f + k f_t (a line
+    and its aliases, the mirror of a real signal) fold alike."""
+    p = np.mod(np.asarray(f_hz, float) / ft, 1.0)
+    return np.minimum(p, 1.0 - p) * ft
 
 
 def _cross(q, level, grid=_GROWTH_X):

@@ -563,6 +563,7 @@ def sdm_spectral_radius(
     depth,
     m: int | None = None,
     accuracy: float = 1.0,
+    multiplier: bool = False,
 ) -> np.ndarray:
     """Spectral radius ρ of the Floquet transition matrix at (rpm, depth), broadcast.
 
@@ -584,11 +585,15 @@ def sdm_spectral_radius(
         Steps over the cut, every node carried; default: see :func:`sdm_lobes`.
     accuracy : float
         Resolution factor of the default discretisation (see :func:`sdm_lobes`).
+    multiplier : bool, default False
+        Return the critical Floquet multiplier μ itself (complex, |μ| = ρ): its angle says the chatter
+        frequency modulo the tooth-passing frequency f_T = 1/T, f ≡ ±arg(μ) f_T / 2π (mod f_T) — which mode
+        grows, where several could.
 
     Returns
     -------
     numpy.ndarray
-        ρ, dimensionless, shape of the broadcast of ``rpm`` and ``depth``.
+        ρ, dimensionless (μ, complex, with ``multiplier``), shape of the broadcast of ``rpm`` and ``depth``.
 
     Examples
     --------
@@ -607,8 +612,8 @@ def sdm_spectral_radius(
     if np.any(~np.isfinite(r) | (r <= 0)) or np.any(~np.isfinite(a) | (a < 0)):
         raise InputError("speeds must be > 0 rpm and depths finite and ≥ 0 m", field="rpm/depth")
     mm, ss = sysm.resolution(r.reshape(-1), m, acc, int(round(M_MAX * max(acc, 1.0))))
-    rho, _ = sysm.multipliers(r.reshape(-1), a.reshape(-1), mm, ss)
-    return rho.reshape(r.shape)
+    rho, mu = sysm.multipliers(r.reshape(-1), a.reshape(-1), mm, ss)
+    return (mu if multiplier else rho).reshape(r.shape)
 
 
 def sdm_limit_near(
