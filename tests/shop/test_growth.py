@@ -193,7 +193,7 @@ def test_the_sdm_s_own_growth_reads_the_distance_past_a_pocket_s_limit():
     # there). The line heard: the SDM's chatter frequency at the truth's limit, computed apart (sdm_limits: the
     # strongest line of the critical eigen-solution, not the multiplier's angle) — then the reading is the same as
     # with no frequency stated, also for its alias one f_t up; a line of the tool's other mode (1747 Hz, its fold
-    # 66 Hz off) is another mode's chatter, which no reference grows there: no reading. (EM12-60's truth 48
+    # 212 Hz off) is another mode's chatter, which no reference grows there: no reading. (EM12-60's truth 48
     # chattered at 1648 Hz, an alias of its 762 Hz mode, growing at 7.4 /s 0.46 past its limit; its references grew
     # another line there and read 0.01, and the band after that cut, 2.58–3.02 mm, missed the truth's 1.85 mm.)
     f_s = sdm_limits(pr, th[0], [rpm])[1][0]

@@ -831,7 +831,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         the zero-order κ (``_sdm_growth_x``: at a pocket or a flip lobe another lobe limits and grows, and κ x
         was 0.04–2.2× the SDM's rate there); the references' spread joins the error. A reference whose growing line
         at the reading is not the cut's chatter frequency (folded by the tooth-passing frequency, 3 %) does not read
-        it: its curve is another mode's. None: the rates are not used.
+        it: its curve is another line's growth. None: the rates are not used.
     ring_error : (float, float) or None, default :data:`RING_ERROR`
         How a stable cut's ring (``TestCut.ring_per_s``: how fast the line it rings at decays,
         :func:`toolpoint.shop.growth.ring_decay`) enters, with ``forward="sdm"``: (ln sd of a reading slower than
@@ -1281,9 +1281,9 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
     Cornelius tool, a quarter of a reading 2 % past). A reference reads a cut that states its chatter frequency only
     where what grows on its curve at the reading is that line: the critical multiplier's ±arg μ f_t / 2π within 3 %
     of the heard frequency, both folded by the tooth-passing frequency f_t (:func:`_fold_hz`) — else its curve is
-    another mode's growth (EM12-60's truth 48 chattered at 1648 Hz, an alias of its 762 Hz mode, at 7.4 /s 0.46 past
-    its limit; its four references grew a line 170–200 Hz off there and read 0.01, and the band after that cut missed
-    the truth). (mean, sd) over the references, each (C,); nan where a cut has no reading, or fewer than two
+    another line's growth (EM12-60's truth 48 chattered at 1648 Hz, an alias of its 762 Hz mode, at 7.4 /s 0.46 past
+    its limit; its four references grew a line 170–196 Hz off (folded) there and read 0.01, and the band after that
+    cut missed the truth). (mean, sd) over the references, each (C,); nan where a cut has no reading, or fewer than two
     references bracket it (one, of one reference; the reading past x = 1, the curve not crossing zero within the
     grid: no SDM limit near the search's; or another line growing there).
 
@@ -1310,7 +1310,7 @@ def _sdm_growth_x(prior, theta, cuts, lr_c, f, bias: float = 1.0):
             if q[0] >= 0 or q[-1] < sig_m[j]:
                 continue
             # what grows at the reading on this reference's curve must be the line heard: else it is another
-            # mode's growth, and the curve says nothing of how far past the limit the heard chatter was
+            # line's growth, and the curve says nothing of how far past the limit the heard chatter was
             if abs(phi[int(np.argmax(q >= sig_m[j]))] - heard[j]) > _GROWTH_HZ_REL * hz[j]:
                 continue
             got[i, j] = _cross(q, sig_m[j]) - _cross(q, 0.0)
