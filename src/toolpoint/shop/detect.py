@@ -248,6 +248,7 @@ _CUT_PROMINENCE_DB = 4.0  # dB over noise: a quiet stretch whose tooth-passing h
 _AIR_EXCESS_DB = 3.0  # dB over noise: a loud part whose tooth-passing harmonics stand out no further has none …
 _SWAP_DB = 3.0  # … and a quiet part whose stand out this much further is the cut: a level upside down (see _split)
 _AIR_PROMINENCE_DB = 2.0  # a loud stretch whose tooth-passing harmonics stand out as in the air (± this): air
+_OWN_LINE_DB = 20.0  # dB over its floor: a loud stretch's line this strong that the air lacks is no air's (_split)
 
 
 @dataclass(frozen=True)
@@ -1359,13 +1360,29 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
             # the gain. Only where it is at the air's own (its median ± 2 dB): developed chatter lowers it in the cut
             # too (heavy chatter at a pocket: from 25–30 dB to 9–14 dB in the short frames, the air's 5–7 dB), a
             # spindle whose lines ring in air can raise the air's above the cut's, and shorter disagreements (where
-            # the tool enters and leaves) are left to the level.
+            # the tool enters and leaves) are left to the level. Nor where the stretch holds a strong line of its own
+            # that the air lacks (_lines_of_its_own): saturated chatter brings the prominence down to the air's for
+            # as long as it lasts (a 3 s cut 1.39 × its limit, chattering from its second second on at 7 × the forced
+            # vibration: its chatter was taken for air and the cut judged stable on its first second)
             act = act.copy()
             if (~act).sum() >= n_min:
                 like_air = act & (np.abs(prom - np.median(prom[~act])) <= _AIR_PROMINENCE_DB)
                 if (act & ~like_air).sum() >= n_min:
+                    # the air's spectrum from the long frames wholly inside it: a frame reaching into a chattering
+                    # stretch holds its chatter through the window
+                    half = 0.5 * L / rate
+                    n_cut = np.concatenate(([0], np.cumsum(act)))
+                    ia, ib = np.searchsorted(short_t, frame_t - half), np.searchsorted(short_t, frame_t + half)
+                    air = (ib > ia) & (n_cut[ib] == n_cut[ia])
+                    keep = (freq >= lo) & (freq <= hi)
+                    S_air = P[air].mean(axis=0) if air.any() else None
                     for s, e, v in _runs(like_air):
                         if v and short_t[e - 1] - short_t[s] >= min_air:
+                            run = (frame_t >= short_t[s]) & (frame_t <= short_t[e - 1])
+                            if S_air is not None and run.any() and _lines_of_its_own(
+                                    P[run].mean(axis=0), S_air, freq, keep, np.zeros_like(keep), f_nom,
+                                    freq[1] - freq[0]):
+                                continue
                             act[s:e] = False
             return act
 
@@ -1418,6 +1435,19 @@ def _lines_held(S_loud, S_q, freq, keep, harm, f_s, df, top=8, line_db=10.0, hel
     held = (near >= 10 ** (held_db / 10)) & (r[idx] >= near * 10 ** (louder_db / 10))
     w = r[idx]
     return float(np.sum(w * held) / np.sum(w))
+
+
+def _lines_of_its_own(S_a, S_b, freq, keep, harm, f_s, df, line_db=None) -> bool:
+    """Whether spectrum ``S_a`` holds a line off the spindle harmonics standing ≥ ``line_db`` (default
+    :data:`_OWN_LINE_DB`) over its own floor, and ``S_b`` holds (≥ 6 dB over its own floor, ±1 bin) less than half of
+    ``S_a``'s strongest lines by their excess (:func:`_lines_held`). Floors are each spectrum's own, so a recorder's
+    gain moves neither: air lifted by a gain control holds the air's lines (fans, the spindle ringing), which the cut
+    holds too; developed chatter a line that the air and the forced cut before it lack."""
+    line_db = _OWN_LINE_DB if line_db is None else line_db
+    r = S_a / (_block_floor(S_a[None, :], keep)[0] + _leakage(S_a, freq, harm, f_s, f_s, df) + 1e-300)
+    if not np.any(keep & (r >= 10 ** (line_db / 10))):
+        return False
+    return _lines_held(S_a, S_b, freq, keep, harm, f_s, df, louder_db=-np.inf) < 0.5
 
 
 def _noise_prominence_db(rate, frames, f_t, tol, lo, hi):
