@@ -211,8 +211,7 @@ def test_a_slot_s_noise_driven_hump_is_not_chatter_and_heavy_chatter_still_is():
     assert before == ["chatter", "chatter", "chatter"]
 
 
-
-@pytest.mark.slow  # ~10 s: four 3 s records
+@pytest.mark.slow  # ~13 s: two 3 s records
 def test_a_long_cut_whose_chatter_saturates_is_not_taken_for_air():
     """A 3 s cut whose chatter grows slowly, then saturates at ~7 × the forced vibration for seconds: its tooth
     passing then stands out no further than in the air, and the level split's veto took the chattering stretch for
@@ -245,6 +244,7 @@ def test_a_long_cut_whose_chatter_saturates_is_not_taken_for_air():
         assert r.verdict == "chatter", seed
         alias = float(res.chatter_hz[0]) + 3 * rpm / 60 * np.arange(-3, 4)
         assert np.min(np.abs(r.chatter_hz - alias)) / r.chatter_hz < 0.01
+
 
 def test_a_bad_hump_bar_is_refused():
     from toolpoint.errors import InputError
