@@ -354,3 +354,23 @@ def test_the_default_range_widens_to_the_deep_pockets_of_a_lightly_damped_mode()
     for bad in ({"chatter": "False"}, {"seed": 0}):  # a flag, not a truthy string or number
         with pytest.raises(InputError, match=f"{next(iter(bad))}.*must be True or False"):
             sdm_lobes(mode, mode, c, rpm=rpm, **bad)
+
+
+def test_a_speed_asked_alone_resolves_every_mode_that_can_chatter():
+    # The example tool of toolpoint.shop (three modes: 2213 Hz ζ 0.99 %, 776 Hz ζ 0.55 %, 1908 Hz ζ 2.68 %; 3 teeth,
+    # half immersion, climb). At 9000 rpm the zero-order lobe is the 776 Hz mode's, and the steps were sized for
+    # that wave alone: asked alone, 9000 rpm read 0.56 mm with the 2213 Hz mode spuriously unstable, against
+    # 1.07 mm asked beside 14000 and 20000 rpm (whose lobes are the 2213 Hz mode's). The check is the spectral
+    # radius at accuracy 4, independent of the search: stable 1 % below the limit, unstable 1 % above, both ways
+    # of asking.
+    fn = np.array([2213.0, 776.0, 1908.0])
+    k = np.array([9.02e6, 2.84e7, 1.96e7])
+    tool = ModalModel(fn, [0.0099, 0.0055, 0.0268], k / (2 * np.pi * fn) ** 2)
+    c = CuttingConditions(teeth=3, tangential_coeff=7e8, radial_ratio=0.3, radial_immersion=0.5, milling="down")
+    alone = sdm_lobes(tool, tool, c, rpm=[9000.0])
+    beside = sdm_lobes(tool, tool, c, rpm=[9000.0, 14000.0, 20000.0])
+    assert alone.depth_m[0] == pytest.approx(beside.depth_m[0], rel=2e-3)
+    assert alone.chatter_hz[0] == pytest.approx(776.0, rel=0.01)
+    for a in (alone.depth_m[0], beside.depth_m[0]):
+        assert sdm_spectral_radius(tool, tool, c, rpm=9000.0, depth=0.99 * a, accuracy=4.0) < 1
+        assert sdm_spectral_radius(tool, tool, c, rpm=9000.0, depth=1.01 * a, accuracy=4.0) > 1

@@ -46,9 +46,16 @@ every node). Because the delay is one tooth period, the state
 ζ' = Φ ζ; the cut is stable iff the spectral radius ρ(Φ) < 1 (Floquet).
 
 Default resolution. A chatter wave is a period of f_w = 1.1 × the highest
-zero-order chatter frequency of the speed range, Hz (1.1 × the highest
-natural frequency without a zero-order lobe, with ``seed=False`` and in
-:func:`sdm_spectral_radius`). Per speed,
+frequency that can chatter within the searched depths, Hz: the highest
+zero-order chatter frequency of the speed range, or the highest frequency
+(at most the highest natural frequency) whose zero-order limit lies within
+the search range, whichever is higher (1.1 × the highest natural frequency
+with ``seed=False`` and in :func:`sdm_spectral_radius`). The speed range's
+chatter frequencies alone are not enough: a mode the zero-order lobes pass
+over at these speeds but the delay's interpolation does not resolve turns
+spuriously unstable (the example tool of :mod:`toolpoint.shop` at 9000 rpm
+alone: its 2213 Hz mode at 0.56 mm, against 1.07 mm on the 776 Hz mode
+with the mode resolved). Per speed,
 m = accuracy · max(24 · f_w t_c, 20) on a ladder 20, 24, 28, 32, 40, …
 (≈ 2^(1/4) apart) within [20, m_max] (default 200 × max(accuracy, 1)), and
 s is the largest divisor of m (≤ 16) leaving at least 5 · max(accuracy, 1)
@@ -849,6 +856,25 @@ def sdm_limit_near_many(tools, *, rpm, depth_m, chatter_hz=None, rho_at=None, ex
     return limit, bracketed, {"growth_per_s": growth, "rho_at": rho_at}
 
 
+def _zoa_depths(sysm: _System, phi: np.ndarray):
+    """Zero-order depth limits (m, ``inf`` where no lobe) per frequency of the grid, all eigenvalue branches
+    (:func:`~toolpoint.stability.zoa.depth_and_phase`)."""
+    from .milling import average_directional_matrix
+    from .zoa import depth_and_phase, oriented_eigenvalues
+
+    h0 = average_directional_matrix(sysm.teeth, sysm.tangential_coeff, sysm.radial_ratio, sysm.phi_st, sysm.phi_ex)
+    return depth_and_phase(oriented_eigenvalues(h0, phi[:, 0, 0], phi[:, 1, 1], phi[:, 0, 1], phi[:, 1, 0]))
+
+
+def _chatter_reach(sysm: _System, freq_hz: np.ndarray, phi: np.ndarray, depth_max: float) -> float:
+    """The highest frequency (Hz, at most the highest natural frequency) at which the zero-order limit is at most
+    ``depth_max`` (m): a mode there can chatter within the search, at some speed. 0 when none."""
+    zero_order = _zoa_depths(sysm, phi)
+    ok = zero_order.valid & (zero_order.depth_m <= depth_max)
+    ok = ok.any(axis=0) if ok.ndim > 1 else ok
+    return float(min(freq_hz[ok].max(), sysm.f_max)) if ok.any() else 0.0
+
+
 def _zoa_minimum(sysm: _System, freq_hz: np.ndarray, phi: np.ndarray) -> float:
     """The zero-order absolute minimum, m: min over ω of −1/(2 Re μ(ω)), μ the eigenvalues of H₀Φ(iω).
 
@@ -856,11 +882,7 @@ def _zoa_minimum(sysm: _System, freq_hz: np.ndarray, phi: np.ndarray) -> float:
     lobe: 1/(max |B H_i| / max |B| · max |Φ(f_0)|), a depth at which the cutting
     stiffness is of the order of the structure's stiffness at the lowest grid frequency f_0.
     """
-    from .milling import average_directional_matrix
-    from .zoa import depth_and_phase, oriented_eigenvalues
-
-    h0 = average_directional_matrix(sysm.teeth, sysm.tangential_coeff, sysm.radial_ratio, sysm.phi_st, sysm.phi_ex)
-    zero_order = depth_and_phase(oriented_eigenvalues(h0, phi[:, 0, 0], phi[:, 1, 1], phi[:, 0, 1], phi[:, 1, 0]))
+    zero_order = _zoa_depths(sysm, phi)
     if zero_order.valid.any():
         return float(zero_order.depth_m[zero_order.valid].min())
     hmax = np.abs(sysm.directional(M_MIN)).max()
@@ -1023,6 +1045,9 @@ def sdm_lobes(
     widen = _check_widen(widen) if depth_max is None else 0
     depth_min, depth_max = _depth_range(sysm, f, phi, depth_min, depth_max)
     start, f_wave = _starts(sysm, grid, f, phi, seed, depth_min, depth_max)
+    if f_wave is not None:  # resolve every mode that can chatter within the searched depths, not only this range's
+        reach = _chatter_reach(sysm, f, phi, depth_max * 10.0 ** widen)
+        f_wave = max(f_wave, WAVE_MARGIN * reach)
     if m_max is None:
         m_max = int(round(M_MAX * max(acc, 1.0)))
     msteps, spacing = sysm.resolution(grid, m, acc, m_max, f_wave)
