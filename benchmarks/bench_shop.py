@@ -1,7 +1,7 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard] [--shops zoa,noisy,sim]
+        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard|bracket] [--shops zoa,noisy,sim]
         [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
@@ -46,6 +46,9 @@ CPU time (time.process_time), not wall time: the machine is shared.
 6. ``heard``: what decides whether the whole loop's shop hears a cut past the limit as chatter — the label against
    the zero-order κ x, the SDM's secant κ x and the SDM's own growth at the cut's depth, each times the cut's duration,
    fitted as P(heard) = Φ((ln(g t) − ln G) / s) (truths from the prior, cuts 0–25 % past the SDM limit, 0.9–4 s).
+7. ``bracket`` (``--seeds`` truths from ``--seed-start``): the band ``update`` leaves after cuts that bracket each
+   truth's SDM limit at one speed exactly (no simulation, no detector: an oracle's labels), with the label model and
+   with exact labels — the floor the label offset sets on the loop's width target, however well the cuts are placed.
 """
 
 from __future__ import annotations
@@ -640,6 +643,54 @@ def bench_ceiling(cases, library_prior=None):
                   f"{np.round(np.quantile(cov, [0.1, 0.25, 0.5]), 2).tolist()}", flush=True)
 
 
+def bench_bracket(cases, library_prior=None, truths=8, seed_start=40, n_samples=1000, lobe_samples=400):
+    """The band ``update`` leaves after cuts that bracket the truth's SDM limit at one speed exactly (an oracle:
+    no simulation, no detector), with ``update``'s label model (the label offset δ and growth G it expects of a
+    shop that hears chatter) and with exact labels (``label_offset`` and ``label_growth`` 0): how much of the band
+    the label model keeps open, however well the cuts are placed."""
+    from toolpoint.shop.update import TestCut
+
+    print(f"\n## bracket: update's band after cuts bracketing the truth's SDM limit at the prior's recommended speed "
+          f"(truths {seed_start}…{seed_start + truths - 1}, {n_samples} samples, {lobe_samples} lobe samples, cuts of "
+          "1 s, no chatter frequency); width (a95 − a05) / a50 at that speed, [a05, a95] / the truth's limit")
+    priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
+    if library_prior:
+        from toolpoint.shop.prior import prior_from_library
+
+        out, tool = library_prior.rsplit(":", 1)
+        priors["library"] = prior_from_library(out, tool)
+    settings = {"label model": {}, "exact labels": {"label_offset": (0.0, 0.0), "label_growth": (0.0, 0.0)}}
+    brackets = {"0.93 s / 1.07 C": ((0.93, True), (1.07, False)), "0.97 s / 1.03 C": ((0.97, True), (1.03, False)),
+                "0.90 0.95 0.98 s / 1.02 1.05 1.10 C": ((0.9, True), (0.95, True), (0.98, True), (1.02, False),
+                                                        (1.05, False), (1.1, False))}
+    for case in cases:
+        pr = priors[case]
+        truth = sdm_limit(pr)
+        widths: dict = {}
+        for seed in range(seed_start, seed_start + truths):
+            rng = np.random.default_rng(seed)  # the truth as virtual_campaign draws it from this seed
+            th = pr.theta((rng.standard_normal(pr.sigma.size) * (pr.sigma > 0))[None, :])[0]
+            p0 = update(pr, [], rng=np.random.default_rng(1000 + seed), n_samples=n_samples,
+                        lobe_samples=lobe_samples)
+            r0 = p0.recommended["rpm"]
+            lim = float(np.ravel(truth(th, [r0]))[0])
+            line = []
+            for bn, br in brackets.items():
+                cuts = [TestCut(r0, f * lim, st, duration_s=1.0) for f, st in br]
+                for sn, kw in settings.items():
+                    q = update(pr, cuts, rng=np.random.default_rng(2000 + seed), n_samples=n_samples,
+                               lobe_samples=lobe_samples, **kw).limit_q_m
+                    j = int(np.argmin(np.abs(p0.rpm - r0)))
+                    w = (q[2, j] - q[0, j]) / q[1, j]
+                    widths.setdefault((bn, sn), []).append(w)
+                    line.append(f"{w:.3f} [{q[0, j] / lim:.2f}, {q[2, j] / lim:.2f}]")
+            print(f"   {pr.name[:24]} truth {seed}: {r0:.0f} rpm, limit {1e3 * lim:.3f} mm: " + "; ".join(line),
+                  flush=True)
+        for (bn, sn), w in widths.items():
+            print(f"{pr.name[:40]:40s} {bn:36s} {sn:13s}: width median {np.median(w):.3f} (range "
+                  f"{min(w):.3f}–{max(w):.3f})", flush=True)
+
+
 def bench_heard(cases, library_prior=None, truths=12, seed_start=60):
     """What decides whether the whole loop's shop hears a cut past the limit as chatter: the label against three
     measures of how much chatter grew within the cut, ln(g t) — the zero-order κ times x = ln(a / a_SDM) (what
@@ -756,7 +807,7 @@ def main():
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", choices=("cut", "teeth", "twocut", "inside", "update", "sampler", "forward", "ceiling",
-                                       "sdm-bands", "heard"))
+                                       "sdm-bands", "heard", "bracket"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -814,6 +865,8 @@ def main():
         bench_ceiling(a.cases.split(","), a.library_prior)
     if a.only in (None, "heard"):
         bench_heard(a.cases.split(","), a.library_prior, 4 if a.quick else 12)
+    if a.only in (None, "bracket"):
+        bench_bracket(a.cases.split(","), a.library_prior, a.seeds, a.seed_start)
     if a.only in (None, "sampler"):
         bench_sampler()
     if a.only in (None, "sdm-bands"):

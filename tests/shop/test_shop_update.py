@@ -498,6 +498,28 @@ def test_a_spreadsheet_s_table_reads_as_the_plain_one(tmp_path):
         assert b[1].depth_m == pytest.approx(0.95e-3) and b[1].chatter_hz == 1290.5
 
 
+def test_a_spreadsheet_s_headers_with_units_read_as_the_table_s_names(tmp_path):
+    """"Spindle speed [rpm]", "Depth (mm)", "Chatter [Hz]" as a shop's sheet heads its columns: the same cuts; a depth
+    in µm or inches is refused naming the column (not converted by guess), and two columns of one name are refused."""
+    plain, sheet = tmp_path / "plain.csv", tmp_path / "sheet.csv"
+    plain.write_text("rpm,depth_mm,result,chatter_hz\n20000,0.5,stable,\n20000,0.95,chatter,1290.5\n")
+    sheet.write_text("Spindle speed [rpm],Depth (mm),Verdict,Chatter [Hz]\n20000,0.5,stable,\n20000,0.95,chatter,"
+                     "1290.5\n")
+    a, b = read_test_cuts(plain), read_test_cuts(sheet)
+    assert [(c.rpm, c.depth_m, c.stable, c.chatter_hz) for c in a] == \
+        [(c.rpm, c.depth_m, c.stable, c.chatter_hz) for c in b]
+    for head, match in (("rpm,depth [µm],result", "depth \\[µm\\].*give it in mm"),
+                        ("rpm,Depth (in),result", "in: give it in mm"),
+                        ("rpm,Speed [rpm],depth_mm,result", "'rpm' and 'Speed \\[rpm\\]' both give rpm")):
+        sheet.write_text(head + "\n20000,0.5,stable,stable\n")
+        with pytest.raises(InputError, match=match):
+            read_test_cuts(sheet)
+    # a cutting speed in m/min is not a spindle speed: not taken for one
+    sheet.write_text("Speed [m/min],depth_mm,result\n300,0.5,stable\n")
+    with pytest.raises(InputError, match="missing column 'rpm'"):
+        read_test_cuts(sheet)
+
+
 def test_a_depth_far_outside_the_prior_s_lobes_is_warned(tmp_path, capsys):
     """A depth typed in m into depth_mm (0.0005 for 0.5 mm) is 1/300 of the lobes: the label tells the posterior next
     to nothing, so the slip would pass unseen — said on stderr, naming the line; a plain table is not warned."""

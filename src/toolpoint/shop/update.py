@@ -177,12 +177,50 @@ class TestCut:
     ring_ln_sd: float | None = None
 
 
+# a spreadsheet's names for the test-cut table's columns (after ``_column_name``'s folding): name → the table's own
+_COLUMN_ALIASES = {
+    "rpm": ("speed_rpm", "spindle_speed_rpm", "spindle_rpm", "n_rpm", "speed_1/min", "spindle_speed_1/min",
+            "n_1/min", "rpm_rpm"),
+    "depth_mm": ("depth_mm_mm", "ap_mm", "a_p_mm", "axial_depth_mm", "depth_of_cut_mm", "doc_mm", "b_mm",
+                 "b_lim_mm"),
+    "result": ("verdict", "label", "outcome"),
+    "chatter_hz": ("chatter_hz_hz", "chatter_frequency_hz", "chatter_freq_hz", "f_chatter_hz", "f_c_hz"),
+    "duration_s": ("duration_s_s", "cut_duration_s", "cutting_time_s"),
+}
+_ALIAS = {a: name for name, aliases in _COLUMN_ALIASES.items() for a in aliases}
+_DEPTH_NAMES = ("depth", "ap", "a_p", "axial_depth", "depth_of_cut", "doc")
+
+
+def _column_name(header: str, path) -> str:
+    """The test-cut table's name for a column header: lower case, blanks as ``_``, a unit in brackets or parentheses
+    as a suffix (``"Depth [mm]"`` → ``"depth_mm"``, ``"Speed (rpm)"`` → ``"rpm"``); a depth in another unit than mm
+    is refused (:class:`InputError` naming the column), not converted by guess.
+
+    >>> _column_name("Depth [mm]", "t.csv"), _column_name("Spindle speed (rpm)", "t.csv"), _column_name("RESULT", "")
+    ('depth_mm', 'rpm', 'result')
+    """
+    h = header.strip().lower().replace("µ", "u").replace("μ", "u")
+    m = re.fullmatch(r"(.*?)\s*[\[(]\s*([^\])]*?)\s*[\])]", h)
+    if m:
+        h = f"{m.group(1)}_{m.group(2).replace(' ', '')}"
+    h = re.sub(r"[\s\-]+", "_", h.strip())
+    h = _ALIAS.get(h, h)
+    base, _, unit = h.rpartition("_")
+    if base in _DEPTH_NAMES and unit in ("um", "m", "in", "inch", "cm", "mil", "thou"):
+        raise InputError(f"column {header.strip()!r} gives the depth in {unit}: give it in mm (depth_mm)", file=path,
+                         field="depth_mm")
+    return h
+
+
 def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
     """Read a test-cut table: CSV ``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz``,
     ``duration_s`` (how long the tool cut, s), ``growth_per_s`` (how fast a chattering cut's chatter grew, 1/s:
     :mod:`toolpoint.shop.growth`), ``ring_per_s`` and ``ring_hz`` (a stable cut's ring: how fast its line at
     ``ring_hz`` decays, σ < 0 in 1/s, :func:`toolpoint.shop.growth.ring_decay`), ``record``, ``start_s`` and
-    ``end_s``; column names in any case,
+    ``end_s``; column names in any case, a unit in brackets read as the name's suffix and a spreadsheet's usual names
+    taken for the table's (``Spindle speed [rpm]`` is ``rpm``, ``Depth (mm)`` or ``ap [mm]`` is ``depth_mm``,
+    ``Verdict`` is ``result``, ``Chatter [Hz]`` is ``chatter_hz``: ``_COLUMN_ALIASES``; a depth in another unit is
+    refused),
     cells split at commas or (a spreadsheet's export with the decimal comma) semicolons
     (:func:`toolpoint.io.table.read_rows`).
 
@@ -205,9 +243,17 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
 
     p = Path(path)
     header, rows = read_table(p, what="the test-cut table")
-    # "RPM", "Depth_mm", "Result" as a spreadsheet capitalises them: the names are matched without case
-    header = [h.lower() for h in header]
-    rows = [(line, {(k.lower() if isinstance(k, str) else k): v for k, v in row.items()}) for line, row in rows]
+    # "RPM", "Depth [mm]", "Result" as a spreadsheet writes them: the names are matched without case, a unit in
+    # brackets is read as the name's suffix, and a depth in another unit is refused rather than guessed
+    names = {h: _column_name(h, p) for h in header}
+    seen: dict = {}
+    for h in header:
+        n = names[h]
+        if n and n in seen:  # one value per cut: a second column of the same name would silently win
+            raise InputError(f"columns {seen[n]!r} and {h!r} both give {n}", file=p, field=n)
+        seen[n] = h
+    header = [names[h] for h in header]
+    rows = [(line, {(names[k] if isinstance(k, str) else k): v for k, v in row.items()}) for line, row in rows]
     for need in ("rpm", "depth_mm"):
         if need not in header:
             raise InputError(f"missing column {need!r} (columns: {', '.join(header) or 'none'})", file=p, field=need)
