@@ -141,7 +141,10 @@ def run(args) -> int:
               and res.ring.resolved else "")
            + f"; spindle {res.rpm:.1f} rpm"
            + (f", its speed wandered ±{100 * res.criterion['speed_wander']:.2g} % (tracked)"
-              if res.criterion.get("speed_tracked") else ""))
+              if res.criterion.get("speed_tracked") else "")
+           + ("; left out " + " and ".join(f"{a:.1f}–{b:.1f} s" for a, b in res.criterion["spindle_off_s"])
+              + " (the spindle not at speed: starting, coasting or stopped)"
+              if res.criterion.get("spindle_off_s") else ""))
     print(msg, file=sys.stderr if out is None else sys.stdout)
     if len(res.cuts) > 1:  # a session's record: each cut's verdict
         print(f"{rec_path.name}: {len(res.cuts)} cuts: " + "; ".join(

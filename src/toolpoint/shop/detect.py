@@ -192,6 +192,15 @@ The detector (:func:`analyse_cut`):
    ("chatter at 1770.7 Hz", a machine line). Where the loud part's tooth passing stands ≤ 3 dB over noise and the
    quiet part's ≥ 4 dB and ≥ 3 dB further, the quiet part is the cut, unless the air this leaves holds the cut's lines
    off the spindle harmonics at all (≥ 6 dB over its floor): now chatter at 1067.4 Hz, the air first.
+   *A spindle not at speed.* A phone started before the spindle, or stopped after it, records the room's quiet, the
+   spindle running up and coasting down: a third level, under the air cut at speed, and the split by level took it
+   for the air and the air cut at speed for cutting — judged with no air to compare against, the machine's own lines
+   "chattered" (the real recording behind 2 s of room noise: its air was "chatter at 1069 Hz"). Each long frame's
+   spindle harmonics are read at the record's speed against the bins half-way between them (≥ 0.35 in ln over 0.5 s:
+   at speed; the real recording's air 0.6–1.1, its cut 0.7–2.3, a run-up, a coast-down and room noise −0.2–0.2).
+   A start and an end of ≥ 0.3 s not at speed are left out (``spindle_off_s``) where what is left holds a quiet level
+   (an air cut) of ≥ 0.5 s at speed and they lie ≥ 3 dB under it, and the judgement of what is left finds an air
+   cut; else the record is judged whole, as before (a spindle that air does not let one hear keeps its air).
 5. **once-per-revolution metric** (where the segment holds ≥ 10 revolutions): the signal resampled at
    64 points per revolution, R = 1 − E_sync/E_total (E_sync: energy of the revolution-synchronous mean,
    with its finite-average bias removed): 0 for a periodic (stable, noiseless) signal, → 1 for chatter
@@ -248,6 +257,8 @@ _CUT_PROMINENCE_DB = 4.0  # dB over noise: a quiet stretch whose tooth-passing h
 _AIR_EXCESS_DB = 3.0  # dB over noise: a loud part whose tooth-passing harmonics stand out no further has none …
 _SWAP_DB = 3.0  # … and a quiet part whose stand out this much further is the cut: a level upside down (see _split)
 _AIR_PROMINENCE_DB = 2.0  # a loud stretch whose tooth-passing harmonics stand out as in the air (± this): air
+_AT_SPEED_LN = 0.35  # ln: a frame's spindle harmonics stand this far out (their excess less the bins between them's):
+#   the spindle runs at the record's speed (see _at_speed_span; measured 0.6–2.3 at speed, −0.2–0.2 not)
 _OWN_LINE_DB = 20.0  # dB over its floor: a loud stretch's line this strong that the air lacks is no air's (_split)
 
 
@@ -343,7 +354,9 @@ class CutAnalysis:
         relative departure of the tracked spindle speed from its median over the cutting frames (0 where it
         could not be tracked), ``speed_tracked`` whether it exceeded the mask's 0.05 % and each judged part
         masked the speeds it ran at (module docstring, step 3); ``analysed_rate_hz`` the rate the spectra were
-        taken at (a record sampled above 50 kHz is decimated to 22–48 kHz first); ``warnings`` what the verdict
+        taken at (a record sampled above 50 kHz is decimated to 22–48 kHz first); ``digital_silence_s`` and
+        ``spindle_off_s`` the spans left out, s (the recorder's input not live; the spindle not at speed at the
+        record's start or end: module docstring, step 2); ``warnings`` what the verdict
         cannot rule out
         (chatter on a mains harmonic, 50 or 60 Hz × k within 2 Δf + 0.2 %, in a record without an air cut: hum
         from a ground loop is a steady tone there, and without the air cut only its strength is judged).
@@ -522,6 +535,92 @@ def _live_part(x, rate, source):
     return k0, k1
 
 
+def _spindle_evidence(P, freq, inband, f_nom, tol, df, hi):
+    """(the record's spindle frequency Hz, per long frame how far its spindle harmonics stand out, ln) or None where
+    the record's mean spectrum holds no comb of spindle harmonics within ``tol`` of ``f_nom``.
+
+    Per frame: the mean over the harmonics k f_s (up to min(``hi``, 40 f_nom)) of the largest log power over the floor
+    within ±max(2 bins, 0.2 % k f_s) of each — a loaded spindle slows by tenths of a percent — less the same statistic
+    half-way between them, ((k + ½) f_s): ≈ 0 on noise (the two are the same statistic of different bins), the
+    harmonics' excess where the spindle runs at f_s, ≈ 0 again where it runs up, coasts down or stands still."""
+    inb = np.flatnonzero(inband)
+    if inb.size < 3 * _BLOCK:
+        return None
+    mean_p = P.mean(axis=0)
+    logp = np.log(mean_p + 1e-300)
+    floor = np.log(_block_floor(mean_p[None, :], inband)[0] + 1e-300)
+    ftop = min(hi, 40 * f_nom)
+    step = df / (4 * max(1.0, ftop / f_nom))
+    f0s = np.arange(f_nom * (1 - tol), f_nom * (1 + tol) + step, step)
+    score = _comb_score(freq, logp, floor, f0s, ftop)
+    best = int(np.argmax(score))
+    if score[best] <= 0.5 or not 4 <= best < score.size - 4:  # the comb test of analyse_cut's step 1
+        return None
+    f_s = float(f0s[best])
+    k = np.arange(1, int(ftop / f_s) + 1, dtype=float)
+    k = k[(k * f_s >= freq[inb[0]]) & ((k + 0.5) * f_s <= freq[inb[-1]])]
+    if k.size < 3:
+        return None
+    half = np.maximum(2.0, 0.002 * k * f_s / df).astype(int)
+    lf = np.log(_block_floor(P, inband) + 1e-300)
+    ex = np.log(P + 1e-300) - lf
+
+    def stat(centres):
+        i = np.rint(centres / df).astype(int)
+        off = np.arange(-half.max(), half.max() + 1)
+        idx = np.clip(i[:, None] + off[None, :], 0, freq.size - 1)
+        inside = np.abs(off)[None, :] <= half[:, None]
+        v = np.where(inside[None, :, :], ex[:, idx], -np.inf)  # (frames, harmonics, bins)
+        return v.max(axis=2).mean(axis=1)
+
+    return f_s, stat(k * f_s) - stat((k + 0.5) * f_s)
+
+
+def _at_speed_span(P, frame_t, freq, inband, f_nom, tol, df, hi, frame_s, dur, activity_db):
+    """(start s, end s) of the record without its start and end where the spindle is not at speed, or None.
+
+    Not at speed: the spindle harmonics stand out of the frame by < ``_AT_SPEED_LN`` (:func:`_spindle_evidence`,
+    running median over 0.5 s) for ≥ 0.3 s from the record's start or up to its end, while the rest holds a quiet
+    level (the lower of two by :func:`_two_levels`: an air cut) of ≥ 0.5 s at speed, and the part left out lies
+    ≥ 3 dB under that level (median band power): a spindle running up or coasting is quieter than at speed. A record
+    whose spindle is not heard in air (its air cut's lines under the bar) keeps its air: the rest then holds no
+    quiet level at speed. Measured on the real recording behind a run-up and before a run-down (docs/design/shop.md,
+    *A spindle not at speed*): at speed 0.6–1.1 in air and 0.7–2.3 in the cut, not at speed −0.2–0.2."""
+    ev = _spindle_evidence(P, freq, inband, f_nom, tol, df, hi)
+    if ev is None or frame_t.size < 8:
+        return None
+    hop_s = float(np.median(np.diff(frame_t)))
+    d = median_filter(ev[1], max(3, int(round(0.5 / hop_s)) | 1), mode="nearest")
+    at = d >= _AT_SPEED_LN
+    if not at.any():
+        return None
+    j0, j1 = int(np.argmax(at)), int(at.size - np.argmax(at[::-1]))  # the first and one past the last at speed
+    # from the centre of the first frame at speed to that of the last: the frames reaching further hold both
+    lead = float(frame_t[j0]) if j0 > 0 else 0.0
+    trail = float(frame_t[j1 - 1]) if j1 < at.size else dur
+    if lead < 0.3 and dur - trail < 0.3:
+        return None
+    lead, trail = (lead if lead >= 0.3 else 0.0), (trail if dur - trail >= 0.3 else dur)
+    lvl = 10 * np.log10(P[:, inband].sum(axis=1) + 1e-300)
+    mid = (frame_t - 0.5 * frame_s >= lead) & (frame_t + 0.5 * frame_s <= trail)  # wholly inside, and outside:
+    off = (frame_t + 0.5 * frame_s <= lead) | (frame_t - 0.5 * frame_s >= trail)
+    if not off.any():
+        off = (frame_t < lead) | (frame_t > trail)
+    n_min = max(2, int(round(0.5 / hop_s)))
+    if mid.sum() < 2 * n_min:
+        return None
+    split = _two_levels(lvl[mid], n_min, activity_db)
+    if split is None:
+        return None
+    quiet = mid.copy()
+    quiet[mid] = ~split[0]
+    if (quiet & at).sum() < n_min:  # the air cut is not at speed (or not heard): it stays the reference
+        return None
+    if np.median(lvl[off]) > np.median(lvl[quiet & at]) - 3.0:
+        return None
+    return float(lead), float(trail)
+
+
 def _stft(x, L, hop, chunk=1 << 21):
     """Power spectra of Hann-windowed frames, (frames, bins), scaled to a one-sided PSD in (unit²/Hz)·rate.
 
@@ -693,7 +792,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 band_hz: tuple | None = None, window_s: float = 1.0, activity_db: float = 4.0,
                 rise_db: float = 10.0, dominance: float = 0.05, alias_dominance: float = 0.002,
                 growth_db: float = 6.0, alpha: float = _ALPHA, full_scale: float | None = None,
-                source: str | None = None, span_s: tuple | None = None, hump_db: float = _HUMP_DB) -> CutAnalysis:
+                source: str | None = None, span_s: tuple | None = None, hump_db: float = _HUMP_DB,
+                _at_speed: bool = False) -> CutAnalysis:
     """Judge a record of a milling cut: stable or chatter, per segment, with the chatter frequency.
 
     Parameters
@@ -768,7 +868,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     >>> res.verdict, round(res.chatter_hz)
     ('chatter', 1234)
     """
-    x = np.asarray(samples, float)
+    x = x_in = np.asarray(samples, float)
     kw = dict(rpm=rpm, teeth=teeth, rpm_tolerance=rpm_tolerance, band_hz=band_hz, window_s=window_s,
               activity_db=activity_db, rise_db=rise_db, dominance=dominance, alias_dominance=alias_dominance,
               growth_db=growth_db, alpha=alpha, full_scale=full_scale, source=source, hump_db=hump_db)
@@ -789,9 +889,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 f"the part {a:g}–{min(b, dur):.4g} s holds no air cut: its verdict rests on the cut alone (a chatter "
                 "line must stand out by its own strength, aliases or growth, not by rising over the air); where the "
                 "record has air cut before and after this cut, take it in (the cuts' part_s in cut.json)")]
-        if "digital_silence_s" in crit:
-            crit["digital_silence_s"] = [[u + a, v + a] for u, v in crit["digital_silence_s"]]
-        return _shifted(res, a, crit)
+        return _shifted(res, a, _spans_shifted(crit, a))
     check_record(x, rate_hz, rpm, teeth, full_scale=full_scale, source=source)
     if not (isinstance(alpha, (int, float, np.floating)) and 0 < alpha < 1):
         raise InputError(f"must be a probability in (0, 1), got {alpha!r}", file=source, field="alpha")
@@ -806,7 +904,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         # it — as the low level of the record it made the air cut look like cutting — and the times kept the record's
         res = analyse_cut(x[k0:k1], rate_hz, **kw)
         t0 = k0 / float(rate_hz)
-        return _shifted(res, t0, dict(res.criterion, digital_silence_s=[[0.0, round(t0, 4)], [
+        return _shifted(res, t0, dict(_spans_shifted(res.criterion, t0), digital_silence_s=[[0.0, round(t0, 4)], [
             round(k1 / rate_hz, 4), round(x.size / rate_hz, 4)]]))
     rate = float(rate_hz)
     # a DAQ's 51.2–192 kHz holds nothing the test looks at above its band (≤ 10 kHz): decimated by q to ≥ 22.2 kHz
@@ -837,6 +935,20 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     if inband.sum() < 3 * _BLOCK:
         raise InputError(f"the band {lo:.4g}–{hi:.4g} Hz holds only {int(inband.sum())} frequency lines at this "
                          "record length", file=source, field="band_hz")
+
+    if not _at_speed and rpm_tolerance > 0:
+        # the spindle starting, coasting down or standing still at the record's start or end (a phone started before
+        # the spindle, stopped after it): quieter than the air cut at speed, and as the low level of the record it
+        # made that air cut look like cutting, judged with no air to compare against (the real recording behind 2 s
+        # of room noise: its air "chatter at 1069 Hz"). Judged without it where the rest holds an air cut at speed
+        span = _at_speed_span(P, frame_t, freq, inband, f_nom, rpm_tolerance, df, hi, L / rate, dur, activity_db)
+        if span is not None:
+            r0 = float(rate_hz)
+            i0, i1 = int(round(span[0] * r0)), min(x_in.size, int(round(span[1] * r0)))
+            sub = analyse_cut(x_in[i0:i1], rate_hz, **kw, _at_speed=True)
+            if any(g.kind == "air" for g in sub.segments):
+                off = [[round(a, 4), round(b, 4)] for a, b in ((0.0, i0 / r0), (i1 / r0, x_in.size / r0)) if b > a]
+                return _shifted(sub, i0 / r0, dict(_spans_shifted(sub.criterion, i0 / r0), spindle_off_s=off))
 
     # 1. segments: air cut vs cutting
     active, cand, finish, swap, short_t, min_air = _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth,
@@ -1492,6 +1604,16 @@ def _harmonic_mask(freq, inband, f_lo, f_hi, df):
     pad = 2 * df + _MASK_REL * freq
     near = (k >= 1) & (freq >= k * f_lo - pad) & (freq <= k * f_hi + pad)
     return inband & ~near, inband & near
+
+
+def _spans_shifted(criterion: dict, t0: float) -> dict:
+    """``criterion`` of a part of a record that starts at ``t0`` s, its spans of what was left out (digital silence,
+    the spindle not at speed) in the record's times."""
+    out = dict(criterion)
+    for key in ("digital_silence_s", "spindle_off_s"):
+        if key in out:
+            out[key] = [[round(u + t0, 4), round(v + t0, 4)] for u, v in out[key]]
+    return out
 
 
 def _shifted(res: CutAnalysis, t0: float, criterion: dict) -> CutAnalysis:
