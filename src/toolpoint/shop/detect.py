@@ -562,18 +562,16 @@ def _spindle_evidence(P, freq, inband, f_nom, tol, df, hi):
     if k.size < 3:
         return None
     half = np.maximum(2.0, 0.002 * k * f_s / df).astype(int)
-    lf = np.log(_block_floor(P, inband) + 1e-300)
-    ex = np.log(P + 1e-300) - lf
-
-    def stat(centres):
-        i = np.rint(centres / df).astype(int)
-        off = np.arange(-half.max(), half.max() + 1)
-        idx = np.clip(i[:, None] + off[None, :], 0, freq.size - 1)
-        inside = np.abs(off)[None, :] <= half[:, None]
-        v = np.where(inside[None, :, :], ex[:, idx], -np.inf)  # (frames, harmonics, bins)
-        return v.max(axis=2).mean(axis=1)
-
-    return f_s, stat(k * f_s) - stat((k + 0.5) * f_s)
+    off = np.arange(-half.max(), half.max() + 1)
+    inside = np.abs(off)[None, :] <= half[:, None]
+    idx = [np.clip(np.rint(c / df).astype(int)[:, None] + off[None, :], 0, freq.size - 1)
+           for c in (k * f_s, (k + 0.5) * f_s)]
+    out = np.empty(P.shape[0])
+    for s in range(0, P.shape[0], 256):  # frames a chunk at a time: a 10 min record's spectra are ~0.4 GB already
+        ex = np.log(P[s:s + 256] + 1e-300) - np.log(_block_floor(P[s:s + 256], inband) + 1e-300)
+        on, mid = (np.where(inside[None], ex[:, i], -np.inf).max(axis=2).mean(axis=1) for i in idx)
+        out[s:s + 256] = on - mid
+    return f_s, out
 
 
 def _at_speed_span(P, frame_t, freq, inband, f_nom, tol, df, hi, frame_s, dur, activity_db):
