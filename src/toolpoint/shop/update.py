@@ -179,8 +179,8 @@ class TestCut:
 
 # a spreadsheet's names for the test-cut table's columns (after ``_column_name``'s folding): name → the table's own
 _COLUMN_ALIASES = {
-    "rpm": ("speed_rpm", "spindle_speed_rpm", "spindle_rpm", "n_rpm", "speed_1/min", "spindle_speed_1/min",
-            "n_1/min", "rpm_rpm"),
+    "rpm": tuple(f"{n}_{u}" for n in ("rpm", "speed", "spindle_speed", "spindle", "n", "s")
+                 for u in ("rpm", "1/min", "min^_1", "min_1", "u/min")),
     "depth_mm": ("depth_mm_mm", "ap_mm", "a_p_mm", "axial_depth_mm", "depth_of_cut_mm", "doc_mm", "b_mm",
                  "b_lim_mm"),
     "result": ("verdict", "label", "outcome"),
