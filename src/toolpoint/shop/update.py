@@ -181,8 +181,7 @@ class TestCut:
 _COLUMN_ALIASES = {
     "rpm": tuple(f"{n}_{u}" for n in ("rpm", "speed", "spindle_speed", "spindle", "n", "s")
                  for u in ("rpm", "1/min", "min^_1", "min_1", "u/min")),
-    "depth_mm": ("depth_mm_mm", "ap_mm", "a_p_mm", "axial_depth_mm", "depth_of_cut_mm", "doc_mm", "b_mm",
-                 "b_lim_mm"),
+    "depth_mm": ("depth_mm_mm", "ap_mm", "a_p_mm", "axial_depth_mm", "depth_of_cut_mm", "doc_mm", "b_mm"),
     "result": ("verdict", "label", "outcome"),
     "chatter_hz": ("chatter_hz_hz", "chatter_frequency_hz", "chatter_freq_hz", "f_chatter_hz", "f_c_hz"),
     "duration_s": ("duration_s_s", "cut_duration_s", "cutting_time_s"),
