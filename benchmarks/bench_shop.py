@@ -866,7 +866,7 @@ def main():
     if a.only in (None, "heard"):
         bench_heard(a.cases.split(","), a.library_prior, 4 if a.quick else 12)
     if a.only in (None, "bracket"):
-        bench_bracket(a.cases.split(","), a.library_prior, a.seeds, a.seed_start)
+        bench_bracket(a.cases.split(","), a.library_prior, 2 if a.quick else a.seeds, a.seed_start)
     if a.only in (None, "sampler"):
         bench_sampler()
     if a.only in (None, "sdm-bands"):
