@@ -535,6 +535,15 @@ def _live_part(x, rate, source):
     return k0, k1
 
 
+def _comb_search(freq, logp, floor, f_nom, tol, df, hi):
+    """(candidate spindle frequencies within ``tol`` of ``f_nom``, a quarter bin apart at the highest harmonic; the
+    comb score of each, :func:`_comb_score`; the highest harmonic's frequency searched, min(``hi``, 40 f_nom))."""
+    ftop = min(hi, 40 * f_nom)
+    step = df / (4 * max(1.0, ftop / f_nom))
+    f0s = np.arange(f_nom * (1 - tol), f_nom * (1 + tol) + step, step)
+    return f0s, _comb_score(freq, logp, floor, f0s, ftop), ftop
+
+
 def _spindle_evidence(P, freq, inband, f_nom, tol, df, hi):
     """(the record's spindle frequency Hz, per long frame how far its spindle harmonics stand out, ln) or None where
     the record's mean spectrum holds no comb of spindle harmonics within ``tol`` of ``f_nom``.
@@ -549,10 +558,7 @@ def _spindle_evidence(P, freq, inband, f_nom, tol, df, hi):
     mean_p = P.mean(axis=0)
     logp = np.log(mean_p + 1e-300)
     floor = np.log(_block_floor(mean_p[None, :], inband)[0] + 1e-300)
-    ftop = min(hi, 40 * f_nom)
-    step = df / (4 * max(1.0, ftop / f_nom))
-    f0s = np.arange(f_nom * (1 - tol), f_nom * (1 + tol) + step, step)
-    score = _comb_score(freq, logp, floor, f0s, ftop)
+    f0s, score, ftop = _comb_search(freq, logp, floor, f_nom, tol, df, hi)
     best = int(np.argmax(score))
     if score[best] <= 0.5 or not 4 <= best < score.size - 4:  # the comb test of analyse_cut's step 1
         return None
@@ -1010,10 +1016,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         mean_p, logp, floor = spectrum(frames)
         rev_s = None
         if rpm_tolerance > 0:
-            ftop = min(hi, 40 * f_nom)
-            step = df / (4 * max(1.0, ftop / f_nom))
-            f0s = np.arange(f_nom * (1 - rpm_tolerance), f_nom * (1 + rpm_tolerance) + step, step)
-            score = _comb_score(freq, logp, floor, f0s, ftop)
+            f0s, score, _ = _comb_search(freq, logp, floor, f_nom, rpm_tolerance, df, hi)
             best = int(np.argmax(score))
             f_s = float(f0s[best])
             # the comb's mean log-excess: e^0.5, 2.2 dB over the floor. A best comb at the range's edge is the flank
