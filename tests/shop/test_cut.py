@@ -1169,3 +1169,53 @@ def test_a_spindle_the_air_does_not_let_one_hear_keeps_its_air():
         assert "spindle_off_s" not in res.criterion
         assert res.segments[0].kind == "air" and res.segments[-1].kind == "air"
         assert res.verdict == ("stable" if chatter is None else "chatter")
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_spindle_stopped_between_two_cuts_is_left_out(seed):
+    """One record of a session: a stable cut, the spindle coasting down, 1 s standing still, running up again, and a
+    cut that chatters at 1234 Hz. Before, the stop was the quietest level, so it became the air cut and the air at
+    speed "cutting": the fans (617 and 1813 Hz) of the air chattered, the first cut was not found as a cut. The stop is
+    left out and the two stretches at speed are judged together: two cuts, the first stable, the second chatter, at
+    their own times in the record."""
+    x1, rate, a0, a1 = shop_record(rpm=6000.0, teeth=4, air_s=2.0, cut_s=2.0, seed=seed)
+    x2, _, b0, b1 = shop_record(rpm=6000.0, teeth=4, air_s=2.0, cut_s=2.0, chatter_hz=1234.0, chatter_amp=0.5,
+                                seed=seed + 10)
+    air = np.tile(x1[:int(a0 * rate)], 3)
+    room = 0.002 * np.random.default_rng(seed).standard_normal(int(1.0 * rate))
+    stop = np.r_[_spin(air, rate, 3.0, False), room, _spin(air, rate, 3.0, True)]
+    res = analyse_cut(np.r_[x1, stop, x2], rate, rpm=6000, teeth=4, full_scale=1.0)
+    t2 = (x1.size + stop.size) / rate  # where the second record starts
+    (u, v), = res.criterion["spindle_off_s"]
+    assert u == pytest.approx(x1.size / rate, abs=0.3) and v == pytest.approx(t2, abs=0.3)
+    cuts = res.cuts
+    assert [c[2] for c in cuts] == ["stable", "chatter"], cuts
+    assert cuts[1][3] == pytest.approx(1234.0, rel=0.01)
+    assert res.verdict == "chatter" and res.chatter_hz == pytest.approx(1234.0, rel=0.01)
+    # each cut where it lies (its entry from the tool's entry to its exit's end, within a frame's quarter)
+    assert cuts[0][:2] == pytest.approx((a0, a1), abs=0.1)
+    assert cuts[1][:2] == pytest.approx((t2 + b0, t2 + b1), abs=0.1)
+    assert all(not (u < s.start_s < v or u < s.end_s < v) for s in res.segments)  # nothing judged in the stop
+    assert np.all(np.diff(res.time_s) > 0) and not np.any((res.time_s > u + 0.3) & (res.time_s < v - 0.3))
+
+
+def test_the_real_recording_twice_with_the_spindle_stopped_between():
+    """The real recording's first 25 s (air, a cut that chatters, air), the spindle stopped (a 3 s coast-down of its
+    air, 1.5 s of room noise, a 3 s run-up), and the same 25 s again: each copy reads as the record alone. Before, the
+    second copy's air at speed was "chatter at 1069 Hz" and its air after the cut "chatter at 2330 Hz"."""
+    rec = read_cut_record(REAL)
+    rate = rec.rate_hz
+    x = rec.samples[:int(25 * rate)]
+    air = rec.samples[int(25 * rate):int(40 * rate)]
+    room = 0.002 * np.random.default_rng(1).standard_normal(int(1.5 * rate))
+    stop = np.r_[_spin(air, rate, 3.0, False), room, _spin(air, rate, 3.0, True)]
+    plain = analyse_cut(x, rate, rpm=6500, teeth=2, full_scale=1.0)
+    res = analyse_cut(np.r_[x, stop, x], rate, rpm=6500, teeth=2, full_scale=1.0)
+    t2 = (x.size + stop.size) / rate
+    (u, v), = res.criterion["spindle_off_s"]
+    assert u == pytest.approx(x.size / rate, abs=0.5) and v == pytest.approx(t2, abs=0.5)
+    assert len(res.cuts) == 2 and [c[2] for c in res.cuts] == ["chatter", "chatter"]
+    for (a, b, _, hz), shift in zip(res.cuts, (0.0, t2)):
+        (pa, pb, _, phz), = plain.cuts
+        assert a - shift == pytest.approx(pa, abs=0.05) and b - shift == pytest.approx(pb, abs=0.05)
+        assert hz == pytest.approx(phz, rel=2e-3)

@@ -198,9 +198,12 @@ The detector (:func:`analyse_cut`):
    "chattered" (the real recording behind 2 s of room noise: its air was "chatter at 1069 Hz"). Each long frame's
    spindle harmonics are read at the record's speed against the bins half-way between them (≥ 0.35 in ln over 0.5 s:
    at speed; the real recording's air 0.6–1.1, its cut 0.7–2.3, a run-up, a coast-down and room noise −0.2–0.2).
-   A start and an end of ≥ 0.3 s not at speed are left out (``spindle_off_s``) where what is left holds a quiet level
-   (an air cut) of ≥ 0.5 s at speed and they lie ≥ 3 dB under it, and the judgement of what is left finds an air
-   cut; else the record is judged whole, as before (a spindle that air does not let one hear keeps its air).
+   A start and an end of ≥ 0.3 s not at speed, and a stop of ≥ 1 s between two stretches at speed (a session's record:
+   the spindle stopped and started again between two cuts), are left out (``spindle_off_s``) where what is left holds
+   a quiet level (an air cut) of ≥ 0.5 s at speed and they lie ≥ 3 dB under it, and the judgement of what is left
+   finds an air cut; else the record is judged whole, as before (a spindle that air does not let one hear keeps its
+   air). The stretches at speed are judged as one record, joined by a 20 ms equal-power cross-fade, and their times
+   are the record's again (a segment across a join is split there; the figure leaves the stop blank).
 5. **once-per-revolution metric** (where the segment holds ≥ 10 revolutions): the signal resampled at
    64 points per revolution, R = 1 − E_sync/E_total (E_sync: energy of the revolution-synchronous mean,
    with its finite-average bias removed): 0 for a periodic (stable, noiseless) signal, → 1 for chatter
@@ -258,7 +261,9 @@ _AIR_EXCESS_DB = 3.0  # dB over noise: a loud part whose tooth-passing harmonics
 _SWAP_DB = 3.0  # … and a quiet part whose stand out this much further is the cut: a level upside down (see _split)
 _AIR_PROMINENCE_DB = 2.0  # a loud stretch whose tooth-passing harmonics stand out as in the air (± this): air
 _AT_SPEED_LN = 0.35  # ln: a frame's spindle harmonics stand this far out (their excess less the bins between them's):
-#   the spindle runs at the record's speed (see _at_speed_span; measured 0.6–2.3 at speed, −0.2–0.2 not)
+#   the spindle runs at the record's speed (see _at_speed_spans; measured 0.6–2.3 at speed, −0.2–0.2 not)
+_STOP_MIN_S = 1.0  # s: the least stop between two stretches at speed left out — a coast-down and a run-up take
+#   seconds, and a shorter dip of the harmonics' evidence is not a spindle stopped
 _OWN_LINE_DB = 20.0  # dB over its floor: a loud stretch's line this strong that the air lacks is no air's (_split)
 
 
@@ -356,7 +361,7 @@ class CutAnalysis:
         masked the speeds it ran at (module docstring, step 3); ``analysed_rate_hz`` the rate the spectra were
         taken at (a record sampled above 50 kHz is decimated to 22–48 kHz first); ``digital_silence_s`` and
         ``spindle_off_s`` the spans left out, s (the recorder's input not live; the spindle not at speed at the
-        record's start or end: module docstring, step 2); ``warnings`` what the verdict
+        record's start or end, or stopped between two cuts: module docstring, step 2); ``warnings`` what the verdict
         cannot rule out
         (chatter on a mains harmonic, 50 or 60 Hz × k within 2 Δf + 0.2 %, in a record without an air cut: hum
         from a ground loop is a steady tone there, and without the air cut only its strength is judged).
@@ -580,16 +585,19 @@ def _spindle_evidence(P, freq, inband, f_nom, tol, df, hi):
     return f_s, out
 
 
-def _at_speed_span(P, frame_t, freq, inband, f_nom, tol, df, hi, frame_s, dur, activity_db):
-    """(start s, end s) of the record without its start and end where the spindle is not at speed, or None.
+def _at_speed_spans(P, frame_t, freq, inband, f_nom, tol, df, hi, frame_s, dur, activity_db):
+    """The record's stretches with the spindle at speed, [(start s, end s), …], once its start, its end and its
+    stops between cuts where the spindle is not at speed are left out; or None where nothing is left out.
 
     Not at speed: the spindle harmonics stand out of the frame by < ``_AT_SPEED_LN`` (:func:`_spindle_evidence`,
-    running median over 0.5 s) for ≥ 0.3 s from the record's start or up to its end, while the rest holds a quiet
-    level (the lower of two by :func:`_two_levels`: an air cut) of ≥ 0.5 s at speed, and the part left out lies
-    ≥ 3 dB under that level (median band power): a spindle running up or coasting is quieter than at speed. A record
-    whose spindle is not heard in air (its air cut's lines under the bar) keeps its air: the rest then holds no
-    quiet level at speed. Measured on the real recording behind a run-up and before a run-down (docs/design/shop.md,
-    *A spindle not at speed*): at speed 0.6–1.1 in air and 0.7–2.3 in the cut, not at speed −0.2–0.2."""
+    running median over 0.5 s) for ≥ 0.3 s from the record's start or up to its end, or for ≥ ``_STOP_MIN_S``
+    between two stretches at speed (the spindle stopped between two cuts: a coast-down, the room, a run-up), while
+    the rest holds a quiet level (the lower of two by :func:`_two_levels`: an air cut) of ≥ 0.5 s at speed, and each
+    part left out lies ≥ 3 dB under that level (median band power): a spindle running up, coasting or standing still
+    is quieter than at speed. A record whose spindle is not heard in air (its air cut's lines under the bar) keeps
+    its air: the rest then holds no quiet level at speed. Measured on the real recording behind a run-up and before a
+    run-down (docs/design/shop.md, *A spindle not at speed*): at speed 0.6–1.1 in air and 0.7–2.3 in the cut, not at
+    speed −0.2–0.2."""
     ev = _spindle_evidence(P, freq, inband, f_nom, tol, df, hi)
     if ev is None or frame_t.size < 8:
         return None
@@ -598,18 +606,26 @@ def _at_speed_span(P, frame_t, freq, inband, f_nom, tol, df, hi, frame_s, dur, a
     at = d >= _AT_SPEED_LN
     if not at.any():
         return None
-    j0, j1 = int(np.argmax(at)), int(at.size - np.argmax(at[::-1]))  # the first and one past the last at speed
-    # from the centre of the first frame at speed to that of the last: the frames reaching further hold both
-    lead = float(frame_t[j0]) if j0 > 0 else 0.0
-    trail = float(frame_t[j1 - 1]) if j1 < at.size else dur
-    if lead < 0.3 and dur - trail < 0.3:
+    # runs of frames not at speed, as spans of time from the centre of the last frame at speed before to that of the
+    # first after (the frames reaching further hold both); the record's ends where the run reaches them
+    edges = np.flatnonzero(np.diff(np.r_[True, at, True].astype(int)))
+    gaps = []
+    for j0, j1 in zip(edges[0::2], edges[1::2]):  # frames j0 … j1 − 1 not at speed
+        a = 0.0 if j0 == 0 else float(frame_t[j0 - 1])
+        b = dur if j1 == at.size else float(frame_t[j1])
+        if b - a >= (0.3 if j0 == 0 or j1 == at.size else _STOP_MIN_S):
+            gaps.append((a, b))
+    if not gaps:
         return None
-    lead, trail = (lead if lead >= 0.3 else 0.0), (trail if dur - trail >= 0.3 else dur)
     lvl = 10 * np.log10(P[:, inband].sum(axis=1) + 1e-300)
-    mid = (frame_t - 0.5 * frame_s >= lead) & (frame_t + 0.5 * frame_s <= trail)  # wholly inside, and outside:
-    off = (frame_t + 0.5 * frame_s <= lead) | (frame_t - 0.5 * frame_s >= trail)
-    if not off.any():
-        off = (frame_t < lead) | (frame_t > trail)
+    half = 0.5 * frame_s
+    off = np.zeros(frame_t.size, bool)
+    inside = []  # per gap, the frames wholly inside it (else its frames' centres)
+    for a, b in gaps:
+        w = (frame_t - half >= a) & (frame_t + half <= b)
+        inside.append(w if w.any() else (frame_t > a) & (frame_t < b))
+        off |= (frame_t + half > a) & (frame_t - half < b)
+    mid = ~off
     n_min = max(2, int(round(0.5 / hop_s)))
     if mid.sum() < 2 * n_min:
         return None
@@ -620,9 +636,18 @@ def _at_speed_span(P, frame_t, freq, inband, f_nom, tol, df, hi, frame_s, dur, a
     quiet[mid] = ~split[0]
     if (quiet & at).sum() < n_min:  # the air cut is not at speed (or not heard): it stays the reference
         return None
-    if np.median(lvl[off]) > np.median(lvl[quiet & at]) - 3.0:
+    air_db = np.median(lvl[quiet & at])
+    gaps = [g for g, w in zip(gaps, inside) if w.any() and np.median(lvl[w]) <= air_db - 3.0]
+    if not gaps:
         return None
-    return float(lead), float(trail)
+    keep, t = [], 0.0
+    for a, b in gaps:
+        if a > t:
+            keep.append((t, a))
+        t = b
+    if t < dur:
+        keep.append((t, dur))
+    return keep or None
 
 
 def _stft(x, L, hop, chunk=1 << 21):
@@ -942,17 +967,22 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
 
     if not _at_speed and rpm_tolerance > 0:
         # the spindle starting, coasting down or standing still at the record's start or end (a phone started before
-        # the spindle, stopped after it): quieter than the air cut at speed, and as the low level of the record it
-        # made that air cut look like cutting, judged with no air to compare against (the real recording behind 2 s
-        # of room noise: its air "chatter at 1069 Hz"). Judged without it where the rest holds an air cut at speed
-        span = _at_speed_span(P, frame_t, freq, inband, f_nom, rpm_tolerance, df, hi, L / rate, dur, activity_db)
-        if span is not None:
+        # the spindle, stopped after it), or between two cuts (stopped and started again): quieter than the air cut
+        # at speed, and as the low level of the record it made that air cut look like cutting, judged with no air to
+        # compare against (the real recording behind 2 s of room noise: its air "chatter at 1069 Hz"; two simulated
+        # cuts with the spindle stopped between them: the stop's fans "chatter at 1813 Hz"). Judged without it — the
+        # stretches at speed spliced — where they hold an air cut at speed
+        spans = _at_speed_spans(P, frame_t, freq, inband, f_nom, rpm_tolerance, df, hi, L / rate, dur, activity_db)
+        if spans is not None:
             r0 = float(rate_hz)
-            i0, i1 = int(round(span[0] * r0)), min(x_in.size, int(round(span[1] * r0)))
-            sub = analyse_cut(x_in[i0:i1], rate_hz, **kw, _at_speed=True)
+            idx = [(int(round(a * r0)), min(x_in.size, int(round(b * r0)))) for a, b in spans]
+            y, starts, xf = _splice(x_in, r0, idx)
+            sub = analyse_cut(y, rate_hz, **kw, _at_speed=True)
             if any(g.kind == "air" for g in sub.segments):
-                off = [[round(a, 4), round(b, 4)] for a, b in ((0.0, i0 / r0), (i1 / r0, x_in.size / r0)) if b > a]
-                return _shifted(sub, i0 / r0, dict(_spans_shifted(sub.criterion, i0 / r0), spindle_off_s=off))
+                kept = [(i0 / r0, i1 / r0) for i0, i1 in idx]
+                ends = [0.0, *(t for sp in kept for t in sp), x_in.size / r0]
+                off = [[round(a, 4), round(b, 4)] for a, b in zip(ends[0::2], ends[1::2]) if b > a]
+                return _unspliced(sub, kept, starts, xf, dict(sub.criterion, spindle_off_s=off))
 
     # 1. segments: air cut vs cutting
     active, cand, finish, swap, short_t, min_air = _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth,
@@ -1624,6 +1654,52 @@ def _shifted(res: CutAnalysis, t0: float, criterion: dict) -> CutAnalysis:
     if gr is not None and gr.start_s is not None:
         gr = replace(gr, start_s=gr.start_s + t0, end_s=gr.end_s + t0)
     return replace(res, segments=segs, criterion=criterion, time_s=res.time_s + t0, growth=gr)
+
+
+def _splice(x, rate, pieces, xfade_s=0.02):
+    """(the pieces ``x[i0:i1]`` joined, each start in the joined record s, the cross-fade s): one piece as it is;
+    several cross-faded over ``xfade_s`` at equal power (sin/cos weights: two uncorrelated signals keep their level,
+    and the spindle's lines, whose phase jumps at the join, are not cut by a click across every band)."""
+    if len(pieces) == 1:
+        i0, i1 = pieces[0]
+        return x[i0:i1], [0.0], 0.0
+    n = max(1, min(int(round(xfade_s * rate)), *((i1 - i0) // 4 for i0, i1 in pieces)))
+    w = np.sin(0.5 * np.pi * (np.arange(n) + 0.5) / n)
+    out, starts, pos = [], [], 0
+    for i0, i1 in pieces:
+        seg = np.array(x[i0:i1], float)
+        if out:
+            prev = out[-1]
+            prev[-n:] = prev[-n:] * w[::-1] + seg[:n] * w
+            seg = seg[n:]
+            pos -= n
+        starts.append(pos / rate)
+        out.append(seg)
+        pos += i1 - i0
+    return np.concatenate(out), starts, n / rate
+
+
+def _unspliced(res: CutAnalysis, kept, starts, xfade_s, criterion: dict) -> CutAnalysis:
+    """``res`` of the stretches ``kept`` (start s, end s in the record) joined by :func:`_splice` (each start in the
+    joined record ``starts``), its times the record's again: a time in the joined record belongs to the piece it lies
+    in, up to the middle of the cross-fade, and a segment across a join is split there."""
+    starts = np.asarray(starts, float)
+    joins = starts[1:] + 0.5 * xfade_s
+    shift = np.array([a for a, _ in kept]) - starts
+
+    def at(tau):
+        return np.asarray(tau, float) + shift[np.searchsorted(joins, tau, side="right")]
+
+    segs = []
+    for g in res.segments:
+        cuts = [g.start_s, *(j for j in joins if g.start_s < j < g.end_s), g.end_s]
+        for u, v in zip(cuts[:-1], cuts[1:]):
+            piece = int(np.searchsorted(joins, 0.5 * (u + v), side="right"))
+            segs.append(replace(g, start_s=float(u + shift[piece]), end_s=float(v + shift[piece])))
+    gr = res.growth
+    if gr is not None and gr.start_s is not None:
+        gr = replace(gr, start_s=float(at(gr.start_s)), end_s=float(at(gr.end_s)))
+    return replace(res, segments=tuple(segs), criterion=criterion, time_s=at(res.time_s), growth=gr)
 
 
 def _one_speed(runs, f_s, f_nom, rpm, tol, teeth, frames_in, spectrum, freq, inband, df, source) -> None:
@@ -2387,8 +2463,18 @@ def plot_cut(res: CutAnalysis, *, fmax_hz: float | None = None, title: str = "",
     ax, ax2 = fig.subplots(2, 1, height_ratios=(3, 2))
     fig.subplots_adjust(top=0.86, hspace=0.35)
     top = np.percentile(db, 99.9)
-    mesh = ax.pcolormesh(t[::step], f, db, shading="nearest", vmin=top - 70, vmax=top, cmap="magma",
+    tc = t[::step]
+    if tc.size > 2:  # a stretch left out (the spindle stopped between two cuts): blank, not the frames beside it drawn
+        h = float(np.median(np.diff(tc)))  # over it (shading "nearest" reaches half-way to the next frame)
+        gap = np.flatnonzero(np.diff(tc) > 3 * h)
+        tc = np.insert(tc, np.repeat(gap + 1, 2), np.column_stack([tc[gap] + h, tc[gap + 1] - h]).ravel())
+        db = np.insert(db, np.repeat(gap + 1, 2), np.nan, axis=1)
+    mesh = ax.pcolormesh(tc, f, np.ma.masked_invalid(db), shading="nearest", vmin=top - 70, vmax=top, cmap="magma",
                          rasterized=True)
+    for a, b in res.criterion.get("spindle_off_s", ()):
+        ax.axvspan(a, b, color="0.85", zorder=0)
+        ax.text(0.5 * (a + b), 0.5, "spindle\nnot at\nspeed", transform=blended_transform_factory(ax.transData,
+                ax.transAxes), ha="center", va="center", fontsize=7, color="0.3")
     # the colour bar beside the spectrogram, not taken from its width: both panels share one frequency scale width
     fig.colorbar(mesh, cax=ax.inset_axes([1.01, 0.0, 0.015, 1.0]), label="power, dB")
 
@@ -2420,7 +2506,8 @@ def plot_cut(res: CutAnalysis, *, fmax_hz: float | None = None, title: str = "",
     ax.set_xlabel("time, s")
     ax.set_ylabel("frequency, Hz")
     ax.set_ylim(0, fmax)
-    ax.set_xlim(0, max([t[-1]] + [s.end_s for s in res.segments]))
+    ax.set_xlim(0, max([t[-1]] + [s.end_s for s in res.segments] + [b for _, b in res.criterion.get("spindle_off_s",
+                                                                                                     ())]))
 
     def mean_db(kinds, verdicts):
         sel = np.zeros(t.size, bool)
