@@ -1511,3 +1511,36 @@ def test_cli_update_says_when_a_cut_lies_off_the_lobes_or_its_chatter_off_the_mo
     assert len(err) == 2, err
     assert "line 2" in err[0] and "outside the speeds of the lobes" in err[0]
     assert "line 3" in err[1] and "50000.0 Hz lies far from every mode" in err[1]
+
+
+def test_a_record_at_another_speed_than_its_row_s_rpm(tmp_path):
+    """A row's rpm and its record's speed disagree (an override, a slipping belt, a typo). Beyond ``cut``'s search
+    range (±3 %) the record is judged at a speed it did not run at: before, a stable cut at 6000 rpm given as 6600 read
+    "chatter" (its own tooth passing, 36 dB out) and sat at 6600 rpm in the lobes with a warning; now the row is
+    refused, naming both speeds. Within the range, the cut is placed at the speed the record ran at, and said so."""
+    import soundfile as sf
+
+    from shop_synth import shop_record
+
+    for name, chat in (("s.wav", None), ("c.wav", 1234.0)):
+        x, rate, *_ = shop_record(rpm=6000.0, teeth=4, cut_s=2.0, chatter_hz=chat, chatter_amp=0.5, seed=3)
+        sf.write(tmp_path / name, (0.5 * x / np.abs(x).max()).astype(np.float32), int(rate))
+    p = tmp_path / "cuts.csv"
+    for rpm in (6600, 5400):
+        p.write_text(f"rpm,depth_mm,result,record\n6000,1.0,,c.wav\n{rpm},0.5,,s.wav\n")
+        with pytest.raises(InputError, match=rf"line 3: the table says {rpm} rpm, its record s.wav ran at 600\d rpm"
+                                             r" \([-+]\d+\.\d %") as exc:
+            read_test_cuts(p, teeth=4)
+        assert exc.value.field == "rpm"
+    p.write_text("rpm,depth_mm,result,record\n6120,1.0,,c.wav\n5900,0.5,,s.wav\n6010,0.6,,s.wav\n")
+    cuts = read_test_cuts(p, teeth=4)
+    assert [c.stable for c in cuts] == [False, True, True]
+    assert [c.rpm for c in cuts[:2]] == [pytest.approx(6000.0, rel=1e-3)] * 2 and cuts[2].rpm == 6010
+    assert "ran at 6000 rpm, -2.0 % from the table's 6120 rpm" in cuts[0].warnings[0]
+    assert "+1.7 % from the table's 5900 rpm" in cuts[1].warnings[0] and cuts[2].warnings == ()
+    # the CLI: one line, exit 2, nothing written
+    p.write_text("rpm,depth_mm,result,record\n6600,0.5,,s.wav\n")
+    out = tmp_path / "out"
+    assert main(["update", "--prior", str(Path(__file__).parents[2] / "examples" / "shop" / "cornelius_prior.toml"),
+                 "--cuts", str(p), "--out", str(out)]) == 2
+    assert not out.exists()

@@ -125,6 +125,10 @@ __all__ = ["DEFAULT_RISK", "GROWTH_ERROR", "PRECURSOR", "RING_ERROR", "TestCut",
            "check_consistent", "log_likelihood", "noisy_shop", "update"]
 
 
+_RPM_AGREE = 0.005
+"""A record's spindle speed (``cut``'s, from its harmonics) further than this from its row's rpm moves the cut there:
+a spindle at load runs within tenths of a percent of its command, an override or a slipping belt further."""
+
 DEFAULT_RISK = {"info": 0.3, "risk": 0.1}
 """The default bound on the next cut's P(chatter) of each next-cut rule (module docstring)."""
 
@@ -227,7 +231,11 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
     ``teeth``): it gives ``result``, ``chatter_hz``, ``growth_per_s`` and a stable cut's ring (where resolved) where
     the table leaves them empty, and
     ``duration_s`` (its longest run of entry, cut and exit); where both are given and disagree the table is refused (a
-    contradiction is reported, not averaged). ``start_s`` and ``end_s`` (s from the record's start; either may be
+    contradiction is reported, not averaged). The record's spindle speed (from its harmonics) places the cut where it
+    differs from the row's ``rpm`` by more than 0.5 % (said in the cut's warnings: an override, a slipping belt); a
+    record whose tooth passing stands out at a speed beyond ``cut``'s search range (±3 %) is refused, naming both
+    speeds (judged at the row's speed its own tooth passing can read as chatter). ``start_s`` and ``end_s`` (s from
+    the record's start; either may be
     empty: its start, its end) name the part of the record that holds the row's cut, as ``toolpoint cut --start
     --end`` does: a shop that records a session of cuts in one file gives each cut its own row and part. What the
     analysis cannot rule out (chatter on a mains harmonic in a record without an air cut) stays with the cut
@@ -338,6 +346,19 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                 a = None  # the table's own label stands, and the user hears why the record did not count
                 warns = (f"its record {what} was not judged ({why}); the table's '{res}' stands",)
         if rec and a is not None:
+            ran = a.criterion.get("speed_elsewhere_rpm")
+            if ran is not None:
+                # judged at a speed it did not run at, its own tooth passing can be the "chatter" (a stable record at
+                # 6000 rpm given 6600: "chatter" 36 dB out) and the cut would sit at the wrong speed in the lobes
+                raise InputError(f"line {line}: the table says {rpm:g} rpm, its record {what} ran at {ran:.0f} rpm "
+                                 f"({100 * (ran / rpm - 1):+.1f} %, by its tooth-passing harmonics): put the speed the "
+                                 f"spindle ran at in rpm (an override?); if it did run at {rpm:g} rpm, heavy chatter "
+                                 "made that comb: give the row its result without the record", file=p, field="rpm")
+            if abs(a.rpm / rpm - 1) > _RPM_AGREE:
+                # within cut's search range but not the speed typed: the cut happened at the speed the record ran at
+                warns += (f"{what}: the spindle ran at {a.rpm:.0f} rpm, {100 * (a.rpm / rpm - 1):+.1f} % from the "
+                          f"table's {rpm:g} rpm (by its harmonics): the cut is placed at {a.rpm:.0f} rpm",)
+                rpm = float(a.rpm)
             if res and res != a.verdict:
                 # what `cut` doubted of the record may be the contradiction's cause (a wrong tooth count makes the
                 # cutter's own tooth harmonics "chatter"): the refusal says it, so `cut` need not be run to find it
@@ -354,7 +375,7 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                 dur = _cutting_s(a)
             if ring is None:
                 ring, ring_hz, ring_sd = ring_fields(a).values()
-            warns = tuple(f"{what}: {w}" for w in a.criterion.get("warnings", ()))
+            warns += tuple(f"{what}: {w}" for w in a.criterion.get("warnings", ()))
             if len({v for *_, v, _ in a.cuts}) > 1:  # a row is one cut; its record holds cuts that disagree
                 warns += (f"{what}: the {'record' if span is None else 'part'} holds {len(a.cuts)} cuts ("
                           + "; ".join(f"{ta:.1f}–{tb:.1f} s {v}" for ta, tb, v, _ in a.cuts)
