@@ -1516,8 +1516,10 @@ def test_cli_update_says_when_a_cut_lies_off_the_lobes_or_its_chatter_off_the_mo
 def test_a_record_at_another_speed_than_its_row_s_rpm(tmp_path):
     """A row's rpm and its record's speed disagree (an override, a slipping belt, a typo). Beyond ``cut``'s search
     range (±3 %) the record is judged at a speed it did not run at: before, a stable cut at 6000 rpm given as 6600 read
-    "chatter" (its own tooth passing, 36 dB out) and sat at 6600 rpm in the lobes with a warning; now the row is
-    refused, naming both speeds. Within the range, the cut is placed at the speed the record ran at, and said so."""
+    "chatter" (its own tooth passing at 400 Hz, 36 dB out) and sat at 6600 rpm in the lobes with a warning; now the row
+    is refused, naming both speeds, unless its result confirms the record's reading (heavy chatter at the right speed
+    makes such a comb on an accelerometer). Within the range, the cut is placed at the speed the record ran at, and
+    said so."""
     import soundfile as sf
 
     from shop_synth import shop_record
@@ -1528,10 +1530,15 @@ def test_a_record_at_another_speed_than_its_row_s_rpm(tmp_path):
     p = tmp_path / "cuts.csv"
     for rpm in (6600, 5400):
         p.write_text(f"rpm,depth_mm,result,record\n6000,1.0,,c.wav\n{rpm},0.5,,s.wav\n")
-        with pytest.raises(InputError, match=rf"line 3: the table says {rpm} rpm, its record s.wav ran at 600\d rpm"
-                                             r" \([-+]\d+\.\d %") as exc:
+        said = (rf"line 3: its record s.wav ran at 600\d rpm by its tooth-passing harmonics \([-+]\d+\.\d % from the "
+                rf"table's {rpm} rpm\), and its 'chatter' at 400\.\d Hz is a tooth-passing harmonic of 600\d rpm")
+        with pytest.raises(InputError, match=said) as exc:
             read_test_cuts(p, teeth=4)
         assert exc.value.field == "rpm"
+    # the row's result confirms the record's reading: kept, with cut's warning of the other speed
+    p.write_text("rpm,depth_mm,result,record\n6600,0.5,chatter,s.wav\n")
+    (c,) = read_test_cuts(p, teeth=4)
+    assert not c.stable and c.rpm == 6600 and any("6002 rpm" in w for w in c.warnings), c.warnings
     p.write_text("rpm,depth_mm,result,record\n6120,1.0,,c.wav\n5900,0.5,,s.wav\n6010,0.6,,s.wav\n")
     cuts = read_test_cuts(p, teeth=4)
     assert [c.stable for c in cuts] == [False, True, True]

@@ -364,7 +364,10 @@ class CutAnalysis:
         (None where that test cannot run: fewer than 3 teeth, or no air cut); ``speed_wander`` the largest
         relative departure of the tracked spindle speed from its median over the cutting frames (0 where it
         could not be tracked), ``speed_tracked`` whether it exceeded the mask's 0.05 % and each judged part
-        masked the speeds it ran at (module docstring, step 3); ``analysed_rate_hz`` the rate the spectra were
+        masked the speeds it ran at (module docstring, step 3); ``spindle_heard`` whether its harmonics stood out
+        within ``rpm_tolerance`` of the speed given (else the record was judged at that speed on a strong chatter
+        line alone, and warned of); ``speed_elsewhere_rpm`` a speed outside it where the tooth-passing harmonics
+        stand out far more (None: none); ``analysed_rate_hz`` the rate the spectra were
         taken at (a record sampled above 50 kHz is decimated to 22–48 kHz first); ``digital_silence_s`` and
         ``spindle_off_s`` the spans left out, s (the recorder's input not live; the spindle not at speed at the
         record's start or end, or stopped between two cuts: module docstring, step 2); ``warnings`` what the verdict
@@ -1333,6 +1336,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                  "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None,
                  "speed_wander": round(wander, 6), "speed_tracked": track is not None,
                  "speed_elsewhere_rpm": None if elsewhere is None else round(60 * elsewhere[0], 1),
+                 "spindle_heard": bool(spindle_found),
                  "analysed_rate_hz": rate, "warnings": warns}
     res = CutAnalysis(verdict, chatter_hz, tuple(segments), float(rpm), 60 * f_s, int(teeth), rec,
                       alts, criterion, frame_t, freq, P)

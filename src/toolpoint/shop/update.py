@@ -215,6 +215,13 @@ def _column_name(header: str, path) -> str:
     return h
 
 
+def _on_tooth_passing(f_hz: float, rpm: float, teeth: int) -> bool:
+    """Whether ``f_hz`` lies on a tooth-passing harmonic k N rpm / 60 (k ≥ 1), within max(3 Hz, 0.3 %)."""
+    f_t = teeth * rpm / 60.0
+    k = round(f_hz / f_t)
+    return k >= 1 and abs(f_hz - k * f_t) <= max(3.0, 0.003 * f_hz)
+
+
 def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_options: dict | None = None) -> list:
     """Read a test-cut table: CSV ``rpm, depth_mm, result`` (stable|chatter), optional ``chatter_hz``,
     ``duration_s`` (how long the tool cut, s), ``growth_per_s`` (how fast a chattering cut's chatter grew, 1/s:
@@ -232,9 +239,13 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
     the table leaves them empty, and
     ``duration_s`` (its longest run of entry, cut and exit); where both are given and disagree the table is refused (a
     contradiction is reported, not averaged). The record's spindle speed (from its harmonics) places the cut where it
-    differs from the row's ``rpm`` by more than 0.5 % (said in the cut's warnings: an override, a slipping belt); a
-    record whose tooth passing stands out at a speed beyond ``cut``'s search range (±3 %) is refused, naming both
-    speeds (judged at the row's speed its own tooth passing can read as chatter). ``start_s`` and ``end_s`` (s from
+    differs from the row's ``rpm`` by more than 0.5 % (said in the cut's warnings: an override, a slipping belt). A
+    record whose tooth passing stands out at a speed beyond ``cut``'s search range (±3 %) and whose "chatter" is a
+    tooth-passing harmonic of that speed, or whose spindle is not heard at the row's speed, is refused, naming both
+    speeds, unless the row's ``result`` confirms the record's reading: judged at a speed it did not run at, its own
+    tooth passing reads as chatter (simulated records given ±10 %: 398 of the 412 wrong verdicts on a microphone,
+    308 of 325 on a housing accelerometer), and heavy chatter at the right speed makes such a comb on an
+    accelerometer (48 of 576 records; 0 of 576 on a microphone). ``start_s`` and ``end_s`` (s from
     the record's start; either may be
     empty: its start, its end) name the part of the record that holds the row's cut, as ``toolpoint cut --start
     --end`` does: a shop that records a session of cuts in one file gives each cut its own row and part. What the
@@ -347,13 +358,19 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                 warns = (f"its record {what} was not judged ({why}); the table's '{res}' stands",)
         if rec and a is not None:
             ran = a.criterion.get("speed_elsewhere_rpm")
-            if ran is not None:
-                # judged at a speed it did not run at, its own tooth passing can be the "chatter" (a stable record at
-                # 6000 rpm given 6600: "chatter" 36 dB out) and the cut would sit at the wrong speed in the lobes
-                raise InputError(f"line {line}: the table says {rpm:g} rpm, its record {what} ran at {ran:.0f} rpm "
-                                 f"({100 * (ran / rpm - 1):+.1f} %, by its tooth-passing harmonics): put the speed the "
-                                 f"spindle ran at in rpm (an override?); if it did run at {rpm:g} rpm, heavy chatter "
-                                 "made that comb: give the row its result without the record", file=p, field="rpm")
+            on_ran = a.chatter_hz is not None and ran is not None and _on_tooth_passing(a.chatter_hz, ran, a.teeth)
+            if ran is not None and not res and (on_ran or not a.criterion.get("spindle_heard", True)):
+                # judged at a speed it did not run at, its own tooth passing is the "chatter" (a stable record at 6000
+                # rpm given as 6600: "chatter at 400 Hz", 36 dB out) and the cut sits at the wrong speed in the lobes.
+                # Heavy chatter at the right speed can look the same on a housing accelerometer (48 of 576 simulated
+                # records; none of 576 on a microphone): the row's own result confirms the record's reading
+                why = (f"its 'chatter' at {a.chatter_hz:.1f} Hz is a tooth-passing harmonic of {ran:.0f} rpm" if on_ran
+                       else f"no spindle harmonics stand out at {rpm:g} rpm")
+                raise InputError(f"line {line}: its record {what} ran at {ran:.0f} rpm by its tooth-passing harmonics "
+                                 f"({100 * (ran / rpm - 1):+.1f} % from the table's {rpm:g} rpm), and {why}: put the "
+                                 f"speed the spindle ran at in rpm (an override?); if it did run at {rpm:g} rpm (heavy "
+                                 "chatter makes such a comb), confirm the record's reading in the row's result",
+                                 file=p, field="rpm")
             if abs(a.rpm / rpm - 1) > _RPM_AGREE:
                 # within cut's search range but not the speed typed: the cut happened at the speed the record ran at
                 warns += (f"{what}: the spindle ran at {a.rpm:.0f} rpm, {100 * (a.rpm / rpm - 1):+.1f} % from the "
