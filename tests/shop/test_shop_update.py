@@ -173,8 +173,8 @@ def test_the_next_cut_lasts_long_enough_for_slow_chatter_to_be_heard(tmp_path, c
     chatter 5 % past the limit grows by e^G̃ within it — the duration the time-domain test above hears (on one 750 Hz
     mode of ζ 0.5 %, κ ≈ ζω_n: about 2 s against a 1 s default; speeds 16000–18000 rpm, between its pockets — at a
     pocket's peak the chatter sits off the resonance and grows at ~1000 /s). Never shorter than the cuts so far,
-    never lengthened past the cap; a well-damped tool's cuts (Cornelius, κ ≈ 400 /s) keep the default; 0 (the
-    default) proposes the cuts' own length."""
+    never lengthened past the cap; a well-damped tool's cuts (Cornelius, κ ≈ 400 /s) keep the default; 0 proposes
+    the cuts' own length. The default margin, 0.025 (since 2026-12-01), asks for twice as long as 0.05."""
     from toolpoint.shop.model import growth_rate
 
     one, th = _one_slow_mode()
@@ -191,6 +191,9 @@ def test_the_next_cut_lasts_long_enough_for_slow_chatter_to_be_heard(tmp_path, c
         "duration_s"] == pytest.approx(1.2)
     off = update(one, [], **dict(kw, rng=np.random.default_rng(0), audible_margin=0.0)).next_cut
     assert off["duration_s"] == 1.0 and not off["duration_by_growth"]
+    dflt = update(one, [], **{k: v for k, v in dict(kw, rng=np.random.default_rng(0)).items() if k != "audible_margin"})
+    assert dflt.next_cut["duration_s"] == pytest.approx(2.5 / (dflt.next_cut["growth_rate_p25_per_s"] * 0.025),
+                                                        rel=1e-9) and 3.0 < dflt.next_cut["duration_s"] < 5.0
     # cuts of 8 s so far: the next lasts as long (the 5 s cap bounds the lengthening, not the cuts made)
     cut = TestCut(nc["rpm"], 0.5 * nc["depth_m"], True, duration_s=8.0)
     assert update(one, [cut], **dict(kw, rng=np.random.default_rng(0))).next_cut["duration_s"] == pytest.approx(8.0)
@@ -202,8 +205,11 @@ def test_the_next_cut_lasts_long_enough_for_slow_chatter_to_be_heard(tmp_path, c
     toml = tmp_path / "slow.toml"
     toml.write_text(PRIOR_TOML.split("[[mode]]")[0].replace("rpm_min = 5000", "rpm_min = 16000").replace(
         "rpm_max = 25000", "rpm_max = 18000") + "[[mode]]\nfreq_hz = 750\nstiffness_n_m = 2e7\ndamping = 0.005\n")
-    assert main([*UPDATE_ZOA, "--prior", str(toml), "--out", str(tmp_path / "d"), "--samples", "100"]) == 0
-    assert "for at least 1.0 s" in capsys.readouterr().out  # by default as long as the cuts so far (none: 1 s)
+    assert main([*UPDATE_ZOA, "--prior", str(toml), "--out", str(tmp_path / "d"), "--samples", "100",
+                 "--audible-margin", "0"]) == 0
+    assert "for at least 1.0 s" in capsys.readouterr().out  # margin 0: as long as the cuts so far (none: 1 s)
+    assert main([*UPDATE_ZOA, "--prior", str(toml), "--out", str(tmp_path / "e"), "--samples", "100"]) == 0
+    assert float(capsys.readouterr().out.split("for at least ")[1].split(" s")[0]) > 3.0  # the default, 0.025
     assert main([*UPDATE_ZOA, "--prior", str(toml), "--out", str(tmp_path / "o"), "--samples", "100",
                  "--audible-margin", "0.05"]) == 0
     printed = capsys.readouterr().out

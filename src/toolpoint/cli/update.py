@@ -84,8 +84,8 @@ def register(sub) -> None:
                    "(default 1; shorter is the safer guess)")
     p.add_argument("--audible-margin", metavar="LN",
                    help="propose the next cut longer than the cuts so far where chatter grows slowly, so that chatter "
-                   "LN past the limit (e.g. 0.05) grows audibly within it (default 0: as long as the cuts so far; "
-                   "measured a trade: a narrower band sooner, more chattering cuts, docs/design/shop.md)")
+                   "LN past the limit grows audibly within it (default 0.025: 3-4 s on a lightly damped mode, "
+                   "a well-damped tool's cuts unchanged; 0: as long as the cuts so far; docs/design/shop.md)")
     p.add_argument("--max-cut-duration",
                    help="with --audible-margin: the longest next test cut proposed, s (default 5)")
     p.add_argument("--forward", choices=("sdm", "zoa"), default="sdm",
