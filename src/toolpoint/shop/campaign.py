@@ -6,8 +6,11 @@ Loop (seeded by one ``numpy.random.Generator``):
 2. update the prior with the cuts so far (:func:`toolpoint.shop.update.update`), propose the next cut;
 3. stop when the posterior 5–95 % band holds the true limit at ≥ ``coverage`` of the speeds and its relative
    width (a₉₅ − a₀₅)/a₅₀ at the recommended speed is ≤ ``width`` — or after ``max_cuts``;
-4. make the proposed cut with ``shop(theta_true, rpm, depth_m, rng, duration_s) -> TestCut`` (``duration_s`` None:
-   the shop's usual cut; the proposal's where ``update``'s ``audible_margin`` lengthened it) and go to 2.
+4. make the proposed cut with ``shop(theta_true, rpm, depth_m, rng, duration_s) -> TestCut``, ``duration_s`` the
+   proposal's (``next_cut["duration_s"]``: the cuts' own median, lengthened where ``update``'s ``audible_margin``
+   asks), as a user who follows every proposal cuts (the CLI prints "for at least … s"), and go to 2. Until
+   2026-12-01 the shop cut its usual length unless the proposal was lengthened, so a proposal after a lengthened
+   cut (the cuts' median, itself long) was made short.
 
 Shops: :func:`zoa_shop` labels a cut by the true zero-order limit (and gives the true chatter frequency) —
 the update's own forward model, a check of the sampler and the rule; :func:`simulated_shop` makes the cut in
@@ -207,9 +210,8 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
         if n == max_cuts:
             break
         nc = post.next_cut
-        # the shop makes its usual cut unless the proposal asks for a longer one (update's audible_margin)
-        cuts.append(shop(theta_true, nc["rpm"], nc["depth_m"], rng,
-                         nc["duration_s"] if nc.get("duration_by_growth") else None))
+        # at least as long as proposed: the duration the rule's expected outcomes assumed
+        cuts.append(shop(theta_true, nc["rpm"], nc["depth_m"], rng, nc["duration_s"]))
     chat = sum(not c.stable for c in (cuts if converged is None else cuts[:converged]))
     return CampaignResult(np.asarray(theta_true), tuple(cuts), converged, chat, tuple(cov_h), tuple(wid_h),
                           tuple(cpu), tuple(below), tuple(near_h), tuple(away_h))
