@@ -901,7 +901,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         line-heard gate (2026-12-01, ``docs/design/shop.md``, *The lead measured on every case*), 0.025 converged
         within 6 cuts for 49 of 100 campaigns on EM12-60's truths 20–79 against 24 of 60 with 0, with a median of
         1 chattering cut (at most one in 59 of 100 against 46 of 60) and the recommended depth above the truth after
-        4.2 % of the updates against 5.6 % (it claims 5 %); the other tools' cuts are not lengthened. Those runs'
+        4.2 % of the updates against 5.6 % (it claims 5 %); EM16-50's, EM28-80's and the two-mode case's cuts are
+        not lengthened (the example tool's, three lightly damped modes, are). Those runs'
         shop cut a proposal as long as asked only where it was lengthened; cutting every proposal as long as asked
         (*The virtual shop cuts as long as proposed*), 37 of 60 converged within 6 cuts, 39 of 60 had at most one
         chattering cut, and the recommended depth lay above the truth after 2.2 % of the updates. 0 proposes the
