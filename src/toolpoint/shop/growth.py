@@ -238,6 +238,13 @@ class RingDecay:
         a steady tone — a chatter's limit cycle, or a ring that decays slower than the record can tell.
     reason : str or None
         Why the rate was not read.
+    late_power_ratio : float or None
+        The line's power (its bins, the floor subtracted) in the part's second half over that in its first half:
+        about 1 for a ring the cutting noise sustains, e^{σT} for a kick (the entry's) that decays over the part.
+        None where the rate was not read, or the line stands above the floor in neither half.
+    sustained : bool or None
+        ``late_power_ratio`` ≥ :data:`SUSTAINED_MIN`: the line rings through the part, as the cutting noise makes it
+        ring — not a kick dying away, which any cut's entry gives. None where the ratio was not read.
     """
 
     rate_per_s: float | None
@@ -245,18 +252,30 @@ class RingDecay:
     freq_hz: float | None = None
     resolved: bool = False
     reason: str | None = None
+    late_power_ratio: float | None = None
+    sustained: bool | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dict."""
         def r(v, n=3):
             return None if v is None else float(round(v, n))
         return {"rate_per_s": r(self.rate_per_s, 2), "ln_sd": r(self.ln_sd), "freq_hz": r(self.freq_hz, 2),
-                "resolved": bool(self.resolved), "reason": self.reason}
+                "resolved": bool(self.resolved), "reason": self.reason,
+                "late_power_ratio": r(self.late_power_ratio), "sustained": self.sustained}
 
 
 _RING_MIN_S = 0.2  # s of cut, at least, to read a ring
 _RING_MAX_S = 8.0  # s: the middle of a longer part is read
 _RING_MIN_RATE = 0.3  # 1/s: the fit's lower bound on |σ| (a steady tone reads there)
+SUSTAINED_MIN = 0.1
+"""The least ratio of a ring's power in the second half of the part to that in the first (:class:`RingDecay`'s
+``late_power_ratio``) that counts as sustained. A ring the noise drives has ratio 1 in expectation, scattered as an F
+ratio with ~2|σ|T/π degrees of freedom a half; a kick decaying at σ over the part has e^{σT}, and a kick the fit
+calls resolved (|σ|T ≥ 1 as read) decays far faster than it reads — the Whittle fit assumes a stationary line, and a
+tapered transient looks narrower than it is (a kick of −20 /s read −3 to −8 /s). Measured (2026-12-01, the
+``_sdof`` records of ``tests/shop/test_ring.py``, 60 seeds each): noise-driven modes over σT = −6 to −83 gave ratios
+of 0.088 at the least, 1 of 360 below 0.1 (σT = −5.9); kicks of −20 /s over 1 s 0.000–0.006 in 12 of 12.
+Measured: ``tests/shop/test_ring.py``."""
 
 
 def ring_decay(samples, rate_hz: float, *, rpm: float, teeth: int, line_hz: float, start_s: float,
@@ -417,4 +436,37 @@ def ring_decay(samples, rate_hz: float, *, rpm: float, teeth: int, line_hz: floa
         sd = math.sqrt(v) if v > 0 else None
     except np.linalg.LinAlgError:
         sd = None
-    return RingDecay(-sig, sd, f0, bool(sig * Tm >= 1.0))
+    late = _late_power_ratio(z, rd, B, float(p[1]), sig, fh - f_p)
+    return RingDecay(-sig, sd, f0, bool(sig * Tm >= 1.0), late_power_ratio=late,
+                     sustained=None if late is None else bool(late >= SUSTAINED_MIN))
+
+
+def _late_power_ratio(z, rd: float, B: float, d_hz: float, sig: float, harm_hz) -> float | None:
+    """The line's power in the second half of the baseband series ``z`` (sampled at ``rd`` Hz, the line at ``d_hz``,
+    its half-width σ/2π) over that in the first: each half's Hann periodogram summed over the line's bins (within
+    3 half-widths, at least 3 bins), less the floor there (the mean of the bins 6 half-widths or more from the line
+    within ±B, away from the spindle harmonics ``harm_hz``). None where neither half holds the line above its
+    floor; 0 where the second half does not (a kick that died away); inf where only the second half does."""
+    h = z.size // 2
+    if h < 16:
+        return None
+    f = np.fft.fftfreq(h, 1.0 / rd)
+    df = rd / h
+    hw = max(3.0 * sig / (2 * np.pi), 3.0 * df)
+    away = np.ones(h, bool)
+    for fh in np.atleast_1d(harm_hz):
+        away &= np.abs(f - fh) > 2.0 * df
+    line = (np.abs(f - d_hz) <= hw) & away
+    floor = (np.abs(f) < B) & (np.abs(f - d_hz) >= 2.0 * hw) & away
+    if int(line.sum()) < 1 or int(floor.sum()) < 8:
+        return None
+    w = np.hanning(h)
+    w /= math.sqrt(float(np.sum(w * w)))
+    pw = []
+    for zz in (z[:h], z[h:2 * h]):
+        ii = np.abs(np.fft.fft(w * zz)) ** 2
+        pw.append(float(np.sum(ii[line]) - line.sum() * np.mean(ii[floor])))
+    p1, p2 = (max(v, 0.0) for v in pw)
+    if p1 <= 0 and p2 <= 0:
+        return None
+    return math.inf if p1 <= 0 else p2 / p1

@@ -417,11 +417,13 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
 
 def ring_fields(analysis) -> dict:
     """A stable verdict's ring as :class:`TestCut`'s ``ring_per_s``, ``ring_hz`` and ``ring_ln_sd`` (None each
-    where :func:`toolpoint.shop.analyse_cut` read none, or an unresolved line: as narrow as a steady tone, it says no
-    rate)."""
+    where :func:`toolpoint.shop.analyse_cut` read none; an unresolved line: as narrow as a steady tone, it says no
+    rate; or a line that dies away over the cut — the entry's kick, not a ring the cutting noise sustains
+    (:attr:`~toolpoint.shop.growth.RingDecay.sustained`): its rate, read as a stationary line's, is not its decay,
+    and it says nothing of the shop's noise (:func:`noisy_shop`))."""
     rg = analysis.ring
     ok = (analysis.verdict == "stable" and rg is not None and rg.rate_per_s is not None and rg.resolved
-          and rg.freq_hz is not None)
+          and rg.freq_hz is not None and rg.sustained is not False)
     return {"ring_per_s": rg.rate_per_s if ok else None, "ring_hz": rg.freq_hz if ok else None,
             "ring_ln_sd": rg.ln_sd if ok else None}
 
