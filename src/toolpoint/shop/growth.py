@@ -245,6 +245,10 @@ class RingDecay:
     sustained : bool or None
         ``late_power_ratio`` ≥ :data:`SUSTAINED_MIN`: the line rings through the part, as the cutting noise makes it
         ring — not a kick dying away, which any cut's entry gives. None where the ratio was not read.
+    peak_to_floor : float or None
+        The fitted line's peak over the fitted floor (power ratio): where it is under :data:`RING_MIN_PEAK_DB` the
+        "line" is a bump of the record's noise, not a mode ringing (``docs/design/shop.md``, *An entry's kick is no
+        ring*).
     """
 
     rate_per_s: float | None
@@ -254,6 +258,7 @@ class RingDecay:
     reason: str | None = None
     late_power_ratio: float | None = None
     sustained: bool | None = None
+    peak_to_floor: float | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dict."""
@@ -261,12 +266,19 @@ class RingDecay:
             return None if v is None else float(round(v, n))
         return {"rate_per_s": r(self.rate_per_s, 2), "ln_sd": r(self.ln_sd), "freq_hz": r(self.freq_hz, 2),
                 "resolved": bool(self.resolved), "reason": self.reason,
-                "late_power_ratio": r(self.late_power_ratio), "sustained": self.sustained}
+                "late_power_ratio": r(self.late_power_ratio), "sustained": self.sustained,
+                "peak_to_floor_db": None if not self.peak_to_floor else r(10 * math.log10(self.peak_to_floor), 1)}
 
 
 _RING_MIN_S = 0.2  # s of cut, at least, to read a ring
 _RING_MAX_S = 8.0  # s: the middle of a longer part is read
 _RING_MIN_RATE = 0.3  # 1/s: the fit's lower bound on |σ| (a steady tone reads there)
+RING_MIN_PEAK_DB = 10.0
+"""The least height of a ring's fitted line over its fitted floor, dB, for the line to be a mode ringing rather than a
+bump of the record's noise. Measured (2026-12-01): noise-driven modes (``tests/shop/test_ring.py``'s ``_sdof``, 36
+records) 26.6 dB and up; the rings of the benchmark shop's stable cuts with 5 % force noise (two-mode case, 45) 16 dB
+and up; "lines" the fit found in pink noise alone (6 of 20 records) 5.2–7.5 dB, and the one EM16-50 whole-loop ring
+that turned the precursor on in a shop without force noise 5.4 dB."""
 SUSTAINED_MIN = 0.1
 """The least ratio of a ring's power in the second half of the part to that in the first (:class:`RingDecay`'s
 ``late_power_ratio``) that counts as sustained. A ring the noise drives has ratio 1 in expectation, scattered as an F
@@ -437,8 +449,12 @@ def ring_decay(samples, rate_hz: float, *, rpm: float, teeth: int, line_hz: floa
     except np.linalg.LinAlgError:
         sd = None
     late = _late_power_ratio(z, rd, B, float(p[1]), sig, fh - f_p)
+    # the fitted line's peak over the fitted floor (the expected periodogram's, without the floor, at its maximum)
+    r_fit = math.exp(p[0]) * np.exp((-sig + 2j * np.pi * float(p[1])) * tau) * cw
+    peak = float(np.max(2 * np.real(np.fft.fft(r_fit)) - r_fit[0].real))
     return RingDecay(-sig, sd, f0, bool(sig * Tm >= 1.0), late_power_ratio=late,
-                     sustained=None if late is None else bool(late >= SUSTAINED_MIN))
+                     sustained=None if late is None else bool(late >= SUSTAINED_MIN),
+                     peak_to_floor=peak / math.exp(p[3]))
 
 
 def _late_power_ratio(z, rd: float, B: float, d_hz: float, sig: float, harm_hz) -> float | None:

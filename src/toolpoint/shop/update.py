@@ -420,10 +420,14 @@ def ring_fields(analysis) -> dict:
     where :func:`toolpoint.shop.analyse_cut` read none; an unresolved line: as narrow as a steady tone, it says no
     rate; or a line that dies away over the cut — the entry's kick, not a ring the cutting noise sustains
     (:attr:`~toolpoint.shop.growth.RingDecay.sustained`): its rate, read as a stationary line's, is not its decay,
-    and it says nothing of the shop's noise (:func:`noisy_shop`))."""
+    and it says nothing of the shop's noise (:func:`noisy_shop`); or a "line" less than
+    :data:`~toolpoint.shop.growth.RING_MIN_PEAK_DB` over its floor — a bump of the record's noise)."""
+    from .growth import RING_MIN_PEAK_DB
+
     rg = analysis.ring
     ok = (analysis.verdict == "stable" and rg is not None and rg.rate_per_s is not None and rg.resolved
-          and rg.freq_hz is not None and rg.sustained is not False)
+          and rg.freq_hz is not None and rg.sustained is not False
+          and (rg.peak_to_floor is None or rg.peak_to_floor >= 10 ** (RING_MIN_PEAK_DB / 10)))
     return {"ring_per_s": rg.rate_per_s if ok else None, "ring_hz": rg.freq_hz if ok else None,
             "ring_ln_sd": rg.ln_sd if ok else None}
 
@@ -471,7 +475,12 @@ def noisy_shop(cuts) -> int | None:
     """The first stable cut whose record rings (its ring read to an ln sd ≤ 0.5: :func:`toolpoint.shop.growth.
     ring_decay`), or None: the evidence that the cutting noise drives the tool's modes, so that a stable cut near its
     limit may be heard as chatter (:data:`PRECURSOR`). A quiet cut's record holds the entry's decaying kick at most,
-    which reads loosely (ln sd 1.3–2.2 on noise-free Cornelius records, 0.14–0.32 with 5 % force noise)."""
+    which reads loosely (ln sd 1.3–2.2 on noise-free Cornelius records, 0.14–0.32 with 5 % force noise) — but not
+    always (2 of 24 noise-free EM12-60 records at 0.8–0.95 × the limit read at ln sd 0.36 or with none; one
+    EM16-50 whole-loop cut at 0.47), so a record's ring reaches the cut only where it rings through the cut and
+    stands above the record's noise (:func:`ring_fields`: 44 of 45 rings of 5 % noise two-mode case records did,
+    none of the kicks nor that EM16-50 line, 5.4 dB over its floor; ``docs/design/shop.md``, *An entry's kick is no
+    ring*)."""
     return next((r for r, c in enumerate(cuts) if _ring_readable(c)), None)
 
 
