@@ -247,8 +247,8 @@ class RingDecay:
         ring — not a kick dying away, which any cut's entry gives. None where the ratio was not read.
     peak_to_floor : float or None
         The fitted line's peak over the fitted floor (power ratio): where it is under :data:`RING_MIN_PEAK_DB` the
-        "line" is a bump of the record's noise, not a mode ringing (``docs/design/shop.md``, *An entry's kick is no
-        ring*).
+        "line" is a bump of the record's noise, not a mode ringing (``docs/design/shop.md``, *An entry's kick, or a
+        bump of the noise, is no ring*).
     """
 
     rate_per_s: float | None

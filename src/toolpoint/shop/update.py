@@ -476,10 +476,11 @@ def noisy_shop(cuts) -> int | None:
     ring_decay`), or None: the evidence that the cutting noise drives the tool's modes, so that a stable cut near its
     limit may be heard as chatter (:data:`PRECURSOR`). A quiet cut's record holds the entry's decaying kick at most,
     which reads loosely (ln sd 1.3–2.2 on noise-free Cornelius records, 0.14–0.32 with 5 % force noise) — but not
-    always (2 of 24 noise-free EM12-60 records at 0.8–0.95 × the limit read at ln sd 0.36 or with none; one
-    EM16-50 whole-loop cut at 0.47), so a record's ring reaches the cut only where it rings through the cut and
-    stands above the record's noise (:func:`ring_fields`: 44 of 45 rings of 5 % noise two-mode case records did,
-    none of the kicks nor that EM16-50 line, 5.4 dB over its floor; ``docs/design/shop.md``, *An entry's kick is no
+    always: 2 of 24 noise-free EM12-60 records at 0.8–0.95 × the limit had a kick read at ln sd 0.36 or with none,
+    and an EM16-50 whole-loop cut a bump of the room noise read at 0.47. So a record's ring reaches the cuts only
+    where it rings through the cut and stands 10 dB over the record's noise (:func:`ring_fields`): 44 of 45 rings of
+    5 % force-noise two-mode case records did, none of those kicks nor that bump (5.4 dB over its floor;
+    ``docs/design/shop.md``, *An entry's kick, or a bump of the noise, is no
     ring*)."""
     return next((r for r, c in enumerate(cuts) if _ring_readable(c)), None)
 
