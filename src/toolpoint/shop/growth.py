@@ -286,8 +286,7 @@ ratio with ~2|σ|T/π degrees of freedom a half; a kick decaying at σ over the 
 calls resolved (|σ|T ≥ 1 as read) decays far faster than it reads — the Whittle fit assumes a stationary line, and a
 tapered transient looks narrower than it is (a kick of −20 /s read −3 to −8 /s). Measured (2026-12-01, the
 ``_sdof`` records of ``tests/shop/test_ring.py``, 60 seeds each): noise-driven modes over σT = −6 to −83 gave ratios
-of 0.088 at the least, 1 of 360 below 0.1 (σT = −5.9); kicks of −20 /s over 1 s 0.000–0.006 in 12 of 12.
-Measured: ``tests/shop/test_ring.py``."""
+of 0.088 at the least, 1 of 360 below 0.1 (σT = −5.9); kicks of −20 /s over 1 s 0.000–0.006 in 12 of 12."""
 
 
 def ring_decay(samples, rate_hz: float, *, rpm: float, teeth: int, line_hz: float, start_s: float,
@@ -459,10 +458,10 @@ def ring_decay(samples, rate_hz: float, *, rpm: float, teeth: int, line_hz: floa
 
 def _late_power_ratio(z, rd: float, B: float, d_hz: float, sig: float, harm_hz) -> float | None:
     """The line's power in the second half of the baseband series ``z`` (sampled at ``rd`` Hz, the line at ``d_hz``,
-    its half-width σ/2π) over that in the first: each half's Hann periodogram summed over the line's bins (within
-    3 half-widths, at least 3 bins), less the floor there (the mean of the bins 6 half-widths or more from the line
-    within ±B, away from the spindle harmonics ``harm_hz``). None where neither half holds the line above its
-    floor; 0 where the second half does not (a kick that died away); inf where only the second half does."""
+    its half-width σ/2π) over that in the first: each half's Hann periodogram summed over the line's bins (within 3
+    half-widths of it, or 3 bins where that is wider), less the floor there (the mean of the bins twice as far or
+    more from the line within ±B, away from the spindle harmonics ``harm_hz``). None where neither half holds the
+    line above its floor; 0 where the second half does not (a kick that died away); inf where only it does."""
     h = z.size // 2
     if h < 16:
         return None
