@@ -65,6 +65,11 @@ def test_the_real_recording_s_chatter_is_a_steady_tone():
     g = ring_decay(rec.samples, rec.rate_hz, rpm=res.rpm, teeth=2, line_hz=seg.chatter_hz, start_s=seg.start_s,
                    end_s=seg.end_s)
     assert g.rate_per_s is not None and -g.rate_per_s < 2.0 and abs(g.freq_hz - seg.chatter_hz) < 1.0
+    # a real limit cycle is no dying kick and no bump of the noise: measured ratio 1.75 (second half over first),
+    # 102 dB over the floor (2026-12-01)
+    from toolpoint.shop.growth import RING_MIN_PEAK_DB, SUSTAINED_MIN
+    assert g.sustained and g.late_power_ratio >= SUSTAINED_MIN
+    assert 10 * math.log10(g.peak_to_floor) >= RING_MIN_PEAK_DB + 20
 
 
 def test_what_a_ring_cannot_be_read_from_is_said():

@@ -916,7 +916,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         4.2 % of the updates against 5.6 % (it claims 5 %); EM16-50's, EM28-80's and the two-mode case's cuts are
         not lengthened (the example tool's, three lightly damped modes, are). Those runs'
         shop cut a proposal as long as asked only where it was lengthened; cutting every proposal as long as asked
-        (*The virtual shop cuts as long as proposed*), 37 of 60 converged within 6 cuts, 39 of 60 had at most one
+        (*The virtual shop cuts as long as proposed*; on the code before the ring's floor),
+        37 of 60 converged within 6 cuts, 39 of 60 had at most one
         chattering cut, and the recommended depth lay above the truth after 2.2 % of the updates. 0 proposes the
         cuts' own length.
     max_cut_duration_s : float, default 5.0
