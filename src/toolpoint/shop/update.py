@@ -959,7 +959,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         a label is not certain). Skipping them changed 7 of 60 Cornelius campaigns and 2 of 40 EM28-80 ones: within
         6 cuts 34 → 36 of 60 and 18 → 18 of 40, at most one chattering cut 30 → 30 and 37 → 38
         (``docs/design/shop.md``). Where every candidate repeats, the rule proposes as without it. False: as before
-        2026-11-28.
+        2026-11-28. Counting the labels of cuts within 2 % of a speed once (their boundary's error shared) was
+        tried twice and not kept: fewer campaigns converged (2026-12-01: EM16-50 10 → 8 of 20, EM12-60's held-out
+        truths 11 → 6) for a band barely better calibrated (EM12-60's held out after 6 cuts: coverage 0.78 → 0.80,
+        claims 0.90; ``docs/design/shop.md``, *Tried again and not kept: cuts near one speed share their boundary*).
     min_step : float, optional
         ``"info"`` rule: a cut e^min_step above the highest stable cut near a speed is a candidate even where it
         exceeds ``risk``, when the risk bound stops short of it — until the first chatter
