@@ -11,7 +11,7 @@ from shop_synth import shop_record
 from toolpoint.errors import InputError
 from toolpoint.io.records import read_cut_record
 from toolpoint.shop import analyse_cut
-from toolpoint.shop.growth import ring_decay
+from toolpoint.shop.growth import RING_MIN_PEAK_DB, SUSTAINED_MIN, ring_decay
 
 REAL = Path(__file__).resolve().parents[2] / "examples" / "cuts" / "combined_chatter6567.mp3"
 RATE = 20000.0
@@ -67,7 +67,6 @@ def test_the_real_recording_s_chatter_is_a_steady_tone():
     assert g.rate_per_s is not None and -g.rate_per_s < 2.0 and abs(g.freq_hz - seg.chatter_hz) < 1.0
     # a real limit cycle is no dying kick and no bump of the noise: measured ratio 1.75 (second half over first),
     # 102 dB over the floor (2026-12-01)
-    from toolpoint.shop.growth import RING_MIN_PEAK_DB, SUSTAINED_MIN
     assert g.sustained and g.late_power_ratio >= SUSTAINED_MIN
     assert 10 * math.log10(g.peak_to_floor) >= RING_MIN_PEAK_DB + 20
 
