@@ -974,10 +974,13 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         rule before 2026-11-29; ``docs/design/shop.md``). ``"near"``: while no cut within ±``creep_span`` of
         the speed has chattered — a chatter elsewhere gives that speed's bracket no upper side, and the stable
         cuts that follow it at a new recommended speed crept under the risk bound alone. It trades chattering
-        cuts for convergence: in the whole loop (truths 40–59, 6 cuts) EM12-60 converged within 6 cuts for
-        11 of 20 against 8 (median 6 cuts), with a median of 2 chattering cuts against 1 and its recommended
-        depth above the truth after 12 of 120 updates against 10; EM16-50 12 against 11, chattering median 1
-        both (``docs/design/shop.md``, *The step after a chatter elsewhere*). Not the default for that.
+        cuts for convergence. In the whole loop (6 cuts) on the code of 2026-12-01, against the default:
+        EM16-50 (truths 40–59) converged within 6 cuts for 12 of 20 against 10, a median of 1 chattering cut
+        both; EM12-60's held-out truths 20–39 for 9 of 20 against 11, with a median of 2 chattering cuts against
+        1 (at most one for 7 of 20 against 13); the two-mode case (10 truths) had at most one chattering cut
+        for 6 of 10 (17 of 20 by default) and with 5 % force noise 1 of 10 (11 of 20)
+        (``docs/design/shop.md``, *The step after a chatter elsewhere* and *`"near"` on EM12-60's held-out
+        truths*). Not the default for that.
     creep_span : float, default 0.02
         ``"info"`` rule: the stable cuts within ±creep_span (relative speed) of a candidate speed count for its
         step, each depth moved to that speed by the posterior median's ratio between the two (0.005 before
