@@ -978,7 +978,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         EM16-50 (truths 40–59) converged within 6 cuts for 12 of 20 against 10, a median of 1 chattering cut
         both; EM12-60's held-out truths 20–39 for 9 of 20 against 11, with a median of 2 chattering cuts against
         1 (at most one for 7 of 20 against 13); the two-mode case (10 truths) had at most one chattering cut
-        for 6 of 10 (17 of 20 by default) and with 5 % force noise 1 of 10 (11 of 20)
+        for 6 of 10 (17 of 20 by default, on ``6e85d85``) and with 5 % force noise 1 of 10 (11 of 20)
         (``docs/design/shop.md``, *The step after a chatter elsewhere* and *`"near"` on EM12-60's held-out
         truths*). Not the default for that.
     creep_span : float, default 0.02
