@@ -58,6 +58,7 @@ def test_the_shop_is_noisy_only_where_a_stable_cut_s_ring_is_read_tightly():
     assert noisy_shop([hand]) == 0
 
 
+@pytest.mark.slow  # 4–5 s: the fast tier read 175–190 s on clean clones of the shared VM (limit 3 min)
 def test_update_keeps_more_limits_above_a_chatter_label_only_in_a_noisy_shop():
     """A stable cut at 15000 rpm and a chatter at 20000 rpm (importance resampling of the same prior draws, so the
     runs differ only by the term): with a tight ring on the stable cut more posterior samples put the limit at

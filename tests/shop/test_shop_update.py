@@ -239,6 +239,7 @@ def test_smc_posterior_matches_quadrature_on_one_parameter():
     assert exact[2] - exact[0] < 0.6 * 2 * 1.645  # the cuts did narrow it
 
 
+@pytest.mark.slow  # 5 s: the fast tier read 175–190 s on clean clones of the shared VM (limit 3 min)
 def test_smc_posterior_matches_quadrature_with_the_label_offset():
     """K_t and the label offset δ uncertain: the exact posterior of ln K_t on a 2-D grid (ln K_t × δ, the labels'
     boundary at a_lim e^δ) vs the SMC samples' — δ shifts the band down (chatter heard only above the limit) and
@@ -737,6 +738,7 @@ def test_library_adapter_reads_modes_and_cutting(tmp_path):
         prior_from_library(tmp_path, "T9")
 
 
+@pytest.mark.slow  # 3 s: the fast tier read 175–190 s on clean clones of the shared VM (limit 3 min)
 def test_library_prior_is_not_surer_than_the_library(tmp_path, capsys):
     """A real ``library`` output (the shared small run): the prior update makes of each tool holds the library's
     own 5–95 % band of the limit at every speed (the adapter may add what the library does not model — the
@@ -947,6 +949,7 @@ def test_table_records_are_analysed_and_contradictions_reported(tmp_path):
     assert exc.value.field == "record"
 
 
+@pytest.mark.slow  # 3 s: the fast tier read 175–190 s on clean clones of the shared VM (limit 3 min)
 def test_a_table_row_names_its_part_of_a_session_record(tmp_path):
     """A shop records a session of test cuts in one file: a row's ``start_s``/``end_s`` name its cut's part (as
     ``cut --start --end``). Before, a row could only take the whole record: two cuts at one speed gave both rows the
