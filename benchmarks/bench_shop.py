@@ -1,7 +1,8 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard|bracket] [--shops zoa,noisy,sim]
+        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard|bracket|prior-pocket]
+        [--shops zoa,noisy,sim]
         [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
@@ -49,6 +50,8 @@ CPU time (time.process_time), not wall time: the machine is shared.
 7. ``bracket`` (``--seeds`` truths from ``--seed-start``): the band ``update`` leaves after cuts that bracket each
    truth's SDM limit at one speed exactly (no simulation, no detector: an oracle's labels), with the label model and
    with exact labels — the floor the label offset sets on the loop's width target, however well the cuts are placed.
+8. ``prior-pocket``: the prior's band (``update`` with no cut) near its recommended speed, where the first cuts go,
+   against the SDM limits of 400 truths drawn from the prior: the share below its 5 % and above its 95 % line.
 """
 
 from __future__ import annotations
@@ -479,6 +482,18 @@ def shop_accelerometer(res, rpm, teeth, rng, point=0):
 SENSORS = {"microphone": shop_microphone, "accelerometer": shop_accelerometer}
 
 
+def _priors(library_prior=None) -> dict:
+    """The benchmark's priors by case name; ``library_prior`` OUT:TOOL adds "library", a tool of a `toolpoint library`
+    output, its prior as `update --library` makes it."""
+    priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
+    if library_prior:
+        from toolpoint.shop.prior import prior_from_library
+
+        out, tool = library_prior.rsplit(":", 1)
+        priors["library"] = prior_from_library(out, tool)
+    return priors
+
+
 def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius", "example"), update_kw=None,
                  max_cuts=10, verbose=False, seed_start=0, library_prior=None, detector=None, stop=True,
                  sensor="microphone", force_noise=0.0):
@@ -492,12 +507,9 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
           + (f"; simulated cuts with force noise {force_noise:g}" if force_noise else "")
           + ("" if stop else "; no stop: every campaign makes all its cuts, convergence read from the same sequence")
           + ")")
-    priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
-    if library_prior:  # OUT:TOOL — a tool of a `toolpoint library` output, its prior as `update --library` makes it
-        from toolpoint.shop.prior import prior_from_library
-
-        out, tool = library_prior.rsplit(":", 1)
-        priors["library"] = prior_from_library(out, tool)
+    priors = _priors(library_prior)
+    if library_prior:
+        tool = library_prior.rsplit(":", 1)[1]
         print(f"library prior {tool}: modes {np.round(priors['library'].freq_hz, 0).tolist()} Hz, σ stiffness "
               f"{np.round(priors['library'].sigma_stiffness, 3).tolist()}, σ K_t {priors['library'].sigma_kt}, "
               f"σ K_r {priors['library'].sigma_kr}, rpm {priors['library'].rpm_range}")
@@ -605,12 +617,7 @@ def bench_ceiling(cases, library_prior=None):
     from toolpoint.shop.update import _default_grid, _limits
 
     print("\n## ceiling: a calibrated band (the prior's own, zero-order) against 1000 truths from the same prior")
-    priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
-    if library_prior:
-        from toolpoint.shop.prior import prior_from_library
-
-        out, tool = library_prior.rsplit(":", 1)
-        priors["library"] = prior_from_library(out, tool)
+    priors = _priors(library_prior)
     # the label offset's own floor: however the cuts bracket the heard boundary at one speed, the limit lies the
     # offset δ + min(G / (κ t), 0.5) below it (update's label_offset and label_growth priors), so the band there is
     # at least as wide as that offset's 5–95 % range
@@ -653,12 +660,7 @@ def bench_bracket(cases, library_prior=None, truths=8, seed_start=40, n_samples=
     print(f"\n## bracket: update's band after cuts bracketing the truth's SDM limit at the prior's recommended speed "
           f"(truths {seed_start}…{seed_start + truths - 1}, {n_samples} samples, {lobe_samples} lobe samples, cuts of "
           "1 s, no chatter frequency); width (a95 − a05) / a50 at that speed, [a05, a95] / the truth's limit")
-    priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
-    if library_prior:
-        from toolpoint.shop.prior import prior_from_library
-
-        out, tool = library_prior.rsplit(":", 1)
-        priors["library"] = prior_from_library(out, tool)
+    priors = _priors(library_prior)
     settings = {"label model": {}, "exact labels": {"label_offset": (0.0, 0.0), "label_growth": (0.0, 0.0)}}
     brackets = {"0.93 s / 1.07 C": ((0.93, True), (1.07, False)), "0.97 s / 1.03 C": ((0.97, True), (1.03, False)),
                 "0.90 0.95 0.98 s / 1.02 1.05 1.10 C": ((0.9, True), (0.95, True), (0.98, True), (1.02, False),
@@ -705,12 +707,7 @@ def bench_heard(cases, library_prior=None, truths=12, seed_start=60):
     from toolpoint.stability import sdm_spectral_radius
 
     print(f"\n## heard: chatter heard against its growth within the cut ({truths} truths per case, 3 cuts each)")
-    priors = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
-    if library_prior:
-        from toolpoint.shop.prior import prior_from_library
-
-        out, tool = library_prior.rsplit(":", 1)
-        priors["library"] = prior_from_library(out, tool)
+    priors = _priors(library_prior)
     for case in cases:
         pr = priors[case]
         shop, truth = simulated_shop(pr, record=SENSORS["microphone"]), sdm_limit(pr)
@@ -767,6 +764,33 @@ def bench_heard(cases, library_prior=None, truths=12, seed_start=60):
                   flush=True)
 
 
+def bench_prior_pocket(cases, library_prior=None, truths=400, seed=123):
+    """The prior's band (``update`` with no cut, ``forward="sdm"``, defaults) at the recommended speed and every third
+    grid speed within ±3 % of it — where the first cuts go — against the SDM limits of ``truths`` tools drawn from
+    the same prior (their own rng): the share below the band's 5 % and above its 95 % (each claims 0.05)."""
+    from toolpoint.shop.model import sdm_limits
+
+    print(f"\n## prior-pocket: the prior's 5-95 % band near the recommended speed against {truths} truths' SDM limits")
+    priors = _priors(library_prior)
+    for case in cases:
+        pr = priors[case]
+        c0 = time.process_time()
+        post = update(pr, [], rng=np.random.default_rng(0))
+        j = int(np.argmin(np.abs(post.rpm - post.recommended["rpm"])))
+        sel = np.where(np.abs(post.rpm / post.rpm[j] - 1) <= 0.03)[0][::3]
+        th = pr.theta(np.random.default_rng(seed).standard_normal((truths, pr.sigma.size)) * (pr.sigma > 0))
+        lims = np.array([sdm_limits(pr, t, post.rpm[sel])[0] for t in th])  # (truths, speeds), m
+        q = post.limit_q_m[:, sel]
+        tq = np.quantile(lims, [0.05, 0.5, 0.95], axis=0)
+        print(f"{pr.name[:40]:40s} recommended {post.recommended['rpm']:.0f} rpm; speeds "
+              + " ".join(f"{r:.0f}" for r in post.rpm[sel]) + "; below the 5 %: "
+              + " ".join(f"{v:.3f}" for v in (lims < q[0]).mean(0)) + "; above the 95 %: "
+              + " ".join(f"{v:.3f}" for v in (lims > q[2]).mean(0)) + " (each claims 0.05); band 5/50/95 % "
+              + " ".join("/".join(f"{1e3 * v:.2f}" for v in q[:, k]) for k in range(sel.size))
+              + " mm; truths' " + " ".join("/".join(f"{1e3 * v:.2f}" for v in tq[:, k]) for k in range(sel.size))
+              + f" mm; {time.process_time() - c0:.0f} s CPU", flush=True)
+
+
 def bench_sdm_bands(truths=40, grids=(41, 21), update_kw=None):
     """``forward="sdm"`` against the truth's own SDM limit (not zero-order × reference ratio): Cornelius σ 0.12,
     truths from the prior (their own rng: every setting sees the same truths), three cuts at grid speeds labelled
@@ -807,7 +831,7 @@ def main():
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", choices=("cut", "teeth", "twocut", "inside", "update", "sampler", "forward", "ceiling",
-                                       "sdm-bands", "heard", "bracket"))
+                                       "sdm-bands", "heard", "bracket", "prior-pocket"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -863,6 +887,8 @@ def main():
         bench_forward()
     if a.only in (None, "ceiling"):
         bench_ceiling(a.cases.split(","), a.library_prior)
+    if a.only in (None, "prior-pocket"):
+        bench_prior_pocket(a.cases.split(","), a.library_prior, 60 if a.quick else 400)
     if a.only in (None, "heard"):
         bench_heard(a.cases.split(","), a.library_prior, 4 if a.quick else 12)
     if a.only in (None, "bracket"):

@@ -15,7 +15,7 @@ from toolpoint.errors import InputError
 from toolpoint.shop.campaign import virtual_campaign
 from toolpoint.shop.model import ModalPrior, cornelius_2024, limit_at_speeds, receptance
 from toolpoint.shop.prior import prior_from_library, read_modal_prior
-from toolpoint.shop.update import TestCut, log_likelihood, read_test_cuts, update
+from toolpoint.shop.update import OWN_MIN_ESS, TestCut, _own_temper, log_likelihood, read_test_cuts, update
 from toolpoint.stability.zoa_batch import zoa_limits
 
 # the command line's tests of parsing, files and messages run the cheaper zero-order model (the default is "sdm":
@@ -1400,6 +1400,26 @@ def test_the_corrected_samples_own_sdm_limits_move_the_band_to_the_sdm():
     assert np.mean(err[60]) < 0.035 and np.mean(err[60]) < np.mean(err[0]), {k: np.mean(v) for k, v in err.items()}
 
 
+def test_own_sdm_weights_are_tempered_only_as_far_as_the_samples_need():
+    """The own-SDM weights' power: 1 where the weights leave enough samples effective; else the largest power that
+    keeps the ESS at the floor — computed here independently, as the ESS Σw² form on a fine grid of powers."""
+    rng = np.random.default_rng(3)
+    flat = rng.normal(0.0, 0.1, 400)  # nearly equal weights: ESS ≈ 400
+    assert _own_temper(flat, 100.0) == 1.0
+    for scale in (3.0, 8.0, 30.0):  # heavy weights: a handful of samples carry them
+        lw = rng.normal(0.0, scale, 400)
+
+        def ess(a):
+            w = np.exp(a * (lw - lw.max()))
+            return w.sum() ** 2 / (w ** 2).sum()
+
+        assert ess(1.0) < 100
+        alpha = _own_temper(lw, 100.0)
+        grid = np.linspace(1e-4, 1.0, 20001)
+        best = grid[np.array([ess(a) for a in grid]) >= 100].max()
+        assert 0 < alpha < 1 and ess(alpha) >= 100 - 1e-6 and abs(alpha - best) < 1e-3, (scale, alpha, best)
+
+
 @pytest.mark.slow
 def test_the_lobe_samples_weighted_by_their_own_sdm_limits_hold_the_sdm_limit():
     """As above (six truths, cuts ±7 % about each one's SDM limit at the flip lobes' 7000 and 7500 rpm), with
@@ -1428,7 +1448,9 @@ def test_the_lobe_samples_weighted_by_their_own_sdm_limits_hold_the_sdm_limit():
                 assert post.own_sdm_ess is None
                 continue
             assert np.all(q[0] <= 1) and np.all(1 <= q[2]), (seed, q)
-            assert 1 < post.own_sdm_ess <= 150 and post.lobe_z.shape == (150, P + 2)
+            # tempered where the full weights leave fewer than a quarter of the samples effective
+            assert OWN_MIN_ESS * 150 - 1e-6 <= post.own_sdm_ess <= 150 and post.lobe_z.shape == (150, P + 2)
+            assert 0 < post.own_sdm_power <= 1
             if seed < 2:
                 own_lim = np.array([sdm_lobes(*pr.tool(t)[:1] * 2, pr.tool(t)[1], rpm=rpm).depth_m
                                     for t in pr.theta(post.lobe_z[:, :P])])

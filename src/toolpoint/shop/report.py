@@ -121,6 +121,8 @@ def _doc(post: Posterior) -> dict:
                     "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
                     # the lobe samples' weights by their own SDM limits at the cut speeds (update's own_sdm)
                     "own_sdm_ess": None if post.own_sdm_ess is None else round(post.own_sdm_ess, 1),
+                    # below 1: those weights left too few effective samples and were tempered (update.OWN_MIN_ESS)
+                    "own_sdm_power": None if post.own_sdm_power is None else round(post.own_sdm_power, 3),
                     "lobe_samples": None if post.lobe_z is None else int(post.lobe_z.shape[0]),
                     "cpu_s": round(post.cpu_s, 2)},
     }
@@ -282,5 +284,8 @@ def _html(post, doc, rows, png) -> str:
         f"{s['acceptance']}"
         + (f"; the {s['lobe_samples']} lobe samples weighted by their own SDM limits at the cut speeds, ESS "
            f"{s['own_sdm_ess']}" if s.get("own_sdm_ess") is not None else "")
+        + (f" (the weights tempered to the power {s['own_sdm_power']}: in full they left too few effective samples, "
+           "so the band lies between the references' SDM correction and the samples' own)"
+           if s.get("own_sdm_power") is not None and s["own_sdm_power"] < 1 else "")
         + f", {s['cpu_s']} s CPU. Files: lobes.csv, p_stable.csv, parameters.csv, update.json.</p>"
         "</body></html>")

@@ -470,6 +470,11 @@ pocket it over-states: 1 of 48 records heard at 0.85–0.975 × on two tools at 
 (``docs/design/shop.md``, *A noisy shop's false chatter*). :func:`update` applies it only where the stable cuts' own
 records say the shop is noisy (:func:`noisy_shop`)."""
 
+OWN_MIN_ESS = 0.25
+"""The least effective share of the lobe samples the own-SDM weights may leave (``update``'s ``own_sdm``): below it
+the weights are tempered (:func:`_own_temper`), so the 5 % and 95 % quantiles of 400 samples rest on at least five
+effective samples each."""
+
 
 def noisy_shop(cuts) -> int | None:
     """The first stable cut whose record rings (its ring read to an ln sd ≤ 0.5: :func:`toolpoint.shop.growth.
@@ -727,8 +732,12 @@ class Posterior:
         Index of the stable cut whose ring said the shop is noisy (:func:`noisy_shop`).
     own_sdm_ess : float or None
         Effective sample size of the lobe samples' weights by their own SDM limits at the cut speeds
-        (:func:`update`'s ``own_sdm``), of ``lobe_samples``; None where they were not weighted, 0 where no weight
-        was finite (the lobe samples left unweighted).
+        (:func:`update`'s ``own_sdm``), of ``lobe_samples``, as resampled (after tempering); None where they were
+        not weighted, 0 where no weight was finite (the lobe samples left unweighted).
+    own_sdm_power : float or None
+        The power α ∈ (0, 1] those weights were raised to: 1 where they left at least :data:`OWN_MIN_ESS` of the
+        lobe samples effective, else the largest α that does (the band then lies between the references' and the
+        own limits'); None where they were not weighted.
     lobe_z : ndarray, shape (m, P + 2), optional
         The lobe samples (rows of ``z``, as ``z``'s columns), resampled by those weights where they were weighted
         (rows repeat): the samples whose limits make ``limit_q_m``.
@@ -757,6 +766,7 @@ class Posterior:
     noisy_evidence: int | None = None
     own_sdm_ess: float | None = None
     lobe_z: np.ndarray | None = None
+    own_sdm_power: float | None = None
 
     @property
     def theta(self) -> np.ndarray:
@@ -999,7 +1009,9 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         wide in ln a, interpolated in ρ; ln sd 0.0044 from the full search). The lobe samples are weighted by the
         cuts' likelihood with their own limits (the boundary width ``boundary_width`` alone) over that of the
         sampling (the references' mean ratio, their spread added to the width), resampled (ESS:
-        ``Posterior.own_sdm_ess``; the samples: ``Posterior.lobe_z``), and each one's lobes moved to its own limit
+        ``Posterior.own_sdm_ess``; the samples: ``Posterior.lobe_z``; where the weights leave fewer than
+        :data:`OWN_MIN_ESS` of the samples effective they are tempered, ``Posterior.own_sdm_power`` < 1, so that
+        the band is no heap of copies of a few samples), and each one's lobes moved to its own limit
         at the cut speeds, linearly between neighbouring cut speeds and fading over ±2 % beyond them. Without it
         the band at a cut speed is no narrower than the spread of the references' ratios there (ln sd 0.05–0.19 on
         EM16-50: one truth's band at a cut speed 0.33–0.57 wide over three seeds for the same cuts), and the
@@ -1181,12 +1193,12 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     m = min(lobe_samples, n_samples)
     pick = rng.choice(n_samples, m, replace=False)
     lim = _limits(prior, prior.theta(z[pick, :P]), f, grid)
-    own_ess = None
+    own_ess = own_power = None
     if log_ratio_grid is not None:  # each lobe sample corrected by one reference's SDM/ZOA ratio
         rows = rng.integers(log_ratio_grid.shape[0], size=m)
         lim = lim * np.exp(log_ratio_grid[rows])
         if own_sdm and kw_sdm is not None:
-            pick, lim, own_ess = _own_reweight(prior, z, pick, lim, cuts, kw_sdm, lr_at_cuts[rows], grid, f,
+            pick, lim, own_ess, own_power = _own_reweight(prior, z, pick, lim, cuts, kw_sdm, lr_at_cuts[rows], grid, f,
                                                boundary_width, rng, growth_by)
     zp = rng.standard_normal((m, P)) * free[:P]
     lim_prior = _limits(prior, prior.theta(zp), f, grid)
@@ -1260,7 +1272,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                                                                            np.full(len(cuts), np.nan))),
                      tuple(float(v) if np.isfinite(v) else None for v in (rx[2] if rx is not None else
                                                                            np.full(len(cuts), np.nan))),
-                     kw.get("precursor"), noisy, own_ess, z[pick])
+                     kw.get("precursor"), noisy, own_ess, z[pick], own_power)
 
 
 def _option(value, field: str, form: str, ok, need: str) -> tuple:
@@ -1629,9 +1641,10 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
     limits at the cut speeds over that of the last sampling (``kw``: the references' mean ratio, their spread in the
     boundary width), resampled, and each one's lobes moved to its own limit at the cut speeds (the residual put on
     the grid by :func:`_interp_near`). ``lr_now`` (m, C): the ratio each lobe sample's lobes carry at the cuts.
-    Returns the new ``pick`` and ``lim`` (rows repeat) and the weights' effective sample size — 0 where no weight is
+    Returns the new ``pick`` and ``lim`` (rows repeat), the weights' effective sample size — 0 where no weight is
     finite (no sample can explain the cuts with its own limits; the likelihood's floors make that unreachable), the
-    lobe samples then left as they were.
+    lobe samples then left as they were — and the power the weights were tempered to (:func:`_own_temper`; None
+    where none was finite).
 
     Why: each lobe sample carries one reference's SDM/ZOA ratio, and the references' ratios at a speed spread by
     ln sd 0.05–0.19 on EM16-50, so the band at a cut speed could not be narrower than that spread however the cuts
@@ -1658,11 +1671,31 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
           - log_likelihood(prior, th, cuts, **dict(kw, **extra)))
     lw = np.where(np.isfinite(lw), lw, -np.inf)
     if not np.isfinite(lw).any():
-        return pick, lim, 0.0
+        return pick, lim, 0.0, None
+    alpha = _own_temper(lw, OWN_MIN_ESS * lw.size)
+    lw = alpha * lw
     w = np.exp(lw - lw.max())
     idx = _systematic(w / w.sum(), rng)
     lim = lim[idx] * np.exp(_interp_near(own[idx] - lr_now[idx][:, first], grid, u))
-    return pick[idx], lim, _ess(lw)
+    return pick[idx], lim, _ess(lw), alpha
+
+
+def _own_temper(lw, ess_min: float) -> float:
+    """The power α ∈ (0, 1] of the own-SDM weights e^{α lw}: 1 where their ESS is at least ``ess_min``, else the
+    largest α that keeps it there (bisection; the ESS falls as α grows).
+
+    Why: with the full weights the ESS was 5–67 of 400 lobe samples for one EM12-60 truth's six cuts over eight
+    seeds of the update, and a band of five distinct samples is a heap of copies — 0.016 wide (5–95 % over the
+    median) with the truth outside it at a fifth of the speeds. Part of the way the band stays between the
+    references' (wider at the cut speeds) and the own limits': wider than the exact posterior, never narrower
+    than its samples can show (``docs/design/shop.md``, *The own-SDM weights tempered*)."""
+    if _ess(lw) >= ess_min:
+        return 1.0
+    lo, hi = 0.0, 1.0
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if _ess(mid * lw) >= ess_min else (lo, mid)
+    return lo
 
 
 def _cut_speeds(rpm_c):
