@@ -1418,6 +1418,12 @@ def test_own_sdm_weights_are_tempered_only_as_far_as_the_samples_need():
         grid = np.linspace(1e-4, 1.0, 20001)
         best = grid[np.array([ess(a) for a in grid]) >= 100].max()
         assert 0 < alpha < 1 and ess(alpha) >= 100 - 1e-6 and abs(alpha - best) < 1e-3, (scale, alpha, best)
+    # weights of 0 (lw = −∞) on 350 of the 400: no power leaves 100 effective; the power stays positive and the
+    # weights finite where they were
+    lw = np.where(np.arange(400) < 50, rng.normal(0.0, 3.0, 400), -np.inf)
+    alpha = _own_temper(lw, 100.0)
+    w = np.exp(alpha * (lw - lw.max()))
+    assert 0 < alpha < 1e-6 and np.all(np.isfinite(w)) and np.count_nonzero(w) == 50
 
 
 @pytest.mark.slow

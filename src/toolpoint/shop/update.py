@@ -1198,8 +1198,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         rows = rng.integers(log_ratio_grid.shape[0], size=m)
         lim = lim * np.exp(log_ratio_grid[rows])
         if own_sdm and kw_sdm is not None:
-            pick, lim, own_ess, own_power = _own_reweight(prior, z, pick, lim, cuts, kw_sdm, lr_at_cuts[rows], grid, f,
-                                               boundary_width, rng, growth_by)
+            pick, lim, own_ess, own_power = _own_reweight(prior, z, pick, lim, cuts, kw_sdm, lr_at_cuts[rows],
+                                                          grid, f, boundary_width, rng, growth_by)
     zp = rng.standard_normal((m, P)) * free[:P]
     lim_prior = _limits(prior, prior.theta(zp), f, grid)
     q = np.quantile(lim, [0.05, 0.5, 0.95], axis=0)
@@ -1695,7 +1695,9 @@ def _own_temper(lw, ess_min: float) -> float:
     for _ in range(30):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if _ess(mid * lw) >= ess_min else (lo, mid)
-    return lo
+    # α > 0 always: a sample of weight 0 (lw = −∞) keeps it, and as α → 0 the ESS tends to the count of the others,
+    # which may lie under the floor (0 · −∞ would make the weights NaN)
+    return lo if lo > 0 else hi
 
 
 def _cut_speeds(rpm_c):
