@@ -1431,9 +1431,11 @@ def test_the_lobe_samples_weighted_by_their_own_sdm_limits_hold_the_sdm_limit():
     """As above (six truths, cuts ±7 % about each one's SDM limit at the flip lobes' 7000 and 7500 rpm), with
     ``own_sdm`` (the default) instead of ``sdm_train``: the band at the cut speeds is made of the lobe samples' own
     SDM limits — against an independent full search (:func:`sdm_lobes`) of ``lobe_z``'s, within 3 % (measured
-    0.977–1.000: ``sdm_limit_near`` halves its bracket twice) — holds every truth's SDM limit at both speeds
-    (without the weights truth 4's 7000 rpm limit lay below the band), and its median is closer to it (measured mean
-    |ln(median / SDM)| 0.024 against 0.065 without the weights; ESS 20–84 of 150)."""
+    0.977–1.000 before the weights were tempered, 0.999–1.000 since: ``sdm_limit_near`` halves its bracket twice) —
+    holds every truth's SDM limit at both speeds (without the weights truth 4's 7000 rpm limit lay below the band),
+    and its median is closer to it (measured mean |ln(median / SDM)| 0.024 against 0.065 without the weights; on the
+    code of 2026-12-01 evening 0.024 against 0.052, ESS 37.5–89.5 of 150, two of the six updates tempered to α 0.83
+    and 0.91; ESS 20–84 before the tempering)."""
     from toolpoint.stability import sdm_lobes
 
     pr = cornelius_2024(0.05)

@@ -473,7 +473,7 @@ records say the shop is noisy (:func:`noisy_shop`)."""
 OWN_MIN_ESS = 0.25
 """The least effective share of the lobe samples the own-SDM weights may leave (``update``'s ``own_sdm``): below it
 the weights are tempered (:func:`_own_temper`), so the 5 % and 95 % quantiles of 400 samples rest on at least five
-effective samples each."""
+effective samples each (where that many samples have a non-zero weight)."""
 
 
 def noisy_shop(cuts) -> int | None:
@@ -737,7 +737,8 @@ class Posterior:
     own_sdm_power : float or None
         The power α ∈ (0, 1] those weights were raised to: 1 where they left at least :data:`OWN_MIN_ESS` of the
         lobe samples effective, else the largest α that does (the band then lies between the references' and the
-        own limits'); None where they were not weighted.
+        own limits'), or ~1e-9 where none does (fewer samples than that of non-zero weight); None where they were
+        not weighted.
     lobe_z : ndarray, shape (m, P + 2), optional
         The lobe samples (rows of ``z``, as ``z``'s columns), resampled by those weights where they were weighted
         (rows repeat): the samples whose limits make ``limit_q_m``.
@@ -1682,7 +1683,8 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
 
 def _own_temper(lw, ess_min: float) -> float:
     """The power α ∈ (0, 1] of the own-SDM weights e^{α lw}: 1 where their ESS is at least ``ess_min``, else the
-    largest α that keeps it there (bisection; the ESS falls as α grows).
+    largest α that keeps it there (bisection; the ESS falls as α grows). Where no power does — fewer than
+    ``ess_min`` weights are non-zero — the smallest tried (2⁻³⁰): the non-zero weights all but equal.
 
     Why: with the full weights the ESS was 5–67 of 400 lobe samples for one EM12-60 truth's six cuts over eight
     seeds of the update, and a band of five distinct samples is a heap of copies — 0.016 wide (5–95 % over the
