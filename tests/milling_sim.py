@@ -134,6 +134,8 @@ def accelerometer(sim, *, rpm, teeth, rate=25600.0, air_s=0.7, seed=0, housing_h
     * sampled at ``rate`` (25.6 kS/s, an IEPE module's usual rate) behind an anti-aliasing filter; ``clip`` (m/s²)
       clips it as an overloaded input range would.
     """
+    from scipy import signal
+
     from toolpoint.simulation import to_audio_rate
 
     t, x, y, fx, fy = sim
@@ -173,7 +175,7 @@ def accelerometer(sim, *, rpm, teeth, rate=25600.0, air_s=0.7, seed=0, housing_h
     sig += mains * (np.sin(2 * np.pi * mains_hz * tt) + np.sin(2 * np.pi * 3 * mains_hz * tt + 1.0) / 3)
     walk = np.cumsum(rng.standard_normal(n))
     k = max(1, int(rate / 1.0))
-    walk = np.convolve(walk, np.ones(k) / k, mode="same")
+    walk = signal.fftconvolve(walk, np.ones(k) / k, mode="same")  # np.convolve's to 1e-15, 35× faster for k = 25600
     walk -= walk.mean()
     sig += offset + drift * walk / (walk.std() + 1e-30)
     sig += noise * rng.standard_normal(n)

@@ -292,7 +292,8 @@ def _housing_slot_record(rpm, seed, chip_noise):
     return x, rate
 
 
-@pytest.mark.parametrize("rpm", [5850.0, 6800.0, 7150.0])
+@pytest.mark.parametrize("rpm", [pytest.param(5850.0, marks=pytest.mark.slow), 6800.0,
+                                 pytest.param(7150.0, marks=pytest.mark.slow)])  # the fast tier: one speed
 def test_a_nominal_speed_several_percent_off_is_warned_with_the_speed_in_the_record(rpm):
     """A nominal speed off by more than the search range (an override, another program's speed) leaves the
     tooth-passing harmonics outside their masks, where they can be judged as chatter. The real recording's spindle
@@ -466,7 +467,7 @@ def test_a_drooping_or_wandering_spindle_is_not_chatter():
     assert not res.criterion["speed_tracked"] and res.criterion["speed_wander"] < 5e-4
 
 
-@pytest.mark.parametrize("attack_s,release_s", [(0.05, 2.0), (0.5, 0.5)])
+@pytest.mark.parametrize("attack_s,release_s", [(0.05, 2.0), pytest.param(0.5, 0.5, marks=pytest.mark.slow)])
 def test_a_record_levelled_by_automatic_gain_control_is_split_and_judged_right(attack_s, release_s):
     # A phone levels the cut to the air cut's loudness within its attack time and lifts the air after the cut back
     # within its release time, so the band's power no longer tells air from cut: the air before the cut sounded as
@@ -1108,7 +1109,8 @@ def _spin(air, rate, seconds, up):
     return np.interp(pos, np.arange(air.size), air) * (0.3 + 0.7 * u if up else 1.0 - 0.7 * u)
 
 
-@pytest.mark.parametrize("before,after", [("room", None), ("up", None), (None, "down"), ("up", "down")])
+@pytest.mark.parametrize("before,after", [("room", None), pytest.param("up", None, marks=pytest.mark.slow),
+                                          pytest.param(None, "down", marks=pytest.mark.slow), ("up", "down")])
 def test_a_spindle_not_at_speed_at_the_record_s_ends_is_left_out(before, after):
     """A phone started before the spindle and stopped after it: the real recording (its first 25 s: air at speed,
     entry, cutting that chatters, exit, air) behind 2 s of room noise or 0.5 s of it and a 3 s run-up, and before a

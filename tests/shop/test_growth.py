@@ -67,7 +67,7 @@ def test_records_without_one_rate_are_refused():
     assert g.rate_per_s is None and "at once" in g.reason
 
 
-@pytest.mark.parametrize("rpm, x", [(11000.0, 0.05), (19000.0, 0.15)])
+@pytest.mark.parametrize("rpm, x", [(11000.0, 0.05), pytest.param(19000.0, 0.15, marks=pytest.mark.slow)])
 def test_simulated_cuts_give_the_semi_discretisation_s_rate(rpm, x):
     """Second method: a cut simulated in the time domain (Cornelius case) at a = a_SDM e^x, heard by the campaign's
     microphone and by the tests' shop microphone (fans, spindle lines, pink noise), read by `cut` — against the SDM's

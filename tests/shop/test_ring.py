@@ -29,7 +29,10 @@ def _sdof(fn, zeta, dur, seed):
     return y / y.std() + 3 * np.sin(2 * np.pi * 100 * t) + 0.05 * rng.standard_normal(y.size)
 
 
-@pytest.mark.parametrize("fn, zeta, dur", [(650.0, 0.003, 2.0), (1250.0, 0.01, 0.8), (1730.0, 0.004, 0.5),
+@pytest.mark.parametrize("fn, zeta, dur", [(650.0, 0.003, 2.0),
+                                            # each 2–3 s: the fast tier keeps one mode, the slow tier has all four
+                                            pytest.param(1250.0, 0.01, 0.8, marks=pytest.mark.slow),
+                                            pytest.param(1730.0, 0.004, 0.5, marks=pytest.mark.slow),
                                             # 12 records of 8 s: ~14 s, the slow tier's
                                             pytest.param(650.0, 0.003, 8.0, marks=pytest.mark.slow)])
 def test_a_noise_driven_mode_s_decay_against_the_closed_form(fn, zeta, dur):
@@ -90,7 +93,8 @@ def test_what_a_ring_cannot_be_read_from_is_said():
     assert e.value.field == "rate_hz"
 
 
-@pytest.mark.parametrize("ring, stable", [(-60.0, True), (-25.0, True), (-5.0, False)])
+@pytest.mark.parametrize("ring, stable", [(-60.0, True), pytest.param(-25.0, True, marks=pytest.mark.slow),
+                                           (-5.0, False)])  # the fast tier: one ring either side
 def test_a_weak_chatter_family_that_is_a_ring_is_judged_stable(ring, stable):
     """The weak-line chatter of test_cut's weak family, but a ring the cutting noise drives (a Lorentzian line,
     shop_synth's ``ring_per_s``) instead of a steady tone: a ring that decays at 25–60 /s is a stable cut near its
@@ -131,7 +135,9 @@ def _kick(sigma, dur, seed, fn=1890.0):
             + 3 * np.sin(2 * np.pi * 100 * t) + 0.05 * rng.standard_normal(t.size))
 
 
-@pytest.mark.parametrize("fn, zeta, dur", [(650.0, 0.003, 2.0), (1250.0, 0.01, 0.8), (1730.0, 0.004, 0.5)])
+@pytest.mark.parametrize("fn, zeta, dur", [(650.0, 0.003, 2.0),  # the fast tier: one mode; the slow tier all three
+                                            pytest.param(1250.0, 0.01, 0.8, marks=pytest.mark.slow),
+                                            pytest.param(1730.0, 0.004, 0.5, marks=pytest.mark.slow)])
 def test_a_ring_the_noise_drives_is_sustained(fn, zeta, dur):
     """A noise-driven mode rings as loudly in the part's second half as in its first: ratio ≈ 1. Measured over 60 other
     seeds each (2026-12-01): at least 0.31 / 0.46 / 0.11 (SUSTAINED_MIN 0.1)."""
