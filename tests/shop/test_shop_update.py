@@ -1620,3 +1620,21 @@ def test_a_record_at_another_speed_than_its_row_s_rpm(tmp_path):
     assert main(["update", "--prior", str(Path(__file__).parents[2] / "examples" / "shop" / "cornelius_prior.toml"),
                  "--cuts", str(p), "--out", str(out)]) == 2
     assert not out.exists()
+
+
+def test_the_band_at_the_pocket_is_made_of_the_lobe_samples_own_sdm_limits():
+    """Before any cut (``forward="sdm"``): at the speeds ``own_pocket`` names, about the most productive one, the band's
+    5 / 50 / 95 % are those of the lobe samples' own SDM limits — against an independent full search
+    (:func:`sdm_lobes`) of ``lobe_z``'s there, within 3 % — and not of their zero-order limits times the references'
+    ratio (the band with ``own_pocket=0``, whose upper line lay 10 % under the samples' own on EM16-50)."""
+    from toolpoint.stability import sdm_lobes
+
+    pr = cornelius_2024(0.1)
+    post = update(pr, [], rng=np.random.default_rng(2), n_samples=300, lobe_samples=60, own_pocket=3)
+    u = np.array(post.own_pocket_rpm)
+    assert u.size >= 3 and u.min() <= post.recommended["rpm"] <= u.max(), (u, post.recommended)
+    th = pr.theta(post.lobe_z[:, :pr.sigma.size])
+    own = np.array([sdm_lobes(*pr.tool(t)[:1] * 2, pr.tool(t)[1], rpm=u).depth_m for t in th])  # (60, 3)
+    for k, r in enumerate(u):
+        j = int(np.argmin(np.abs(post.rpm - r)))
+        np.testing.assert_allclose(post.limit_q_m[:, j], np.quantile(own[:, k], [0.05, 0.5, 0.95]), rtol=0.03)

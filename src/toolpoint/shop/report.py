@@ -123,6 +123,8 @@ def _doc(post: Posterior) -> dict:
                     "own_sdm_ess": None if post.own_sdm_ess is None else round(post.own_sdm_ess, 1),
                     # below 1: those weights left too few effective samples and were tempered (update.OWN_MIN_ESS)
                     "own_sdm_power": None if post.own_sdm_power is None else round(post.own_sdm_power, 3),
+                    # the speeds where the lobe samples' own SDM limits replaced the references' ratio (own_pocket)
+                    "own_pocket_rpm": [round(r, 1) for r in post.own_pocket_rpm],
                     "lobe_samples": None if post.lobe_z is None else int(post.lobe_z.shape[0]),
                     "cpu_s": round(post.cpu_s, 2)},
     }
@@ -287,5 +289,7 @@ def _html(post, doc, rows, png) -> str:
         + (f" (the weights tempered to the power {s['own_sdm_power']}: in full they left too few effective samples, "
            "so the band lies between the references' SDM correction and the samples' own)"
            if s.get("own_sdm_power") is not None and s["own_sdm_power"] < 1 else "")
+        + (f"; at {', '.join(f'{r:.0f}' for r in s['own_pocket_rpm'])} rpm the lobe samples' own SDM limits, between "
+           "them linearly" if s.get("own_pocket_rpm") else "")
         + f", {s['cpu_s']} s CPU. Files: lobes.csv, p_stable.csv, parameters.csv, update.json.</p>"
         "</body></html>")

@@ -470,6 +470,10 @@ pocket it over-states: 1 of 48 records heard at 0.85–0.975 × on two tools at 
 (``docs/design/shop.md``, *A noisy shop's false chatter*). :func:`update` applies it only where the stable cuts' own
 records say the shop is noisy (:func:`noisy_shop`)."""
 
+POCKET_SPEEDS = 5
+"""Speeds over ±3 % of the recommended speed at which the lobe samples' own SDM limits replace the references' ratio
+(``update``'s ``own_pocket``)."""
+
 OWN_MIN_ESS = 0.25
 """The least effective share of the lobe samples the own-SDM weights may leave (``update``'s ``own_sdm``): below it
 the weights are tempered (:func:`_own_temper`), so the 5 % and 95 % quantiles of 400 samples rest on at least five
@@ -742,6 +746,9 @@ class Posterior:
     lobe_z : ndarray, shape (m, P + 2), optional
         The lobe samples (rows of ``z``, as ``z``'s columns), resampled by those weights where they were weighted
         (rows repeat): the samples whose limits make ``limit_q_m``.
+    own_pocket_rpm : tuple of float
+        The speeds (rpm) at which the lobe samples' own SDM limits replaced the references' ratio near the most
+        productive speed (:func:`update`'s ``own_pocket``); empty where none did.
     """
 
     prior: ModalPrior
@@ -768,6 +775,7 @@ class Posterior:
     own_sdm_ess: float | None = None
     lobe_z: np.ndarray | None = None
     own_sdm_power: float | None = None
+    own_pocket_rpm: tuple = ()
 
     @property
     def theta(self) -> np.ndarray:
@@ -815,7 +823,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            skip_repeats: bool = True, step_until_chatter: bool | str = True, creep_span: float = 0.02,
            audible_margin: float = 0.025, max_cut_duration_s: float = 5.0,
            growth_error: tuple | None = GROWTH_ERROR, ring_error: tuple | None = RING_ERROR,
-           precursor: tuple | None = PRECURSOR, own_sdm: bool = True, growth_by: str = "zoa") -> Posterior:
+           precursor: tuple | None = PRECURSOR, own_sdm: bool = True, growth_by: str = "zoa",
+           own_pocket: int = POCKET_SPEEDS) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -1038,6 +1047,20 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         against 0.933 (the references' mean ratio instead: 10–11 of 20, 15–22 of 120); on EM28-80 14 of 20
         against 13, 6 of 120 against 7. Not the default.
 
+    own_pocket : int, default :data:`POCKET_SPEEDS`
+        ``forward="sdm"``: the lobe samples' own SDM limits at this many speeds evenly over ±3 % of the speed where the
+        band is most productive (the recommended speed as the references' ratios put it) replace the references'
+        ratio there, linearly between those speeds and fading over ±2 % beyond them (:func:`_pocket_own`); the
+        recommended point, the P(stable) map and the next cut then follow the corrected band. Each lobe sample
+        carries one of ``sdm_refs`` references' SDM/ZOA ratio curves, and at a lobe's peak the ratio depends on
+        where the sample's own peak lies: over 80 prior samples of EM16-50 a reference's ratio stood in for a
+        sample's own to ln sd 0.032 over the grid but 0.107 within ±3 % of the recommended speed (0.285 of the
+        samples off by more than 0.1), and the samples whose own peak is there are those whose SDM limit lies
+        furthest above their zero-order one — the band's upper tail was too light (95 % line 3.60 mm at
+        14704 rpm, the samples' own 3.96 mm; ``docs/design/shop.md``, *The band at the pocket from the samples' own
+        SDM limits*). It costs one search per lobe sample at each speed, all together (6.4 s CPU for 400 samples at
+        five speeds on EM16-50). 0: the references' ratios alone (as before 2026-12-01, night).
+
     Returns
     -------
     Posterior
@@ -1122,6 +1145,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                          field="min_step")
     if step_until_chatter not in (True, False, "near"):
         raise InputError(f"must be True, False or 'near', got {step_until_chatter!r}", field="step_until_chatter")
+    if int(own_pocket) != own_pocket or not 0 <= own_pocket <= 50:
+        raise InputError(f"must be a whole number in [0, 50], got {own_pocket}", field="own_pocket")
     cuts = tuple(cuts)
     f = prior.freq_grid()
     P = prior.sigma.size
@@ -1195,12 +1220,17 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     pick = rng.choice(n_samples, m, replace=False)
     lim = _limits(prior, prior.theta(z[pick, :P]), f, grid)
     own_ess = own_power = None
+    pocket_rpm = ()
     if log_ratio_grid is not None:  # each lobe sample corrected by one reference's SDM/ZOA ratio
         rows = rng.integers(log_ratio_grid.shape[0], size=m)
         lim = lim * np.exp(log_ratio_grid[rows])
         if own_sdm and kw_sdm is not None:
             pick, lim, own_ess, own_power = _own_reweight(prior, z, pick, lim, cuts, kw_sdm, lr_at_cuts[rows],
                                                           grid, f, boundary_width, rng, growth_by)
+        if own_pocket > 0:  # the band's upper tail at the productive speeds from the samples' own limits
+            lim, pocket_rpm = _pocket_own(prior, z[pick, :P], f, grid, lim, int(own_pocket),
+                                          cut_rpm=(np.array([c.rpm for c in cuts]) if own_sdm and kw_sdm is not None
+                                                   else None))
     zp = rng.standard_normal((m, P)) * free[:P]
     lim_prior = _limits(prior, prior.theta(zp), f, grid)
     q = np.quantile(lim, [0.05, 0.5, 0.95], axis=0)
@@ -1273,7 +1303,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                                                                            np.full(len(cuts), np.nan))),
                      tuple(float(v) if np.isfinite(v) else None for v in (rx[2] if rx is not None else
                                                                            np.full(len(cuts), np.nan))),
-                     kw.get("precursor"), noisy, own_ess, z[pick], own_power)
+                     kw.get("precursor"), noisy, own_ess, z[pick], own_power, pocket_rpm)
 
 
 def _option(value, field: str, form: str, ok, need: str) -> tuple:
@@ -1679,6 +1709,53 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
     idx = _systematic(w / w.sum(), rng)
     lim = lim[idx] * np.exp(_interp_near(own[idx] - lr_now[idx][:, first], grid, u))
     return pick[idx], lim, _ess(lw), alpha
+
+
+def _pocket_own(prior, zp, f, grid, lim, n: int, span: float = 0.03, cut_rpm=None):
+    """The lobes ``lim`` (m, G) of the lobe samples ``zp`` (m, P; rows may repeat) moved to each sample's own SDM limit
+    at ``n`` grid speeds evenly over ±``span`` of the speed where the band's 5 % limit times the speed is largest —
+    linearly in ln a between those speeds, fading over ±2 % beyond them (:func:`_interp_near`). Each search starts
+    from what the sample's lobes carry there (:func:`_sdm_own_log_ratio`, two halvings: ln sd 0.0044 from the full
+    search); a speed no lobe reaches, or a search that found no limit, leaves the sample's lobes as they were. A speed
+    within 0.4 % of one of ``cut_rpm`` is not searched: the lobes already carry the samples' own limits there
+    (:func:`_own_reweight`), and it keeps them. One pass: where the corrected band is most productive outside the
+    speeds searched (the recommended speed moved more than ``span``), the band there is the references' — the
+    recommended depth is checked there by held-out samples' own limits all the same (:func:`_recommended_own`).
+
+    Why: the references' ratio is one of a few samples' own, and at a lobe's peak the ratio depends on where the
+    sample's own peak lies — a random reference's stood in there to ln sd 0.107 on EM16-50 (0.032 over the whole
+    grid), and the samples whose peak lies at the speed, whose SDM limit is furthest above their zero-order one, got
+    another's: the band's upper tail was too light where the first cuts go (:func:`update`'s ``own_pocket``).
+
+    Returns the new lobes and the speeds searched (a tuple of rpm, increasing)."""
+    with np.errstate(invalid="ignore"):
+        q05 = np.quantile(lim, 0.05, axis=0)
+    q05 = np.where(np.isfinite(q05), q05, np.nan)
+    if not np.isfinite(q05).any():
+        return lim, ()
+    j = int(np.nanargmax(grid * q05))
+    ks = np.unique([int(np.argmin(np.abs(grid - grid[j] * (1 + d)))) for d in np.linspace(-span, span, n)])
+    u = grid[ks]
+    done = (np.zeros(u.size, bool) if cut_rpm is None or len(cut_rpm) == 0 else
+            np.min(np.abs(u[:, None] / np.asarray(cut_rpm)[None, :] - 1), axis=1) <= 0.004)
+    if done.all():
+        return lim, ()
+    uz, inv = np.unique(zp, axis=0, return_inverse=True)  # resampled rows repeat: one search per distinct sample
+    inv = inv.ravel()
+    first = np.zeros(uz.shape[0], int)
+    first[inv[::-1]] = np.arange(inv.size)[::-1]
+    s = ~done
+    a, fc = limit_at_speeds(prior, prior.theta(uz), u[s], f)  # (S, U')
+    carried = lim[first][:, ks[s]]
+    resid = np.zeros((uz.shape[0], u.size))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        guess = np.where(np.isfinite(carried / a) & (carried > 0), np.log(carried / a), 0.0)
+        lr = _sdm_own_log_ratio(prior, uz, u[s], f, guess, zoa=(a, fc), near=dict(bisections=2))
+        # _sdm_own_log_ratio gives 0 where its search found no limit: such a sample keeps its lobes
+        own = np.where(lr != 0.0, a * np.exp(lr), np.nan)
+        r = np.log(own / carried)
+    resid[:, s] = np.where(np.isfinite(r), r, 0.0)
+    return lim * np.exp(_interp_near(resid[inv], grid, u)), tuple(float(v) for v in u[s])
 
 
 def _own_temper(lw, ess_min: float) -> float:
