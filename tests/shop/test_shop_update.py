@@ -1638,3 +1638,6 @@ def test_the_band_at_the_pocket_is_made_of_the_lobe_samples_own_sdm_limits():
     for k, r in enumerate(u):
         j = int(np.argmin(np.abs(post.rpm - r)))
         np.testing.assert_allclose(post.limit_q_m[:, j], np.quantile(own[:, k], [0.05, 0.5, 0.95]), rtol=0.03)
+    for bad in (-1, 2.5, 51):
+        with pytest.raises(InputError, match="own_pocket"):
+            update(pr, [], rng=np.random.default_rng(0), n_samples=300, lobe_samples=60, own_pocket=bad)

@@ -1049,9 +1049,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
 
     own_pocket : int, default :data:`POCKET_SPEEDS`
         ``forward="sdm"``: the lobe samples' own SDM limits at this many speeds evenly over ±3 % of the speed where the
-        band is most productive (the recommended speed as the references' ratios put it) replace the references'
-        ratio there, linearly between those speeds and fading over ±2 % beyond them (:func:`_pocket_own`); the
-        recommended point, the P(stable) map and the next cut then follow the corrected band. Each lobe sample
+        band is most productive (the recommended speed as the references' ratios put it; one: that speed alone)
+        replace the references' ratio there, linearly between those speeds and fading over ±2 % beyond them
+        (:func:`_pocket_own`); the recommended point, the P(stable) map and the next cut then follow the corrected
+        band. Each lobe sample
         carries one of ``sdm_refs`` references' SDM/ZOA ratio curves, and at a lobe's peak the ratio depends on
         where the sample's own peak lies: over 80 prior samples of EM16-50 a reference's ratio stood in for a
         sample's own to ln sd 0.032 over the grid but 0.107 within ±3 % of the recommended speed (0.285 of the
@@ -1734,7 +1735,8 @@ def _pocket_own(prior, zp, f, grid, lim, n: int, span: float = 0.03, cut_rpm=Non
     if not np.isfinite(q05).any():
         return lim, ()
     j = int(np.nanargmax(grid * q05))
-    ks = np.unique([int(np.argmin(np.abs(grid - grid[j] * (1 + d)))) for d in np.linspace(-span, span, n)])
+    offsets = np.linspace(-span, span, n) if n > 1 else np.zeros(1)  # one speed: the most productive itself
+    ks = np.unique([int(np.argmin(np.abs(grid - grid[j] * (1 + d)))) for d in offsets])
     u = grid[ks]
     done = (np.zeros(u.size, bool) if cut_rpm is None or len(cut_rpm) == 0 else
             np.min(np.abs(u[:, None] / np.asarray(cut_rpm)[None, :] - 1), axis=1) <= 0.004)
