@@ -663,7 +663,7 @@ def _stft(x, L, hop, chunk=1 << 21):
 
     The frames are a strided view of ``x``, windowed and transformed ``chunk`` samples' worth at a time: all of them
     at once held ~14 copies of the record (3.8 GB for 10 min of 44.1 kHz audio), this the spectra and one chunk."""
-    from scipy import fft as sfft  # NumPy < 2's own FFT is 2–3× slower at these sizes: the CI floor runs 1.26
+    from scipy import fft as sfft  # as _long_psd's (there NumPy 1.26, CI's floor, is ~3× slower at odd lengths)
 
     n_frames = 1 + (x.size - L) // hop
     w = np.hanning(L)
@@ -2334,7 +2334,7 @@ _NEAR_HARMONICS = 8  # the lowest spindle harmonics searched
 
 def _long_psd(seg, rate, n):
     """One Hann frame of ``n`` samples (zero-padded ×4): (frequencies Hz, power spectral density)."""
-    from scipy import fft as sfft
+    from scipy import fft as sfft  # 4 n is any length: NumPy 1.26's FFT (CI's floor) ~3× slower at odd ones
 
     w = np.hanning(seg.size)
     z = sfft.rfft((seg - seg.mean()) * w, 4 * n)

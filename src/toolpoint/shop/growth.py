@@ -348,7 +348,7 @@ def ring_decay(samples, rate_hz: float, *, rpm: float, teeth: int, line_hz: floa
     >>> round(d.rate_per_s, 1), round(d.ln_sd, 2), d.resolved  # −26.1 /s within its ±1.96 ln sd
     (-22.7, 0.11, True)
     """
-    from scipy import fft as sfft  # every nll below is one FFT: NumPy < 2's own is 2–3× slower (the CI floor, 1.26)
+    from scipy import fft as sfft  # every nll below is one FFT: NumPy 1.26's (CI's floor) ~3× slower at odd lengths
     from scipy.optimize import minimize
     from scipy.signal import butter, sosfiltfilt
 
@@ -398,8 +398,9 @@ def ring_decay(samples, rate_hz: float, *, rpm: float, teeth: int, line_hz: floa
     edge = int(rd * 2.0 / B)  # the filter's settling at either end
     z = z[::q][edge:-edge]
     # the middle of it at a length whose FFT is fast (a product of 2, 3, 5, 7, 11: at most 4.3 % shorter): every
-    # likelihood below is one FFT of it, 4–5× faster than at an awkward length (Bluestein's; 9601 samples: 464 µs
-    # against 44 µs at 4800, benchmarks/bench_fft_sizes.py)
+    # likelihood below is one FFT of it, 4–8× faster than at an awkward length of about the same size (Bluestein's;
+    # scipy.fft, 2026-12-01: 192 µs at 4799 samples against 50 µs at 4800, 708 µs at 9601 against 85 µs at 9600;
+    # benchmarks/bench_fft_sizes.py)
     m = z.size
     while sfft.next_fast_len(m) != m:
         m -= 1
