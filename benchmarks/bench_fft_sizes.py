@@ -35,16 +35,11 @@ def main():
         x = rng.standard_normal(m) + 1j * rng.standard_normal(m)
         print(f"complex FFT of {m} ({'fast' if sfft.next_fast_len(m) == m else 'awkward'} length): numpy "
               f"{per_call(np.fft.fft, x, 1000):.0f}, scipy {per_call(sfft.fft, x, 1000):.0f}")
-    worst = 0.0
-    for m in range(200, 20001):
-        k = m
-        while sfft.next_fast_len(k) != k:
-            k -= 1
-        worst = max(worst, 1 - k / m)
+    from toolpoint.shop.growth import fast_len_at_most, ring_decay
+
+    worst = max(1 - fast_len_at_most(m) / m for m in range(200, 20001))
     print(f"trimmed to a fast length (lengths 200-20000): at most {100 * worst:.2f} % shorter")
     from scipy.signal import lfilter
-
-    from toolpoint.shop.growth import ring_decay
 
     rate, w, z = 20000.0, 2 * np.pi * 830.0, 0.005
     r, th = np.exp(-z * w / rate), w * np.sqrt(1 - z * z) / rate

@@ -1634,10 +1634,10 @@ def test_the_band_at_the_pocket_is_made_of_the_lobe_samples_own_sdm_limits():
     u = np.array(post.own_pocket_rpm)
     assert u.size >= 3 and u.min() <= post.recommended["rpm"] <= u.max(), (u, post.recommended)
     th = pr.theta(post.lobe_z[:, :pr.sigma.size])
-    own = np.array([sdm_lobes(*pr.tool(t)[:1] * 2, pr.tool(t)[1], rpm=u).depth_m for t in th])  # (60, 3)
+    own = np.array([sdm_lobes(mm, mm, cut, rpm=u).depth_m for mm, cut in map(pr.tool, th)])  # (60, 3)
     for k, r in enumerate(u):
         j = int(np.argmin(np.abs(post.rpm - r)))
         np.testing.assert_allclose(post.limit_q_m[:, j], np.quantile(own[:, k], [0.05, 0.5, 0.95]), rtol=0.03)
-    for bad in (-1, 2.5, 51):
+    for bad in (-1, 2.5, 51, "five"):
         with pytest.raises(InputError, match="own_pocket"):
             update(pr, [], rng=np.random.default_rng(0), n_samples=300, lobe_samples=60, own_pocket=bad)

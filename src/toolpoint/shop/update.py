@@ -1146,8 +1146,9 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                          field="min_step")
     if step_until_chatter not in (True, False, "near"):
         raise InputError(f"must be True, False or 'near', got {step_until_chatter!r}", field="step_until_chatter")
-    if int(own_pocket) != own_pocket or not 0 <= own_pocket <= 50:
-        raise InputError(f"must be a whole number in [0, 50], got {own_pocket}", field="own_pocket")
+    if not (isinstance(own_pocket, (int, float, np.integer, np.floating)) and float(own_pocket).is_integer()
+            and 0 <= own_pocket <= 50):
+        raise InputError(f"must be a whole number in [0, 50], got {own_pocket!r}", field="own_pocket")
     cuts = tuple(cuts)
     f = prior.freq_grid()
     P = prior.sigma.size
