@@ -35,7 +35,7 @@ CPU time (time.process_time), not wall time: the machine is shared.
    band holds the true limit at ≥ 90 % of the speeds and is ≤ 20 % of the limit wide at the recommended speed;
    ≤ 1 chattering cut (median); each update ≤ 30 s CPU. SMC against SIR (ESS at equal CPU) on one case.
    With ``--no-stop``, after each number of cuts: the band's mean coverage over the truths with its standard error
-   (a truth's coverage is one draw: its speeds are not independent; ±0.03–0.05 over 20 truths), and its change from
+   (a truth's coverage is one draw: its speeds are not independent; ±0.02–0.05 over 20 truths), and its change from
    the prior's band paired by truth.
 3. ``forward``: CPU of one call of the likelihood's forward model (``limit_at_speeds``, 500 samples, 6 speeds).
 4. ``ceiling``: what the convergence test asks of an exactly calibrated band. The prior's own 5–95 % band
@@ -574,7 +574,7 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                     away = np.array([r.coverage_away[n] for r in runs])
                     wid = np.median([r.width[n] for r in runs])
                     # the standard error over truths: a truth's coverage is one number (its speeds are not
-                    # independent draws), and over 20 truths it was ±0.03–0.05; the change from the prior's band on
+                    # independent draws), and over 20 truths it was ±0.02–0.05; the change from the prior's band on
                     # the same truths (paired) takes out which truths the set happened to hold
                     se = cov.std(ddof=1) / math.sqrt(cov.size) if cov.size > 1 else float("nan")
                     d = cov - np.array([r.coverage[0] for r in runs])
