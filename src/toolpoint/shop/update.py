@@ -1057,10 +1057,11 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         where the sample's own peak lies: over 80 prior samples of EM16-50 a reference's ratio stood in for a
         sample's own to ln sd 0.032 over the grid but 0.107 within ±3 % of the recommended speed (0.285 of the
         samples off by more than 0.1), and the samples whose own peak is there are those whose SDM limit lies
-        furthest above their zero-order one — the band's upper tail was too light (95 % line 3.60 mm at
-        14704 rpm, the samples' own 3.96 mm; ``docs/design/shop.md``, *The band at the pocket from the samples' own
-        SDM limits*). It costs one search per lobe sample at each speed, all together (6.4 s CPU for 400 samples at
-        five speeds on EM16-50). 0: the references' ratios alone (as before 2026-12-01, night).
+        furthest above their zero-order one — the band's upper tail was too light (the prior's update with
+        ``rng`` seed 0: 95 % line 3.60 mm at 14704 rpm, with the samples' own 3.96 mm; ``docs/design/shop.md``,
+        *The band at the pocket from the samples' own SDM limits*). It costs one search per lobe sample at each
+        speed, all together (6.4 s CPU for 400 samples at five speeds on EM16-50). 0: the references' ratios
+        alone (as before 2026-12-01, night).
 
     Returns
     -------
@@ -1743,10 +1744,9 @@ def _pocket_own(prior, zp, f, grid, lim, n: int, span: float = 0.03, cut_rpm=Non
             np.min(np.abs(u[:, None] / np.asarray(cut_rpm)[None, :] - 1), axis=1) <= 0.004)
     if done.all():
         return lim, ()
-    uz, inv = np.unique(zp, axis=0, return_inverse=True)  # resampled rows repeat: one search per distinct sample
+    # resampled rows repeat: one search per distinct sample (``first``: its first row)
+    uz, first, inv = np.unique(zp, axis=0, return_index=True, return_inverse=True)
     inv = inv.ravel()
-    first = np.zeros(uz.shape[0], int)
-    first[inv[::-1]] = np.arange(inv.size)[::-1]
     s = ~done
     a, fc = limit_at_speeds(prior, prior.theta(uz), u[s], f)  # (S, U')
     carried = lim[first][:, ks[s]]
@@ -1784,9 +1784,7 @@ def _own_temper(lw, ess_min: float) -> float:
 
 def _cut_speeds(rpm_c):
     """The distinct cut speeds u (sorted), each cut's index into u, and the first cut at each speed."""
-    u, inv = np.unique(rpm_c, return_inverse=True)
-    first = np.zeros(u.size, int)
-    first[inv[::-1]] = np.arange(rpm_c.size)[::-1]
+    u, first, inv = np.unique(rpm_c, return_index=True, return_inverse=True)
     return u, inv, first
 
 
