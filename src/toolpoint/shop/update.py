@@ -65,7 +65,8 @@ corrected by the semi-discretisation (``forward="sdm"``, the default: a machine'
 
 Recommended point: the speed that maximises n · a₀₅(n) (removal rate at a fixed feed per tooth and width)
 at the depth a₀₅ (P(stable) = 0.95); with ``forward="sdm"`` the depth is lowered to the own SDM 5 % limit, at
-that speed, of posterior samples other than the lobe samples where that is lower (``update``). **Next test
+that speed, of posterior samples other than the lobe samples where that is lower (``update``) — each weighted by
+the cuts within 0.4 % of that speed, with its own limit there (:func:`_recommended_own`). **Next test
 cut**, two rules:
 
 * ``"info"`` (default): the cut that most reduces the expected log width ln(a₉₅/a₀₅) of the limit at
@@ -1028,7 +1029,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         samples agree with the cuts only through the references' mean. It costs one search per lobe sample over
         the cut speeds, all samples together (:func:`~toolpoint.stability.sdm_limit_near_many`: 1.2 s CPU for 120
         samples at three speeds on EM16-50, against 1.9–2.1 s one sample at a time). The recommended depth's
-        check (held-out samples' own limits at its speed) is not weighted: it stays the more cautious figure.
+        check (held-out samples' own limits at its speed) is weighted by the cuts within 0.4 % of that speed alone,
+        untempered (:func:`_recommended_own`; unweighted where no cut lies there).
         Measured in the whole loop: ``docs/design/shop.md`` (*Own SDM limits at the cut speeds*). False: as before
         2026-11-30.
     growth_by : {"zoa", "sdm"}, default "zoa"
@@ -1292,7 +1294,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         # limit 0.79–0.83 mm at the example tool's prior recommended speed, fresh prior samples' 0.68–0.72 mm)
         hold = np.setdiff1d(np.arange(n_samples), pick)[:m]
         held = hold.size >= min(m, 100)  # else (few samples beyond the lobes' ones) the lobe samples
-        rec = _recommended_own(prior, z[hold if held else pick, :P], f, grid, lim, rec, lobe_samples=not held)
+        rec = _recommended_own(prior, z[hold if held else pick], f, grid, lim, rec, lobe_samples=not held,
+                               cuts=cuts, kw=kw_sdm if own_sdm else None, boundary_width=boundary_width)
         if not cuts:  # measured calibrated with the lobe samples (docs/design/shop.md): kept on them
             nxt = _first_cut_own(prior, z[pick, :P], f, grid, lim, nxt, bound)
     k_next = int(np.argmin(np.abs(grid - nxt["rpm"])))
@@ -1807,6 +1810,7 @@ def _own_limits(prior, z, f, grid, lim, k, lobe_samples=True):
     """Posterior samples' ``z`` own SDM limits at grid[k] (S,), searched from their zero-order limit times the
     median SDM/ZOA ratio of the lobes there (:func:`_sdm_own_log_ratio`): each lobe sample's own ratio when ``z``
     are the lobe samples (rows of ``lim``), else the ratio of the medians. inf where no lobe reaches the speed."""
+    z = z[:, :prior.sigma.size]  # the modal parameters' columns (not the label offset's and growth's)
     u = grid[k:k + 1]
     zoa = limit_at_speeds(prior, prior.theta(z), u, f)
     a_zoa = zoa[0][:, 0]
@@ -1818,25 +1822,73 @@ def _own_limits(prior, z, f, grid, lim, k, lobe_samples=True):
     return np.where(np.isfinite(own), own, np.inf)
 
 
-def _recommended_own(prior, z, f, grid, lim, rec, lobe_samples=False):
+def _recommended_own(prior, z, f, grid, lim, rec, lobe_samples=False, cuts=(), kw=None, boundary_width=0.05):
     """The recommended depth checked against the own SDM limits of posterior samples ``z`` that are not the lobe
     samples: the lower of the band's 5 % limit and theirs, P(stable) from theirs.
 
     The band rests on four references' SDM/ZOA ratio curves and on the lobe samples, and the recommended speed is
     the one where that estimate of n · a₀₅ is largest — where it is likely too high, as for the first cut
     (:func:`_first_cut_own`). Other samples' own limits at that one speed are an estimate the choice did not see.
-    Measured: ``docs/design/shop.md`` (*The recommended depth checked*)."""
-    own = _own_limits(prior, z, f, grid, lim, int(np.argmin(np.abs(grid - rec["rpm"]))), lobe_samples)
-    # the deepest own limit with at most 5 % of the samples at or below it, as the risk rule's: an interpolated
-    # quantile sat up to one sample above it (P(stable) 0.947 claimed as 0.95 with 150 samples)
-    kq = int(math.floor(0.05 * own.size + 1e-9))
-    srt = np.sort(own)
+    Measured: ``docs/design/shop.md`` (*The recommended depth checked*).
+
+    Held-out samples (``lobe_samples`` False) with cuts within 0.4 % of the recommended speed and ``kw`` (the
+    likelihood's arguments of the sampling): each sample is weighted by those cuts' likelihood with its own limit
+    there (the boundary width ``boundary_width`` alone) over the sampling's (the references' mean ratio, their
+    spread in the width), and the 5 % limit and P(stable) are the weighted ones — untempered. Why: the sampling
+    sees a cut through the references' mean ratio, and at a speed where the samples' own ratios spread (EM12-60
+    truth 93 at 17769 rpm: ln sd 0.07, their mean 0.09 above the references') most of its samples put their own
+    limit above a cut heard chattering there; the lobe samples' weights are tempered (:func:`_own_temper`), and
+    the depth recommended after its 5th cut was 2.54 mm, 8 % under that cut (2.76 mm). With the weights 2.46 mm
+    (``rng`` seed 1) — still above the truth's limit there, 2.30 mm: the weights make the check agree with the
+    cuts at its speed; they cannot move a posterior that is wrong elsewhere. On EM12-60's truths 80–99 the
+    whole loop's cuts and the updates whose recommended depth lay above the truth were the same with and without
+    them (``docs/design/shop.md``)."""
+    k = int(np.argmin(np.abs(grid - rec["rpm"])))
+    own = _own_limits(prior, z, f, grid, lim, k, lobe_samples)
+    w = _own_weights_at(prior, z, f, grid[k], own, cuts, kw, boundary_width) if not lobe_samples else None
+    srt_i = np.argsort(own, kind="stable")
+    srt = own[srt_i]
+    if w is None:
+        # the deepest own limit with at most 5 % of the samples at or below it, as the risk rule's: an interpolated
+        # quantile sat up to one sample above it (P(stable) 0.947 claimed as 0.95 with 150 samples)
+        kq = int(math.floor(0.05 * own.size + 1e-9))
+    else:  # the same with the weights: the deepest own limit with at most 5 % of the weight at or below it
+        kq = int(np.searchsorted(np.cumsum(w[srt_i]) / w.sum(), 0.05 + 1e-9, side="right"))
     q = float(srt[kq - 1]) if kq >= 1 else float(srt[0] * (1 - 1e-9))
     out = dict(rec, own_sdm_p05_m=q if np.isfinite(q) else None, own_sdm_held_out=not lobe_samples)
     if np.isfinite(q) and q < rec["depth_m"]:
         out["depth_m"] = q
-    out["p_stable"] = float(np.mean(own > out["depth_m"]))
+    above = own > out["depth_m"]
+    out["p_stable"] = float(np.mean(above) if w is None else np.sum(w[above]) / w.sum())
     return out
+
+
+def _own_weights_at(prior, z, f, rpm, own, cuts, kw, boundary_width):
+    """Weights (S,) of posterior samples ``z`` by the cuts within 0.4 % of ``rpm`` with their own SDM limits ``own``
+    (S,) at ``rpm`` over the sampling's likelihood (``kw``: its log_ratio and boundary width per cut); None where no
+    cut lies there (or no weight is finite: the likelihood's floors make that unreachable)."""
+    near = [i for i, c in enumerate(cuts) if abs(c.rpm / rpm - 1.0) <= 0.004] if kw is not None else []
+    if not near:
+        return None
+    P = prior.sigma.size
+    C = len(cuts)
+    th = prior.theta(z[:, :P])
+    mu, sd = kw["label_offset"]
+    g_med, g_sd = kw["label_growth"]
+    extra = dict(label_offset=mu + sd * z[:, P], label_growth=g_med * np.exp(g_sd * z[:, P + 1]))
+    lr0 = np.broadcast_to(np.asarray(kw.get("log_ratio", 0.0), float), (z.shape[0], C)).copy()
+    bw0 = np.broadcast_to(np.asarray(kw["boundary_width"], float), (C,)).copy()
+    a_c = limit_at_speeds(prior, th, np.array([cuts[i].rpm for i in near]), f)[0]  # zero-order, (S, n)
+    lr1, bw1 = lr0.copy(), bw0.copy()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lr1[:, near] = np.log(own)[:, None] - np.log(a_c)  # the own limit at rpm stands for the cuts' speeds
+    bw1[near] = boundary_width
+    lw = (log_likelihood(prior, th, cuts, **dict(kw, **extra, log_ratio=lr1, boundary_width=bw1))
+          - log_likelihood(prior, th, cuts, **dict(kw, **extra, log_ratio=lr0, boundary_width=bw0)))
+    lw = np.where(np.isfinite(lw), lw, -np.inf)
+    if not np.isfinite(lw).any():
+        return None
+    return np.exp(lw - lw.max())
 
 
 def _first_cut_own(prior, z, f, grid, lim, nxt, bound):
