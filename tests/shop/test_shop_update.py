@@ -1434,7 +1434,7 @@ def test_the_recommended_depths_check_weighs_held_out_samples_by_the_cuts_at_its
     The weighted 5 % limit is then the deepest own limit with at most 5 % of the weight at or below it."""
     from scipy.stats import norm
 
-    from toolpoint.shop.update import _own_weights_at, _recommended_own
+    from toolpoint.shop.update import _own_limits, _own_weights_at, _recommended_own
 
     pr = cornelius_2024(0.1)
     P = pr.sigma.size
@@ -1470,8 +1470,6 @@ def test_the_recommended_depths_check_weighs_held_out_samples_by_the_cuts_at_its
     lim = np.tile(own[:, None], (1, 3))  # the lobes: the samples' own limits (the guess of the search)
     rec = {"rpm": rpm, "depth_m": 10.0, "p_stable": 1.0}
     got = _recommended_own(pr, z, f, grid, lim, rec, cuts=cuts, kw=kw, boundary_width=w)
-    from toolpoint.shop.update import _own_limits
-
     o = _own_limits(pr, z, f, grid, lim, 1, False)
     wo = _own_weights_at(pr, z, f, rpm, o, cuts, kw, w)
     order = np.argsort(o)
