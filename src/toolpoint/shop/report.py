@@ -203,7 +203,8 @@ def away_note(cuts) -> str:
     # measured on 180 campaigns without a stop (nine sets of 20 truths of four tools, 1–6 cuts, 2026-12-01/02;
     # docs/design/shop.md, *The recommended depth's check weighs the cuts at its speed*): the band is calibrated on
     # average away from the cuts on some tools, not on all, and a tool in the prior's tail falls outside it over a
-    # range; the recommended depth's 5 % held on three tools, not on EM12-60 (0.10 ± 0.02 of its updates)
+    # range; the recommended depth's 5 % held on three tools, not on EM12-60 (0.10 ± 0.02 of its updates; 140 of
+    # the 180 truths ran before the held-out samples were weighted by the cuts at the recommended speed: the same cuts)
     return (f"the band is tested by your cuts at {min(rpm):.0f}–{max(rpm):.0f} rpm; away from those speeds it rests "
             "on the model alone — in virtual campaigns it held the true limit at 85–96 % of those speeds on average "
             "(it claims 90 %), yet at under 90 % of all speeds for 15–40 % of the tools, and the true limit lay under "
