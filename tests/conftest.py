@@ -23,6 +23,8 @@ from toolpoint.dynamics.assembly import load_assembly
 _HERE = Path(__file__).resolve().parent
 sys.path[:0] = [str(_HERE)] + sorted(str(d) for d in _HERE.iterdir() if d.is_dir() and any(d.glob("test_*.py")))
 
+pytest_plugins = ["shared_fixtures"]  # tests/base: the property and fault tests' session fixtures
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "numerical_case.toml"
 

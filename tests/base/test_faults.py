@@ -44,7 +44,6 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from test_properties import heavy, seeds  # noqa: F401  (module fixtures: the small campaign, models, FRFs, library)
 from toolpoint.cli.main import main
 from toolpoint.errors import InputError
 from toolpoint.io.table import csv_safe, csv_unsafe
@@ -151,7 +150,7 @@ def test_csv_cells_never_formulas_and_read_back_as_written(text):
 
 
 @pytest.fixture(scope="module")
-def camp(seeds, tmp_path_factory):  # noqa: F811
+def camp(seeds, tmp_path_factory):
     """The seeds' campaign with its holder as a model (no inverse RCSA: a library run costs ~0.1 s a tool)."""
     d = tmp_path_factory.mktemp("fastcamp") / "camp"
     shutil.copytree(seeds / "camp", d)
@@ -202,7 +201,7 @@ def _tree(folder: Path) -> set:
 @_n(3)
 @given(ids=st.lists(tool_ids(), min_size=1, max_size=3))
 @example(ids=["../../x", "x-9bdbf20b56", "em10", "=cmd|' /C calc'!A0", "CON.x\x00/../" + "z" * 300])
-def test_library_writes_only_inside_its_folder_and_report_reads_only_what_it_wrote(seeds, camp, tmp_path, ids):  # noqa: F811
+def test_library_writes_only_inside_its_folder_and_report_reads_only_what_it_wrote(seeds, camp, tmp_path, ids):
     """Each example: a library of generated ids, run in-process (tiny settings), then ``report``."""
     from toolpoint.recommend.library import read_library
     from toolpoint.recommend.report import write_report
@@ -351,7 +350,7 @@ def _one_error_line(text: str) -> str:
     return errors[0]
 
 
-def _commands(seeds, heavy, d: Path) -> dict:  # noqa: F811
+def _commands(seeds, heavy, d: Path) -> dict:
     lobes = ["lobes", seeds / "tp.csv", "--teeth", "2", "--immersion", "1", "--rpm", "5000:20000", "--rpm-points",
              "40", "--tangential-coeff", "6e8", "--radial-ratio", "0.3"]
     lib = ["library", heavy / "lib.csv", "--campaign", seeds / "camp", "--models", seeds / "results" / "models",
@@ -378,7 +377,7 @@ COMMANDS = ["tap --out", "tap --plot", "modal --out", "modal --plot", "identify 
 
 
 @pytest.mark.parametrize("name", COMMANDS)
-def test_a_full_disk_is_one_line_naming_the_file_and_nothing_is_left(seeds, heavy, disk, name,  # noqa: F811
+def test_a_full_disk_is_one_line_naming_the_file_and_nothing_is_left(seeds, heavy, disk, name,
                                                                       request):
     argv, named = _commands(seeds, heavy, disk.path)[name]
     inputs = _snapshot_inputs([a for a in argv if isinstance(a, Path) and not a.is_relative_to(disk.path)]
@@ -402,7 +401,7 @@ def test_a_full_disk_is_one_line_naming_the_file_and_nothing_is_left(seeds, heav
     assert "file system:" not in line and str(named) in line, line  # names the file, not "the file system"
 
 
-def _library_args(seeds, camp, lib: Path, out: Path, samples="4", rpm_points="8") -> list:  # noqa: F811
+def _library_args(seeds, camp, lib: Path, out: Path, samples="4", rpm_points="8") -> list:
     return ["library", lib, "--campaign", camp, "--models", seeds / "results" / "models", "--out", out,
             "--workers", "1", "--samples", samples, "--rpm-points", rpm_points]
 
@@ -413,7 +412,7 @@ def _ids_in(table: Path) -> list[str]:
 
 
 @pytest.mark.parametrize("at", ["tool files", "row"])
-def test_library_filling_the_disk_mid_run_keeps_finished_rows(seeds, camp, tmp_path, disk, monkeypatch,  # noqa: F811
+def test_library_filling_the_disk_mid_run_keeps_finished_rows(seeds, camp, tmp_path, disk, monkeypatch,
                                                               request, at):
     """The disk fills while the second of three tools is written (its files, or its row: ids of 5000 characters make
     a row longer than a page, so the append cannot fit in the table's last page): exit 2, one line naming the file,
@@ -559,7 +558,7 @@ def _cut(blob: bytes, how: str) -> bytes:
 @pytest.mark.parametrize("how", ["half", "number", "no-newline"])
 @pytest.mark.parametrize("kind", ["frf", "csv"])
 @pytest.mark.parametrize("command", ["lobes", "modal", "identify"])
-def test_commands_refuse_an_frf_cut_short_with_one_line(heavy, tmp_path, command, kind, how):  # noqa: F811
+def test_commands_refuse_an_frf_cut_short_with_one_line(heavy, tmp_path, command, kind, how):
     """The tool-point FRF of the coarse assembly (150 points), cut: exit 2, one line naming the file and the line,
     nothing written; complete but without its last line break: read (exit 0)."""
     from toolpoint.io.frf_files import read_frf, write_frf
@@ -591,7 +590,7 @@ def test_commands_refuse_an_frf_cut_short_with_one_line(heavy, tmp_path, command
 # ---------------------------------------------------------------- SIGTERM
 @pytest.mark.slow
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGTERM")
-def test_library_killed_with_sigterm_resumes_keeping_its_rows(seeds, camp, tmp_path):  # noqa: F811
+def test_library_killed_with_sigterm_resumes_keeping_its_rows(seeds, camp, tmp_path):
     from toolpoint.campaign.run import folder_lock
 
     ids = [f"T{k:02d}" for k in range(8)]

@@ -1394,11 +1394,58 @@ def test_the_corrected_samples_own_sdm_limits_move_the_band_to_the_sdm():
         cuts = [TestCut(float(r), float(a * q), bool(q < 1)) for r, a in zip(rpm, a_sdm) for q in (0.93, 1.07)]
         for tr in err:
             q = update(pr, cuts, rng=np.random.default_rng(0), n_samples=300, lobe_samples=150, forward="sdm",
-                       sdm_refs=2, rpm_grid=rpm, sdm_train=tr, own_sdm=False).limit_q_m / a_sdm
+                       sdm_refs=2, rpm_grid=rpm, sdm_train=tr, sdm_train_model="mean", own_sdm=False).limit_q_m / a_sdm
             err[tr].extend(np.abs(np.log(q[1])))
             if tr:
                 assert np.all(q[0] <= 1) and np.all(1 <= q[2]), (seed, q)
     assert np.mean(err[60]) < 0.035 and np.mean(err[60]) < np.mean(err[0]), {k: np.mean(v) for k, v in err.items()}
+
+
+def test_the_ratio_fit_recovers_a_quadratic_and_holds_its_range():
+    """``sdm_train_model="quadratic"``: each sample's SDM/ZOA ratio at the cut speeds from its prior coordinates. On
+    ratios that are exactly quadratic in the free columns of z the fit recovers them on fresh samples to rounding
+    (a fixed column is ignored, the search's failures — ratio 0 — are left out), its residual sd is the noise's
+    added to them (χ² with T − p degrees of freedom), a sample far outside the training cloud is held within the
+    training range widened by one residual sd, a speed with too few rows gets their mean, and ``_at`` hands the
+    likelihood each sample's ratio per cut."""
+    from toolpoint.shop.update import _at, _RatioFit
+
+    rng = np.random.default_rng(7)
+    free = np.array([True, True, False, True])
+    T = 200
+
+    def truth(z):  # two speeds, each quadratic in the free columns
+        return np.c_[0.3 + 0.05 * z[:, 0] - 0.02 * z[:, 1] + 0.01 * z[:, 3] ** 2,
+                     0.1 - 0.03 * z[:, 3] + 0.02 * z[:, 0] ** 2]
+
+    z = rng.standard_normal((T, 6)) * np.r_[free, True, True]
+    lr = truth(z)
+    lr[:7, 1] = 0.0  # the search found no limit there
+    inv = np.array([0, 1, 1])  # three cuts, two at the second speed
+    fit = _RatioFit(z, lr, free, inv)
+    znew = rng.standard_normal((50, 6)) * np.r_[free, True, True]
+    kept = [lr[:, k][lr[:, k] != 0] for k in range(2)]  # the range (no noise: no widening) of the training ratios
+    held = np.clip(truth(znew), [v.min() for v in kept], [v.max() for v in kept])
+    assert np.mean(held == truth(znew)) > 0.9  # most fresh samples inside it
+    np.testing.assert_allclose(fit(znew), held[:, inv], atol=1e-12)
+    assert np.all(fit.resid_sd < 1e-12)
+    # noise: the residual sd estimates it (sd of the estimate ≈ σ / √(2 (T − p)): 5 % here)
+    noisy = truth(z) + rng.normal(0, 0.02, (T, 2))
+    fit_n = _RatioFit(z, noisy, free, inv)
+    np.testing.assert_allclose(fit_n.resid_sd, 0.02, rtol=0.2)
+    # far outside the training cloud: held within [min − sd, max + sd] of the training ratios
+    far = np.zeros((1, 6))
+    far[0, 0] = 40.0
+    out = fit_n(far)[0]
+    assert np.all(out <= noisy.max(axis=0)[inv] + fit_n.resid_sd[inv] + 1e-12)
+    assert out[0] == pytest.approx(noisy[:, 0].max() + fit_n.resid_sd[0])
+    # too few rows for the 7 coefficients (fewer than 14): their mean, their sd
+    few = _RatioFit(z[:10], noisy[:10], free, inv)
+    np.testing.assert_allclose(few(znew), np.broadcast_to(noisy[:10].mean(axis=0)[inv], (50, 3)), atol=1e-12)
+    np.testing.assert_allclose(few.resid_sd, noisy[:10].std(axis=0, ddof=1))
+    kw = _at(dict(boundary_width=0.05, ratio_fit=fit), znew)
+    assert "ratio_fit" not in kw and kw["log_ratio"].shape == (50, 3)
+    assert _at(dict(boundary_width=0.05), znew) == dict(boundary_width=0.05)
 
 
 def test_own_sdm_weights_are_tempered_only_as_far_as_the_samples_need():

@@ -475,6 +475,10 @@ POCKET_SPEEDS = 5
 """Speeds over ±3 % of the recommended speed at which the lobe samples' own SDM limits replace the references' ratio
 (``update``'s ``own_pocket``)."""
 
+SDM_TRAIN = 200
+"""Posterior samples whose own SDM limits at the cut speeds train ``update``'s per-sample SDM/ZOA ratio (its
+``sdm_train``; :class:`_RatioFit`) before the third sampling."""
+
 OWN_MIN_ESS = 0.25
 """The least effective share of the lobe samples the own-SDM weights may leave (``update``'s ``own_sdm``): below it
 the weights are tempered (:func:`_own_temper`), so the 5 % and 95 % quantiles of 400 samples rest on at least five
@@ -818,7 +822,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            freq_sigma: float = 0.02, freq_outlier: float = 0.05, rule: str = "info", risk: float | None = None,
            lobe_samples: int = 400,
            n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "sdm", sdm_refs: int = 4,
-           min_step: float | None = None, sdm_train: int = 0, miss_rate: float = 0.0,
+           min_step: float | None = None, sdm_train: int = SDM_TRAIN, sdm_train_model: str = "quadratic",
+           miss_rate: float = 0.0,
            label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
            cut_duration_s: float = 1.0, risk_after_chatter: float | None = None,
            skip_repeats: bool = True, step_until_chatter: bool | str = True, creep_span: float = 0.02,
@@ -885,15 +890,26 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         Probability that a chattering cut is labelled stable (a detector's missed chatter; module docstring):
         a stable label then never rules out a limit below it by more than ε + m. The risk of the next cut stays
         the cut's own P(chatter).
-    sdm_train : int, default 0
+    sdm_train : int, default :data:`SDM_TRAIN`
         ``forward="sdm"`` with cuts: samples of the corrected posterior whose own SDM limits at the cut speeds
         (:func:`~toolpoint.stability.sdm_limit_near`) replace the references' ratio there — its mean in the
         likelihood, its spread added to the boundary width — before a third sampling; the lobe samples' ratio
         is moved to that mean within a few % of the cut speeds (0: the references only). The references come
         from the zero-order posterior, which moved its parameters to explain the cuts; their ratio at the
-        cut speeds was measured 0.1–0.2 (ln) off the corrected samples' own. 60 brings the median limit at the
-        cut speeds closer to the SDM's but did not make campaigns converge more often, at 3–6 s more per update:
-        off by default (``docs/design/shop.md``).
+        cut speeds was measured 0.1–0.2 (ln) off the corrected samples' own. With their mean alone
+        (``sdm_train_model="mean"``) 60 brought the median limit at the cut speeds closer to the SDM's but did not
+        make campaigns converge more often, at 3–6 s more per update (``docs/design/shop.md``). With each sample's
+        own ratio (the quadratic fit, the default since 2026-12-02) the recommended depth on EM12-60's fresh truths
+        120–139 lay above the truth after 5 of 120 updates against 11 with ``sdm_train=0``, where it claims 5 %
+        (*Each sample's own SDM ratio in the sampling* there), for about 2–4 s more CPU per update (one search of
+        200 samples at the cut speeds, a third sampling; EM16-50 after 6 cuts: 28.9 s against 24.9 s). 0: the
+        references only (as before 2026-12-02).
+    sdm_train_model : {"quadratic", "mean"}, default "quadratic"
+        With ``sdm_train`` > 0, how the training samples' own ratios enter the third sampling. ``"mean"``: their
+        mean at each cut speed, their spread added to the boundary width (as measured above, with the full
+        search). ``"quadratic"``: each sample's own ratio from a least-squares fit quadratic in its prior
+        coordinates (:class:`_RatioFit`; the searches with two halvings), the fit's residual sd added to the
+        width — the sampling then sees each sample's own limit at the cut speeds, not one mean for all.
     label_offset : (float, float), default (0.035, 0.035)
         Mean and standard deviation of δ, ln of how far above the stability limit the shop first *hears* chatter:
         the labels' boundary is a_lim e^δ, one δ for all the cuts (a parameter of the posterior, column ``P`` of
@@ -1100,6 +1116,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         raise InputError(f"must be in (0, risk = {risk:g}], got {risk_after_chatter}", field="risk_after_chatter")
     if int(sdm_train) != sdm_train or sdm_train < 0:
         raise InputError(f"must be a whole number ≥ 0, got {sdm_train}", field="sdm_train")
+    if sdm_train_model not in ("mean", "quadratic"):
+        raise InputError(f"must be 'mean' or 'quadratic', got {sdm_train_model!r}", field="sdm_train_model")
     if not 0 <= miss_rate < 1:
         raise InputError(f"must be in [0, 1), got {miss_rate}", field="miss_rate")
     if not (math.isfinite(freq_sigma) and 0 < freq_sigma <= 0.5):
@@ -1207,11 +1225,18 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                 u, inv, first = _cut_speeds(rpm_c)
                 lr_ref_u = lr_c[:, first]  # (R, U)
                 z_tr = z[rng.choice(n_samples, min(int(sdm_train), n_samples), replace=False), :P]
-                lr_tr = _sdm_own_log_ratio(prior, z_tr, u, f, lr_ref_u.mean(axis=0))  # (T, U)
-                mean_u = lr_tr.mean(axis=0)
-                sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
+                if sdm_train_model == "mean":
+                    lr_tr = _sdm_own_log_ratio(prior, z_tr, u, f, lr_ref_u.mean(axis=0))  # (T, U)
+                    mean_u = lr_tr.mean(axis=0)
+                    sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
+                    ratio = dict(log_ratio=mean_u[inv])
+                else:  # each sample's own ratio from a quadratic fit in z (its residual sd in the width)
+                    lr_tr = _sdm_own_log_ratio(prior, z_tr, u, f, lr_ref_u.mean(axis=0), near=dict(bisections=2))
+                    fit = _RatioFit(z_tr, lr_tr, prior.sigma > 0, inv)
+                    mean_u, sd_u = fit.mean, fit.resid_sd
+                    ratio = dict(ratio_fit=fit)
                 kw3 = dict(kw, boundary_width=np.sqrt(boundary_width ** 2 + sd_u[inv] ** 2),
-                           log_ratio=mean_u[inv], growth_error=growth_error, growth_x=gx, **sdm_kw)
+                           growth_error=growth_error, growth_x=gx, **ratio, **sdm_kw)
                 z = _sample(prior, _draw_z(rng, n_samples, free), cuts, kw3, method, n_moves,
                             rng, ess_hist, acc)
                 log_ratio_grid = lr_g + _carry(mean_u[None, :] - lr_ref_u, grid, u)
@@ -1334,6 +1359,59 @@ def _draw_z(rng, n, free):
     return z
 
 
+class _RatioFit:
+    """Each sample's ln(a_SDM / a_ZOA) at the cut speeds from its prior coordinates: a least-squares fit,
+    quadratic in z (its free columns, no cross terms), to training samples' own ratios ``lr`` (T, U) at the U
+    distinct cut speeds, one fit per speed (a speed with fewer than two training rows per coefficient: their mean
+    alone). ``inv`` (C,): each cut's speed. Rows where the search found no limit (ratio 0) are left out of the
+    fit. A prediction is held within the training ratios' range widened by one residual sd, since a quadratic
+    far from its training cloud (the tempering starts from the prior) is no model of the ratio.
+
+    Why: the sampling otherwise sees the cuts through one mean ratio per speed, while the samples' own ratios
+    spread by ln sd 0.07–0.11 at EM12-60's productive speeds; a fit in z explained 0.77–0.89 of that spread on
+    held-out posterior samples (one truth, four speeds; 0.41–0.48 where linear) — ``docs/design/shop.md``."""
+
+    def __init__(self, z, lr, free, inv):
+        self.free, self.inv = np.asarray(free, bool), np.asarray(inv, int)
+        X = self._features(z)
+        U = lr.shape[1]
+        self.coef = np.zeros((X.shape[1], U))
+        self.mean, self.resid_sd = np.zeros(U), np.zeros(U)
+        self.lo, self.hi = np.zeros(U), np.zeros(U)
+        for k in range(U):
+            ok = lr[:, k] != 0
+            y = lr[ok, k]
+            if y.size == 0:
+                continue
+            self.mean[k] = y.mean()
+            if y.size >= 2 * X.shape[1]:
+                b, *_ = np.linalg.lstsq(X[ok], y, rcond=None)
+                res = y - X[ok] @ b
+                self.resid_sd[k] = math.sqrt(float(res @ res) / (y.size - X.shape[1]))
+            else:
+                b = np.r_[y.mean(), np.zeros(X.shape[1] - 1)]
+                self.resid_sd[k] = float(y.std(ddof=1)) if y.size > 1 else 0.0
+            self.coef[:, k] = b
+            self.lo[k], self.hi[k] = y.min() - self.resid_sd[k], y.max() + self.resid_sd[k]
+
+    def _features(self, z):
+        zf = np.asarray(z, float)[:, :self.free.size][:, self.free]
+        return np.c_[np.ones(zf.shape[0]), zf, zf ** 2]
+
+    def __call__(self, z) -> np.ndarray:
+        """The predicted ratios (S, C) of samples ``z`` (S, ≥ P) at each cut."""
+        return np.clip(self._features(z) @ self.coef, self.lo, self.hi)[:, self.inv]
+
+
+def _at(kw, z):
+    """The likelihood's keywords ``kw`` for samples ``z``: a :class:`_RatioFit` (key ``ratio_fit``) evaluated at
+    them as the per-sample ``log_ratio``; ``kw`` itself without one."""
+    fit = kw.get("ratio_fit")
+    if fit is None:
+        return kw
+    return dict({k: v for k, v in kw.items() if k != "ratio_fit"}, log_ratio=fit(z))
+
+
 def _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc):
     """Posterior samples (z) from prior samples ``z`` given the cuts: SIR or tempered SMC (module docstring)."""
     n_samples, P = z.shape[0], prior.sigma.size
@@ -1343,7 +1421,7 @@ def _sample(prior, z, cuts, kw, method, n_moves, rng, ess_hist, acc):
 
     def loglik(z):
         return log_likelihood(prior, prior.theta(z[:, :P]), cuts, **dict(
-            kw, label_offset=mu + sd * z[:, P], label_growth=g_med * np.exp(g_sd * z[:, P + 1])))
+            _at(kw, z), label_offset=mu + sd * z[:, P], label_growth=g_med * np.exp(g_sd * z[:, P + 1])))
 
     ll = loglik(z)
     if method == "sir":
@@ -1703,6 +1781,7 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
     g_med, g_sd = kw["label_growth"]
     th = prior.theta(zp[:, :P])
     extra = dict(label_offset=mu + sd * zp[:, P], label_growth=g_med * np.exp(g_sd * zp[:, P + 1]))
+    kw = _at(kw, zp)
     lw = (log_likelihood(prior, th, cuts, **dict(kw, **extra, boundary_width=boundary_width,
                                                  log_ratio=own[:, inv], kappa=kap))
           - log_likelihood(prior, th, cuts, **dict(kw, **extra)))
@@ -1873,6 +1952,7 @@ def _own_weights_at(prior, z, f, rpm, own, cuts, kw, boundary_width):
     P = prior.sigma.size
     C = len(cuts)
     th = prior.theta(z[:, :P])
+    kw = _at(kw, z)
     mu, sd = kw["label_offset"]
     g_med, g_sd = kw["label_growth"]
     extra = dict(label_offset=mu + sd * z[:, P], label_growth=g_med * np.exp(g_sd * z[:, P + 1]))
