@@ -892,16 +892,17 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         the cut's own P(chatter).
     sdm_train : int, default :data:`SDM_TRAIN`
         ``forward="sdm"`` with cuts: samples of the corrected posterior whose own SDM limits at the cut speeds
-        (:func:`~toolpoint.stability.sdm_limit_near`) replace the references' ratio there — its mean in the
-        likelihood, its spread added to the boundary width — before a third sampling; the lobe samples' ratio
-        is moved to that mean within a few % of the cut speeds (0: the references only). The references come
+        (:func:`~toolpoint.stability.sdm_limit_near`) replace the references' ratio there before a third
+        sampling — each sample's own ratio from a fit to theirs, or their mean (``sdm_train_model``), with the
+        fit's residual or their spread added to the boundary width; the lobe samples' ratio is moved to their
+        mean within a few % of the cut speeds (0: the references only). The references come
         from the zero-order posterior, which moved its parameters to explain the cuts; their ratio at the
         cut speeds was measured 0.1–0.2 (ln) off the corrected samples' own. With their mean alone
         (``sdm_train_model="mean"``) 60 brought the median limit at the cut speeds closer to the SDM's but did not
         make campaigns converge more often, at 3–6 s more per update (``docs/design/shop.md``). With each sample's
         own ratio (the quadratic fit, the default since 2026-12-02) the recommended depth on EM12-60's fresh truths
         120–139 lay above the truth after 5 of 120 updates against 11 with ``sdm_train=0``, where it claims 5 %
-        (*Each sample's own SDM ratio in the sampling* there), for about 2–4 s more CPU per update (one search of
+        (*Each sample's own SDM ratio in the sampling* there), for about 1.5–4 s more CPU per update (one search of
         200 samples at the cut speeds, a third sampling; EM16-50 after 6 cuts: 28.9 s against 24.9 s). 0: the
         references only (as before 2026-12-02).
     sdm_train_model : {"quadratic", "mean"}, default "quadratic"
@@ -1368,8 +1369,9 @@ class _RatioFit:
     far from its training cloud (the tempering starts from the prior) is no model of the ratio.
 
     Why: the sampling otherwise sees the cuts through one mean ratio per speed, while the samples' own ratios
-    spread by ln sd 0.07–0.11 at EM12-60's productive speeds; a fit in z explained 0.77–0.89 of that spread on
-    held-out posterior samples (one truth, four speeds; 0.41–0.48 where linear) — ``docs/design/shop.md``."""
+    spread by ln sd 0.07–0.11 at EM12-60's productive speeds; a fit in z explained 0.41–0.89 of that spread on
+    held-out posterior samples where linear, and 0.48 and 0.77 (linear 0.41, 0.42) at the two speeds where it did
+    least (one truth, four speeds) — ``docs/design/shop.md``."""
 
     def __init__(self, z, lr, free, inv):
         self.free, self.inv = np.asarray(free, bool), np.asarray(inv, int)
