@@ -479,6 +479,16 @@ SDM_TRAIN = 200
 """Posterior samples whose own SDM limits at the cut speeds train ``update``'s per-sample SDM/ZOA ratio (its
 ``sdm_train``; :class:`_RatioFit`) before the third sampling."""
 
+OWN_NEAR = dict(log_step=0.07, max_steps=15, bisections=0)
+"""The search options of the samples' own SDM limits (:func:`~toolpoint.stability.sdm_limit_near_many`; the training
+of the per-sample ratio, the lobe samples' own limits at the cuts and in the pocket, the recommended depth's and the
+first cut's checks): steps of 0.07 in ln a from the guess until the verdict changes, then ρ interpolated linearly
+across that bracket — no halvings. Why: the own limits enter a likelihood whose boundary is 0.05 wide in ln a, and
+these searches were half of an update's CPU. Against the full upward search (``sdm_limits``) on 120 of EM16-50 truth
+21's posterior samples at its three cut speeds, from guesses ln sd 0.12 (0.05) off: ln error sd 0.0020 (0.0022),
+max 0.028, 1.02 s (0.78 s) CPU, where steps of 0.2 and two halvings gave sd 0.0015 (0.0101: one step over a thin
+unstable band, 0.19), 1.30 s (1.28 s); 2026-12-02, ``docs/design/shop.md`` (*The own searches without halvings*)."""
+
 OWN_MIN_ESS = 0.25
 """The least effective share of the lobe samples the own-SDM weights may leave (``update``'s ``own_sdm``): below it
 the weights are tempered (:func:`_own_temper`), so the 5 % and 95 % quantiles of 400 samples rest on at least five
@@ -903,13 +913,13 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         own ratio (the quadratic fit, the default since 2026-12-02) the recommended depth on EM12-60's fresh truths
         120–139 lay above the truth after 5 of 120 updates against 11 with ``sdm_train=0``, where it claims 5 %
         (*Each sample's own SDM ratio in the sampling* there), for about 1.5–4 s more CPU per update (one search of
-        200 samples at the cut speeds, a third sampling; EM16-50 after 6 cuts: 28.9 s against 24.9 s). 0: the
-        references only (as before 2026-12-02).
+        200 samples at the cut speeds, a third sampling; EM16-50 after 6 cuts: 21.1 s against 18.0 s with the
+        searches of :data:`OWN_NEAR`, beside two other processes). 0: the references only (as before 2026-12-02).
     sdm_train_model : {"quadratic", "mean"}, default "quadratic"
         With ``sdm_train`` > 0, how the training samples' own ratios enter the third sampling. ``"mean"``: their
         mean at each cut speed, their spread added to the boundary width (as measured above, with the full
         search). ``"quadratic"``: each sample's own ratio from a least-squares fit quadratic in its prior
-        coordinates (:class:`_RatioFit`; the searches with two halvings), the fit's residual sd added to the
+        coordinates (:class:`_RatioFit`; the searches as :data:`OWN_NEAR`), the fit's residual sd added to the
         width — the sampling then sees each sample's own limit at the cut speeds, not one mean for all.
     label_offset : (float, float), default (0.035, 0.035)
         Mean and standard deviation of δ, ln of how far above the stability limit the shop first *hears* chatter:
@@ -1033,8 +1043,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         which is still proposed past it: the default proposes no step after a chatter).
     own_sdm : bool, default True
         ``forward="sdm"`` with cuts: each lobe sample's own SDM limit at the cut speeds replaces its reference's
-        ratio there (:func:`~toolpoint.stability.sdm_limit_near` from that ratio, two halvings: a bracket 0.05
-        wide in ln a, interpolated in ρ; ln sd 0.0044 from the full search). The lobe samples are weighted by the
+        ratio there (:func:`~toolpoint.stability.sdm_limit_near` from the fit's ratio of ``sdm_train``, else from
+        that one, as :data:`OWN_NEAR`: ln sd 0.002 from the full search). The lobe samples are weighted by the
         cuts' likelihood with their own limits (the boundary width ``boundary_width`` alone) over that of the
         sampling (the references' mean ratio, their spread added to the width), resampled (ESS:
         ``Posterior.own_sdm_ess``; the samples: ``Posterior.lobe_z``; where the weights leave fewer than
@@ -1232,7 +1242,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                     sd_u = lr_tr.std(axis=0, ddof=1) if lr_tr.shape[0] > 1 else np.zeros(u.size)
                     ratio = dict(log_ratio=mean_u[inv])
                 else:  # each sample's own ratio from a quadratic fit in z (its residual sd in the width)
-                    lr_tr = _sdm_own_log_ratio(prior, z_tr, u, f, lr_ref_u.mean(axis=0), near=dict(bisections=2))
+                    lr_tr = _sdm_own_log_ratio(prior, z_tr, u, f, lr_ref_u.mean(axis=0), near=OWN_NEAR)
                     fit = _RatioFit(z_tr, lr_tr, prior.sigma > 0, inv)
                     mean_u, sd_u = fit.mean, fit.resid_sd
                     ratio = dict(ratio_fit=fit)
@@ -1770,11 +1780,11 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
     P = prior.sigma.size
     u, inv, first = _cut_speeds(np.array([c.rpm for c in cuts]))
     zp = z[pick]
-    # two halvings: a bracket 0.05 wide in ln a, interpolated in ρ — against the full search on 120 of EM16-50
-    # truth 49's lobe samples at its three cut speeds: ln error sd 0.0044 with two, three or four halvings (the
-    # outliers, up to 0.05–0.09, are thin unstable bands the one search or the other stepped over), 1.61 s CPU
-    # against 1.90 and 2.13 s; the guesses (the references' ratios) lay ln sd 0.17 off
-    own = _sdm_own_log_ratio(prior, zp[:, :P], u, f, lr_now[:, first], near=dict(bisections=2),
+    # the search from each sample's ratio predicted by the fit where there is one (the references' ratios, the
+    # guesses otherwise, lay ln sd 0.17 off on EM16-50): fewer steps to its bracket (OWN_NEAR)
+    fit = kw.get("ratio_fit")
+    guess = lr_now[:, first] if fit is None else fit(zp)[:, first]
+    own = _sdm_own_log_ratio(prior, zp[:, :P], u, f, guess, near=OWN_NEAR,
                              cuts=cuts if growth_by == "sdm" else None)  # (m, U), and κ (m, C) with the cuts
     kap = None
     if growth_by == "sdm":
@@ -1802,9 +1812,9 @@ def _pocket_own(prior, zp, f, grid, lim, n: int, span: float = 0.03, cut_rpm=Non
     """The lobes ``lim`` (m, G) of the lobe samples ``zp`` (m, P; rows may repeat) moved to each sample's own SDM limit
     at ``n`` grid speeds evenly over ±``span`` of the speed where the band's 5 % limit times the speed is largest —
     linearly in ln a between those speeds, fading over ±2 % beyond them (:func:`_interp_near`). Each search starts
-    from what the sample's lobes carry there (:func:`_sdm_own_log_ratio`, two halvings: ln sd 0.0044 from the full
-    search); a speed no lobe reaches, or a search that found no limit, leaves the sample's lobes as they were. A speed
-    within 0.4 % of one of ``cut_rpm`` is not searched: the lobes already carry the samples' own limits there
+    from what the sample's lobes carry there (:func:`_sdm_own_log_ratio` as :data:`OWN_NEAR`: ln sd 0.002 from the
+    full search); a speed no lobe reaches, or a search that found no limit, leaves the sample's lobes as they were. A
+    speed within 0.4 % of one of ``cut_rpm`` is not searched: the lobes already carry the samples' own limits there
     (:func:`_own_reweight`), and it keeps them. One pass: where the corrected band is most productive outside the
     speeds searched (the recommended speed moved more than ``span``), the band there is the references' — the
     recommended depth is checked there by held-out samples' own limits all the same (:func:`_recommended_own`).
@@ -1837,7 +1847,7 @@ def _pocket_own(prior, zp, f, grid, lim, n: int, span: float = 0.03, cut_rpm=Non
     resid = np.zeros((uz.shape[0], u.size))
     with np.errstate(divide="ignore", invalid="ignore"):
         guess = np.where(np.isfinite(carried / a) & (carried > 0), np.log(carried / a), 0.0)
-        lr = _sdm_own_log_ratio(prior, uz, u[s], f, guess, zoa=(a, fc), near=dict(bisections=2))
+        lr = _sdm_own_log_ratio(prior, uz, u[s], f, guess, zoa=(a, fc), near=OWN_NEAR)
         # _sdm_own_log_ratio gives 0 where its search found no limit: such a sample keeps its lobes
         own = np.where(lr != 0.0, a * np.exp(lr), np.nan)
         r = np.log(own / carried)
@@ -1898,7 +1908,8 @@ def _own_limits(prior, z, f, grid, lim, k, lobe_samples=True):
     with np.errstate(divide="ignore", invalid="ignore"):
         guess = (np.nanmedian(np.log(lim[:, k] / a_zoa)) if lobe_samples else
                  np.log(np.nanmedian(np.where(lim[:, k] > 0, lim[:, k], np.nan)) / np.nanmedian(a_zoa)))
-    lr = _sdm_own_log_ratio(prior, z, u, f, np.array([guess if np.isfinite(guess) else 0.0]), zoa=zoa)[:, 0]
+    lr = _sdm_own_log_ratio(prior, z, u, f, np.array([guess if np.isfinite(guess) else 0.0]), zoa=zoa,
+                            near=OWN_NEAR)[:, 0]
     own = a_zoa * np.exp(lr)
     return np.where(np.isfinite(own), own, np.inf)
 
