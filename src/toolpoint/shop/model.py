@@ -234,7 +234,8 @@ def limit_at_speeds(prior: ModalPrior, theta, rpm, freq_hz=None) -> tuple[np.nda
     f = prior.freq_grid() if freq_hz is None else np.asarray(freq_hz, float)
     n = np.atleast_1d(np.asarray(rpm, float))
     # In blocks of samples whose (S, 2, F) temporaries stay in cache (~1–2 MB each), not one pass over all: the
-    # same bits, 0.177 → 0.091 s CPU per call on 1000 EM16-50 samples at four speeds (blocks of 100; 2026-12-02).
+    # same bits, 0.174 → 0.106 s CPU per call (best of 15) on 1000 EM16-50 samples at four speeds (blocks of 100;
+    # 2026-12-02).
     if t.shape[0] > _BLOCK:
         parts = [_limit_block(prior, t[i: i + _BLOCK], n, f) for i in range(0, t.shape[0], _BLOCK)]
         return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
