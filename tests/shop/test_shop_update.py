@@ -343,6 +343,29 @@ def test_a_chatter_frequency_read_anywhere_says_nothing():
         with pytest.raises(InputError, match=field):
             update(pr, with_f, rng=np.random.default_rng(0), **{field: bad}, **kw)
 
+@pytest.mark.parametrize("tool", ["cornelius", "example"])
+def test_the_own_searches_find_the_full_searchs_limit(tool):
+    """``OWN_NEAR`` (steps of 0.07 in ln a, no halvings, ρ interpolated across the bracket) against the full upward
+    search of ``sdm_limits`` — a different search of the same SDM — on 8 prior samples at three speeds each, from
+    guesses ln sd 0.1 off: every limit found, ln error sd under 0.005 and each under 0.03 (its docstring: sd 0.002,
+    max 0.028 on EM16-50), far under the likelihood's boundary width of 0.05."""
+    from toolpoint.shop.model import example_tool, sdm_limits
+    from toolpoint.shop.update import OWN_NEAR, _sdm_own_log_ratio
+
+    pr, u = ((cornelius_2024(0.1), np.array([12000.0, 15000.0, 20377.0])) if tool == "cornelius" else
+             (example_tool(0.15), np.array([9000.0, 14000.0, 21000.0])))
+    rng = np.random.default_rng(11)
+    z = rng.standard_normal((8, pr.sigma.size)) * (pr.sigma > 0)
+    th = pr.theta(z)
+    f = pr.freq_grid()
+    full = np.array([sdm_limits(pr, t, u, chatter=False)[0] for t in th])
+    lr_full = np.log(full / limit_at_speeds(pr, th, u, f)[0])
+    lr = _sdm_own_log_ratio(pr, z, u, f, lr_full + rng.normal(0, 0.1, lr_full.shape), near=OWN_NEAR)
+    assert np.all(lr != 0)  # 0: no limit found
+    err = lr - lr_full
+    assert err.std() < 0.005 and np.abs(err).max() < 0.03, err
+
+
 def test_the_label_growth_read_from_each_samples_own_sdm():
     """``growth_by="sdm"``: each lobe sample's κ at a cut is the secant ln ρ(a) / (T ln(a / a_SDM)) from its own
     SDM limit to the cut's depth — checked against ``sdm_spectral_radius`` and ``sdm_limits`` of the same
