@@ -82,11 +82,26 @@ from toolpoint.shop.update import TestCut, update  # noqa: E402
 REAL = Path(__file__).resolve().parents[1] / "examples" / "cuts" / "combined_chatter6567.mp3"
 
 
+def _cpu() -> str:
+    """The CPU model and its widest vector extension: CPU seconds differ 2–4× between the VMs this ran on (an AMD
+    EPYC without AVX-512 took 0.37 s for what took 0.11 s the session before)."""
+    try:
+        info = open("/proc/cpuinfo").read()
+        model = next(ln.split(":", 1)[1].strip() for ln in info.splitlines() if ln.startswith("model name"))
+        flags = next(ln.split(":", 1)[1].split() for ln in info.splitlines() if ln.startswith("flags"))
+        return model + (", AVX-512" if "avx512f" in flags else ", AVX2" if "avx2" in flags else "")
+    except (OSError, StopIteration):
+        return platform.processor() or platform.machine()
+
+
 def header():
+    from toolpoint.memory import keep_freed_memory
+
+    kept = keep_freed_memory()  # as the toolpoint command does on start (toolpoint.memory)
     when = time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())
-    print(f"# {platform.node()} {platform.processor() or platform.machine()}, {when}, "
-          f"load average {os.getloadavg()[0]:.2f}; CPU seconds (process_time), OMP_NUM_THREADS="
-          f"{os.environ.get('OMP_NUM_THREADS', 'unset')}")
+    print(f"# {platform.node()} {platform.machine()} ({_cpu()}, {os.cpu_count()} cores), numpy {np.__version__}, "
+          f"{when}, load average {os.getloadavg()[0]:.2f}; CPU seconds (process_time), OMP_NUM_THREADS="
+          f"{os.environ.get('OMP_NUM_THREADS', 'unset')}; freed memory kept (toolpoint.memory): {kept}")
 
 
 def bench_cut(quick):

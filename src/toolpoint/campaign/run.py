@@ -389,7 +389,8 @@ def folder_lock(out: Path, what: str = "campaign run"):
 
 
 def worker_init(parent_pid: int) -> None:
-    """Make a pool worker end with its parent, however the parent ends (SIGKILL included).
+    """Make a pool worker end with its parent, however the parent ends (SIGKILL included), and keep freed memory
+    as the ``toolpoint`` command does (:func:`toolpoint.memory.keep_freed_memory`).
 
     Linux delivers PR_SET_PDEATHSIG on the parent's death; a watchdog thread
     covers other systems (and the race before prctl took effect).
@@ -404,6 +405,9 @@ def worker_init(parent_pid: int) -> None:
         pass
     if os.getppid() != parent_pid:
         os._exit(1)
+    from ..memory import keep_freed_memory
+
+    keep_freed_memory()  # as the parent command: a spawned worker does not inherit it (toolpoint.memory)
 
     def watch():
         while os.getppid() == parent_pid:
