@@ -204,11 +204,14 @@ def away_note(cuts) -> str:
     # docs/design/shop.md, *The recommended depth's check weighs the cuts at its speed*): the band is calibrated on
     # average away from the cuts on some tools, not on all, and a tool in the prior's tail falls outside it over a
     # range; the recommended depth's 5 % held on three tools, not on EM12-60 (0.10 ± 0.02 of its updates; 140 of
-    # the 180 truths ran before the held-out samples were weighted by the cuts at the recommended speed: the same cuts)
+    # the 180 truths ran before the held-out samples were weighted by the cuts at the recommended speed: the same cuts).
+    # Since the per-sample ratio fit: EM12-60 30 of 600 updates on 100 fresh truths (0.050 ± 0.011), EM16-50 2,
+    # EM28-80 5 and the two-mode case 2 of 120 (2026-12-02; docs/design/shop.md, *EM12-60's recommended depth on 40
+    # more fresh truths*)
     return (f"the band is tested by your cuts at {min(rpm):.0f}–{max(rpm):.0f} rpm; away from those speeds it rests "
             "on the model alone — in virtual campaigns it held the true limit at 85–96 % of those speeds on average "
             "(it claims 90 %), yet at under 90 % of all speeds for 15–40 % of the tools, and the true limit lay under "
-            "the recommended depth after 2–10 % of the updates by tool (it claims 5 %; docs/design/shop.md): make a "
+            "the recommended depth after 2–5 % of the updates by tool (it claims 5 %; docs/design/shop.md): make a "
             "test cut at a speed before trusting the band there")
 
 
