@@ -369,9 +369,9 @@ def test_the_own_searches_find_the_full_searchs_limit(tool):
 def test_the_label_growth_read_from_each_samples_own_sdm():
     """``growth_by="sdm"``: each lobe sample's κ at a cut is the secant ln ρ(a) / (T ln(a / a_SDM)) from its own
     SDM limit to the cut's depth — checked against ``sdm_spectral_radius`` and ``sdm_limits`` of the same
-    sample —; in the likelihood a slower κ moves the heard boundary further above the limit (a stable label 5 %
-    past it is likelier), a NaN κ leaves the zero-order one; ``update`` refuses another value, or ``"sdm"`` without the
-    own SDM searches, naming the field."""
+    sample —, repeated samples get their own figures back; in the likelihood a slower κ moves the heard boundary
+    further above the limit (a stable label 5 % past it is likelier), a NaN κ leaves the zero-order one;
+    ``update`` refuses another value, or ``"sdm"`` without the own SDM searches, naming the field."""
     from toolpoint.shop.update import _sdm_own_log_ratio
     from toolpoint.stability import sdm_spectral_radius
 
@@ -384,6 +384,11 @@ def test_the_label_growth_read_from_each_samples_own_sdm():
             TestCut(15000.0, 1.01 * a_z[0, 1], True)]
     lr, kap = _sdm_own_log_ratio(pr, z, u, pr.freq_grid(), np.zeros(2), near=dict(bisections=6), cuts=cuts)
     assert kap.shape == (3, 3) and np.isfinite(kap).all() and (kap > 0).all()
+    # repeated samples (resampled rows) are searched once and each row gets its own sample's figures back
+    rows = [2, 0, 2, 1, 0]
+    lr_r, kap_r = _sdm_own_log_ratio(pr, z[rows], u, pr.freq_grid(), np.zeros(2), near=dict(bisections=6), cuts=cuts)
+    np.testing.assert_array_equal(lr_r, lr[rows])
+    np.testing.assert_array_equal(kap_r, kap[rows])
     checked = 0
     for i in range(3):
         mm, c = pr.tool(th[i])

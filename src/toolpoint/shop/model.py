@@ -251,7 +251,6 @@ def _limit_block(prior: ModalPrior, t, n, f) -> tuple[np.ndarray, np.ndarray]:
     lam = _eigs(prior, t)  # (S, 2)
     mu = lam[:, :, None] * H[:, None, :]  # (S, 2, F)
     q = -2.0 * mu.real  # 1/a, valid where > 0
-    frac = (np.pi + 2 * np.arctan2(-mu.imag, -mu.real)) / (2 * np.pi)
     N = prior.cutting.teeth
     S, R = t.shape[0], n.size
     best_q = np.zeros((S, R))
@@ -265,10 +264,17 @@ def _limit_block(prior: ModalPrior, t, n, f) -> tuple[np.ndarray, np.ndarray]:
     s_i, f_i = seg // (2 * (F - 1)), seg % (F - 1)
     p0 = seg + seg // (F - 1)  # the segment's first point in the (S, 2, F) order
     q0, q1 = q.ravel()[p0], q.ravel()[p0 + 1]
-    h0, h1 = frac.ravel()[p0], frac.ravel()[p0 + 1]
+    # The phase fraction only at the points with q > 0, which hold every segment's ends (the arctangent was a third
+    # of a block's CPU over all points; elementwise, so the same bits: EM12-60 update after 6 cuts, 2026-12-02)
+    pos = (q > 0).ravel()
+    at = np.cumsum(pos) - 1  # the position of each point with q > 0 among them
+    mp = mu.ravel()[pos]
+    frac = (np.pi + 2 * np.arctan2(-mp.imag, -mp.real)) / (2 * np.pi)
+    h0, h1 = frac[at[p0]], frac[at[p0 + 1]]
     f0, f1 = f[f_i], f[f_i + 1]
+    e0, e1 = 60.0 * f0, 60.0 * f1  # hoisted out of the speeds' loop: the same expression, the same bits
     for r in range(R):  # a few test speeds; vectorised over samples, branches, frequencies
-        g0, g1 = 60.0 * f0 / (N * n[r]) - h0, 60.0 * f1 / (N * n[r]) - h1  # the full grid's expression: same bits
+        g0, g1 = e0 / (N * n[r]) - h0, e1 / (N * n[r]) - h1  # the full grid's expression: same bits
         k0, k1 = np.floor(g0), np.floor(g1)
         x = np.flatnonzero(k0 != k1)
         if x.size == 0:

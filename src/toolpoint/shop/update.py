@@ -1741,26 +1741,43 @@ def _sdm_own_log_ratio(prior, z, u, f, lr_guess, zoa=None, near: dict | None = N
     th = prior.theta(z)
     a_zoa, fc = limit_at_speeds(prior, th, u, f) if zoa is None else zoa  # (S, U)
     guess = a_zoa * np.exp(np.broadcast_to(lr_guess, a_zoa.shape))
-    tools = [(mm, mm, cut) for mm, cut in map(prior.tool, th)]
+    # Resampled samples repeat (the lobe samples: 15–20 % of the rows after the cuts' reweighting on EM12-60): each
+    # distinct (θ, guesses) is searched once — every point's search is its own, so the same bits.
+    one, back = _distinct_rows(th, guess, fc)
+    tools = [(mm, mm, cut) for mm, cut in map(prior.tool, th[one])]
     # all samples' models together (the same search as one sdm_limit_near per sample; skipped guesses give NaN)
     if cuts is None:
-        own, _ = sdm_limit_near_many(tools, rpm=u, depth_m=guess, chatter_hz=fc, **(near or {}))
+        own, _ = sdm_limit_near_many(tools, rpm=u, depth_m=guess[one], chatter_hz=fc[one], **(near or {}))
+        own = own[back]
     else:  # ρ at each cut's depth too: cut c is the j-th at its speed
         k = np.searchsorted(u, [c.rpm for c in cuts])
         j = np.array([sum(k[:i] == k[i]) for i in range(len(cuts))], int)
-        depth = np.full((len(th), u.size, int(j.max()) + 1), np.nan)
+        depth = np.full((one.size, u.size, int(j.max()) + 1), np.nan)
         depth[:, k, j] = np.array([c.depth_m for c in cuts])[None, :]
-        own, _, ex = sdm_limit_near_many(tools, rpm=u, depth_m=guess, chatter_hz=fc, rho_at=depth, extras=True,
-                                         **(near or {}))
+        own, _, ex = sdm_limit_near_many(tools, rpm=u, depth_m=guess[one], chatter_hz=fc[one], rho_at=depth,
+                                         extras=True, **(near or {}))
         period = 60.0 / (prior.cutting.teeth * u[k])  # (C,)
         with np.errstate(divide="ignore", invalid="ignore"):
             x = np.log(depth[:, k, j] / own[:, k])  # (S, C)
             sec = np.log(ex["rho_at"][:, k, j]) / (period[None, :] * x)
             kap = np.where(np.abs(x) >= 0.02, sec, ex["growth_per_s"][:, k])
-        kap = np.where(np.isfinite(kap) & (kap > 0), kap, np.nan)
+        kap = np.where(np.isfinite(kap) & (kap > 0), kap, np.nan)[back]
+        own = own[back]
     with np.errstate(divide="ignore", invalid="ignore"):
         lr = np.where(np.isfinite(own / a_zoa) & (own > 0), np.log(own / a_zoa), 0.0)
     return lr if cuts is None else (lr, kap)
+
+
+def _distinct_rows(*arrays):
+    """(first, back): the index of each distinct row of the arrays side by side (rows compared bit for bit, NaN
+    included), in order of first appearance, and for every row the position of its own among them."""
+    rows = np.ascontiguousarray(np.concatenate([np.asarray(a, float).reshape(len(a), -1) for a in arrays], axis=1))
+    seen, first, back = {}, [], np.empty(rows.shape[0], int)
+    for i, row in enumerate(rows):
+        back[i] = seen.setdefault(row.tobytes(), len(first))
+        if back[i] == len(first):
+            first.append(i)
+    return np.asarray(first, int), back
 
 
 def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width, rng, growth_by="zoa"):
