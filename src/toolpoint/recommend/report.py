@@ -96,10 +96,13 @@ function plot(o){const W=440,H=300,L=62,R=10,T=24,B=42,pw=W-L-R,ph=H-T-B,n=plot.
   g+=`<line x1="${L+8}" x2="${L+30}" y1="${ly-4}" y2="${ly-4}" stroke="${l.color||'#000'}"${dash(l)}/>`+
   `<text x="${L+34}" y="${ly}" font-size="11">${esc(l.label)}</text>`;ly+=14;}
  return g+'</svg>';}
-// (the toggle event of an open section can come while the parser has not reached its data yet:
-// then nothing is drawn here, and the DOMContentLoaded handler draws it)
+// (the toggle event of an open section can come while the parser has not reached its data yet, or has
+// reached only part of it — a slow machine, a large report: JSON.parse failed and the section stayed blank;
+// CI, 2026-12-02): nothing is drawn while the document is still being parsed, and the DOMContentLoaded
+// handler draws the open sections)
 function draw(d){const src=document.getElementById(d.dataset.src),figs=d.querySelector('.figs');
- if(!d.open||d.dataset.drawn||!src||!figs)return;d.dataset.drawn=1;const a=JSON.parse(src.textContent);
+ if(document.readyState==='loading'||!d.open||d.dataset.drawn||!src||!figs)return;
+ const a=JSON.parse(src.textContent);d.dataset.drawn=1;
  const h=a.h.map(r=>r.map(v=>v/100)),lo=Math.min(...h[0]),hi=Math.max(...h[2]);
  const limits=[['5 % limit',''],['50 % limit','6 3'],['95 % limit','2 2']];
  figs.innerHTML=plot({x:[a.f[0],a.f[a.f.length-1]],y:[lo-0.1,hi+0.1],logy:true,xlabel:'frequency, Hz',

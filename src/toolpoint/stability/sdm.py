@@ -338,7 +338,8 @@ class _System:
         w = Lw.shape[-1]
         # Delayed-displacement terms of every step at once: (m, B, n, w·d) over the window's nodes. One product per
         # step over all points' rows (m matrix products of B·n·d rows), not one 2 × w product per point and row: a
-        # quarter of the CPU, the same bits on an EM12-60 update (2026-12-02); step-major, so G[i] is contiguous.
+        # quarter of the CPU; the same bits on EM12-60 updates on an AVX2 VM (2026-12-02: BLAS kernels of other CPUs may
+        # round a 2-term sum differently); step-major, so G[i] is contiguous.
         X = np.stack([E0, E1], axis=4).transpose(1, 0, 2, 3, 4).reshape(m, B * n * d, 2)
         G = (X @ Lw).reshape(m, B, n, d, w).transpose(0, 1, 2, 4, 3).reshape(m, B, n, w * d)
         act = n  # columns of Y that can be non-zero so far (z_0, then the nodes reached)
