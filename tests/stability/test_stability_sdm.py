@@ -265,6 +265,53 @@ def test_limit_near_for_many_models_says_how_fast_chatter_grows():
     _, _, ex2 = sdm_limit_near_many([(mode, mode, half)], rpm=r2, depth_m=a2[None], extras=True)
     assert ex2["growth_per_s"][0] == pytest.approx(0.005 * 2 * np.pi * 750.0, rel=0.05)
 
+
+def _three_mode_floquet(rpm, rel_depth):
+    """Floquet matrices of a three-mode symmetric tool (EM16-50-like: 748, 1890, 2176 Hz) slotting with three
+    teeth at speeds ``rpm`` and depths ``rel_depth`` × each speed's limit: 46–214 states (the cut is the whole tooth
+    period, so low speeds need many nodes)."""
+    modes = ModalModel([748.0, 1890.0, 2176.0], [0.03, 0.025, 0.02], [0.35, 0.06, 0.08])
+    c = CuttingConditions(teeth=3, tangential_coeff=8e8, radial_ratio=0.2, radial_immersion=1.0)
+    sy = sdm_mod._System(sdm_mod.as_state_space(modes, modes), c)
+    rpm = np.asarray(rpm, float)
+    lim = sdm_lobes(modes, modes, c, rpm=rpm).depth_m
+    m, s = sy.resolution(rpm, None, 1.0, sdm_mod.M_MAX, 1.1 * sy.f_max)
+    return [sy.monodromy(np.full(len(rel_depth), r), a * np.asarray(rel_depth), int(mm), int(ss))
+            for r, a, mm, ss in zip(rpm, lim, m, s)]
+
+
+def test_the_krylov_multiplier_is_the_largest_eigenvalue(monkeypatch):
+    """The critical multiplier from :data:`~toolpoint.stability.sdm.KRYLOV_DIM` Arnoldi steps is the eigenvalue of
+    largest modulus of the whole Floquet matrix (all of NumPy's eigenvalues, an independent solver) within 1e-9,
+    angle included, from free vibration (depth 0: Φ has rank n, an invariant subspace ends the Arnoldi steps early)
+    to twice the limit — and without one full eigenvalue problem."""
+    Phis = _three_mode_floquet([3000.0, 6000.0, 9000.0, 15000.0], [0.0, 0.5, 0.95, 1.0, 1.05, 2.0])
+    assert sorted({P.shape[1] for P in Phis}) == [46, 82, 110, 214]
+    want = [np.linalg.eigvals(P) for P in Phis]
+    want = [ev[np.arange(ev.shape[0]), np.argmax(np.abs(ev), axis=1)] for ev in want]
+
+    def refused(*a, **k):
+        raise AssertionError("a full eigenvalue problem was solved")
+
+    monkeypatch.setattr(np.linalg, "eigvals", refused)
+    for P, w in zip(Phis, want):
+        got = sdm_mod.critical_multipliers(P)
+        assert np.abs(got) == pytest.approx(np.abs(w), rel=1e-9)
+        assert got == pytest.approx(w, rel=1e-9, abs=1e-9)  # the same multiplier, not its conjugate's twin only
+    assert np.abs(want[0][1:3]).max() < 1 < np.abs(want[0][4:]).min()  # the depths straddle the limit
+
+
+def test_a_matrix_the_krylov_steps_cannot_resolve_gets_all_its_eigenvalues(monkeypatch):
+    """A cyclic shift scaled by 1.01 has all its 80 eigenvalues on one circle: 24 Arnoldi steps cannot single out
+    the largest (the residual stays large), so the whole eigenvalue problem answers, and the modulus is 1.01."""
+    P = 1.01 * np.roll(np.eye(80), 1, axis=0)
+    full, asked = np.linalg.eigvals, []
+    monkeypatch.setattr(np.linalg, "eigvals", lambda a: (asked.append(a.shape), full(a))[1])
+    mu = sdm_mod.critical_multipliers(np.stack([P, 0.5 * P]))
+    assert np.abs(mu) == pytest.approx([1.01, 0.505], rel=1e-12)
+    assert asked == [(2, 80, 80)]  # both matrices fell back, in one call
+
+
 def test_old_loose_keywords_are_refused():
     with pytest.raises(TypeError, match="teeth"):
         sdm_lobes(MODE, None, teeth=2, kt=6e8, kr=1 / 3, radial_immersion=0.05, rpm=[9000.0], m=20)
