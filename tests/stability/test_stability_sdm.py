@@ -312,6 +312,15 @@ def test_a_matrix_the_krylov_steps_cannot_resolve_gets_all_its_eigenvalues(monke
     assert asked == [(2, 80, 80)]  # both matrices fell back, in one call
 
 
+def test_a_complex_floquet_matrix_gets_its_largest_eigenvalue():
+    """The Arnoldi steps are written for the SDM's real Φ; a complex one is solved whole, not projected wrongly."""
+    rng = np.random.default_rng(3)
+    Q = np.linalg.qr(rng.standard_normal((60, 60)) + 1j * rng.standard_normal((60, 60)))[0]
+    P = (Q * np.r_[1.1j, 0.6 ** np.arange(1, 60)]) @ Q.conj().T
+    mu = sdm_mod.critical_multipliers(P[None])
+    assert mu[0] == pytest.approx(1.1j, abs=1e-12)
+
+
 def test_old_loose_keywords_are_refused():
     with pytest.raises(TypeError, match="teeth"):
         sdm_lobes(MODE, None, teeth=2, kt=6e8, kr=1 / 3, radial_immersion=0.05, rpm=[9000.0], m=20)

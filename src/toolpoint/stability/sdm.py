@@ -163,7 +163,9 @@ KRYLOV_TOL = 1e-10
 def _start_vector(D: int) -> np.ndarray:
     """A fixed generic start vector of length D: every point's search is its own, whatever its batch."""
     v = np.random.default_rng(20261203).standard_normal(D)
-    return v / np.linalg.norm(v)
+    v /= np.linalg.norm(v)
+    v.setflags(write=False)  # shared by every call through the cache
+    return v
 
 
 def critical_multipliers(Phi: np.ndarray) -> np.ndarray:
@@ -175,14 +177,15 @@ def critical_multipliers(Phi: np.ndarray) -> np.ndarray:
     :data:`KRYLOV_DIM` Arnoldi steps (classical Gram–Schmidt twice, all matrices at once) give the Hessenberg
     H_k = Q_kᵀ Φ Q_k, and the Ritz value θ of largest modulus of H_k is taken where its residual
     ‖Φ Q_k y − θ Q_k y‖ = h_{k+1,k} |e_kᵀ y| ≤ :data:`KRYLOV_TOL` |θ| (θ is then an exact eigenvalue of Φ + E,
-    ‖E‖ no larger, so its error is that times the multiplier's condition number); elsewhere (and below that
-    size) ``numpy.linalg.eigvals`` of the whole matrix. Measured (2026-12-03): on 310 prior samples of the
-    campaign tools EM12-60, EM16-50 and EM28-80 at their grids' speeds and depths 0.01–5 mm (D ≥ 60)
-    |ρ_Krylov / ρ_eigvals − 1| ≤ 1.6e-10; on all 20,398 Floquet matrices of an EM16-50 update after 0 and after
-    6 cuts (D = 44–214) ≤ 1.2e-7 (non-normal Φ at D = 54–62; the depth searches stop at a relative width of
-    1e-3), 356 of them (1.7 %) redone by ``eigvals``; 0.83 against 7.4 ms per matrix at D = 214, 0.23 against
-    1.0 ms at D = 82 (``tests/stability/test_stability_sdm.py``; ``benchmarks/bench_lobes.py --sdm-only`` prints
-    the table). The start vector is fixed, so a point's multiplier does not depend on the batch it is computed in.
+    ‖E‖ no larger, so its error is that times the multiplier's condition number); elsewhere (below that size,
+    and for a complex Φ) ``numpy.linalg.eigvals`` of the whole matrix. Measured (2026-12-03): on 310 prior
+    samples of the campaign tools EM12-60, EM16-50 and EM28-80 at their grids' speeds and depths 0.01–5 mm
+    (D ≥ 60) |ρ_Krylov / ρ_eigvals − 1| ≤ 1.6e-10; on all 20,398 Floquet matrices of the EM16-50 updates after 0
+    and after 6 cuts of one truth (D = 44–214) ≤ 1.2e-7 (a non-normal Φ at D = 62; the depth searches stop at a
+    relative width of 1e-3), 356 of them (1.7 %) redone by ``eigvals``; 0.83 against 7.4 ms per matrix at
+    D = 214, 0.23 against 1.0 ms at D = 82 (``tests/stability/test_stability_sdm.py``;
+    ``benchmarks/bench_lobes.py --sdm-only`` prints the table). The start vector is fixed, so a point's multiplier
+    does not depend on the batch it is computed in.
 
     Examples
     --------
@@ -195,7 +198,8 @@ def critical_multipliers(Phi: np.ndarray) -> np.ndarray:
     """
     Phi = np.asarray(Phi)
     B, D = Phi.shape[0], Phi.shape[-1]
-    if D < KRYLOV_MIN_D or B == 0:
+    # the SDM's Φ is real; a complex one (the steps below do not conjugate) gets all its eigenvalues
+    if D < KRYLOV_MIN_D or B == 0 or np.iscomplexobj(Phi):
         ev = np.linalg.eigvals(Phi)
         return ev[np.arange(B), np.argmax(np.abs(ev), axis=1)]
     k = KRYLOV_DIM
