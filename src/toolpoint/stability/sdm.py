@@ -200,8 +200,7 @@ def critical_multipliers(Phi: np.ndarray) -> np.ndarray:
     B, D = Phi.shape[0], Phi.shape[-1]
     # the SDM's Φ is real; a complex one (the steps below do not conjugate) gets all its eigenvalues
     if D < KRYLOV_MIN_D or B == 0 or np.iscomplexobj(Phi):
-        ev = np.linalg.eigvals(Phi)
-        return ev[np.arange(B), np.argmax(np.abs(ev), axis=1)]
+        return _outermost(np.linalg.eigvals(Phi))
     k = KRYLOV_DIM
     Q = np.zeros((B, k + 1, D))
     H = np.zeros((B, k + 1, k))
@@ -225,9 +224,13 @@ def critical_multipliers(Phi: np.ndarray) -> np.ndarray:
     resid = H[:, k, k - 1] * np.abs(Y[b, k - 1, i])
     redo = ~(resid <= KRYLOV_TOL * np.abs(mu))
     if redo.any():
-        ev = np.linalg.eigvals(Phi[redo])
-        mu[redo] = ev[np.arange(ev.shape[0]), np.argmax(np.abs(ev), axis=1)]
+        mu[redo] = _outermost(np.linalg.eigvals(Phi[redo]))
     return mu
+
+
+def _outermost(ev: np.ndarray) -> np.ndarray:
+    """The eigenvalue of largest modulus in each row of ``ev`` (B, D): (B,)."""
+    return ev[np.arange(ev.shape[0]), np.argmax(np.abs(ev), axis=1)]
 
 
 # ------------------------------------------------------------------ model setup
