@@ -1,5 +1,7 @@
 """``toolpoint cut``: chatter detection on synthetic shop records, on a real shop recording, bad input."""
 
+import dataclasses
+import functools
 import json
 from pathlib import Path
 
@@ -13,6 +15,18 @@ from toolpoint.io.records import read_cut_record
 from toolpoint.shop import analyse_cut, harmonizer_rpm
 
 REAL = Path(__file__).resolve().parents[2] / "examples" / "cuts" / "combined_chatter6567.mp3"
+
+
+@functools.cache
+def _real_read():
+    return read_cut_record(REAL)
+
+
+def real_record():
+    """The real recording as :func:`read_cut_record` reads it (the first test below checks that read), decoded once
+    per worker (0.3–0.5 s a read, 15 tests): each test gets its own copy of the samples."""
+    rec = _real_read()
+    return dataclasses.replace(rec, samples=rec.samples.copy())
 
 
 def _cut_segments(res):
@@ -183,7 +197,7 @@ def test_the_plot_shows_the_spectra_the_verdict_rests_on():
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from toolpoint.shop import plot_cut
 
-    rec = read_cut_record(REAL)
+    rec = real_record()
     res = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=2, full_scale=rec.full_scale)
     fig = plot_cut(res, name=REAL.name)
     FigureCanvasAgg(fig).draw()
@@ -301,7 +315,7 @@ def test_a_nominal_speed_several_percent_off_is_warned_with_the_speed_in_the_rec
     not within ±3 % of the nominal, and `cut` says so: a warning (heavy chatter can make a comb elsewhere), or at
     6800 rpm, where no comb stands out within the range and no chatter line ≥ 20 dB out at the nominal speed, a
     refusal naming rpm and the speed; at 6500 rpm it does not."""
-    rec = read_cut_record(REAL)
+    rec = real_record()
     try:
         res = analyse_cut(rec.samples, rec.rate_hz, rpm=rpm, teeth=2, full_scale=rec.full_scale)
     except InputError as exc:  # no comb within the range, and no chatter line ≥ 20 dB out at the nominal speed
@@ -644,7 +658,7 @@ def test_the_real_spindle_in_air_alone_is_not_chatter_said_without_a_doubt(start
     """The real recording's spindle running in air, before and after the cut, cut out as a record of its own: no air
     cut to compare with, and the machine's own lines (1770.7 Hz, 2329.9 Hz) stand out of the floor like chatter. A
     steady line without an air cut is chatter by its strength alone: if called chatter, `cut` says so."""
-    rec = read_cut_record(REAL)
+    rec = real_record()
     a, b = int(start_s * rec.rate_hz), int(end_s * rec.rate_hz)
     res = analyse_cut(rec.samples[a:b], rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
     assert all(s.kind != "air" for s in res.segments)  # nothing to compare with
@@ -739,7 +753,7 @@ def test_a_record_of_cuts_at_two_speeds_is_refused_and_judged_in_parts(tmp_path,
     assert [g.verdict for g in same.segments if g.kind == "cut"] == ["stable", "chatter"]
     assert [(round(t0), round(t1), v) for t0, t1, v, _ in same.cuts] == [(1, 3, "stable"), (5, 7, "chatter")]
     assert same.cuts[1][3] == pytest.approx(1234.0, rel=0.01) and len(same.to_dict()["cuts"]) == 2
-    rec = read_cut_record(REAL)
+    rec = real_record()
     part = rec.samples[:int(25 * rec.rate_hz)]  # air, the cut, air
     both = np.concatenate([part, resample_poly(part, 4, 5)])
     for rpm, where in ((6500, r"30\.\d–3\d\.\d s ran at another spindle speed, ≈ [78]\d\d\d rpm"),
@@ -832,7 +846,7 @@ def test_digital_silence_a_dropout_is_refused_and_a_recorder_s_lead_in_is_cut_of
     cut off: the same verdict, chatter frequency and segments as the recording itself, at the record's own times."""
     import soundfile as sf
 
-    rec = read_cut_record(REAL)
+    rec = real_record()
     x, rate = rec.samples, rec.rate_hz
     ref = analyse_cut(x, rate, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=1.0)
     drop = x.copy()
@@ -859,7 +873,7 @@ def test_a_speed_given_in_rev_per_s_is_named():
     """'--rpm 107.7' for a spindle at 6460 rpm (107.7 rev/s): no spindle harmonics near 107.7 rpm, and the comb at
     60 × that stands out in the real recording — refused, naming rpm and the speed; at the right speed nothing of the
     kind."""
-    rec = read_cut_record(REAL)
+    rec = real_record()
     with pytest.raises(InputError, match="rev/s") as exc:
         analyse_cut(rec.samples, rec.rate_hz, rpm=107.7, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
     assert exc.value.field == "rpm"
@@ -900,7 +914,7 @@ def test_a_record_that_does_not_hear_the_spindle_is_refused_not_judged(tmp_path,
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "noise.wav" in err and "rpm" in err and not out.exists()
 
-    rec = read_cut_record(REAL)
+    rec = real_record()
     a, b = 0, int(20 * rec.rate_hz)  # air, cut, chatter
     res = analyse_cut(rec.samples[a:b], rec.rate_hz, rpm=8000, teeth=2, full_scale=rec.full_scale)
     said = [w for w in res.criterion["warnings"] if "range's edge" in w]
@@ -934,7 +948,7 @@ def test_a_record_taken_inside_the_chattering_cut_is_not_split_into_air_and_cut(
     10–13 s also needs the speed of the tooth-passing harmonics (6459 rpm, steady) where the comb followed the
     chatter's family (6386 rpm), which masked the chatter as a spindle line. (Some 2 s windows still read stable with
     two teeth: a chatter alias pulls the speed tracker at their edge, docs/design/shop.md, Limits.)"""
-    rec = read_cut_record(REAL)
+    rec = real_record()
     a, b = int(start_s * rec.rate_hz), int(end_s * rec.rate_hz)
     res = analyse_cut(rec.samples[a:b], rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=rec.full_scale)
     assert all(s.kind != "air" for s in res.segments)
@@ -975,7 +989,7 @@ def test_the_real_recording_through_a_phone_s_gain_control_keeps_its_air_cut(att
     in the cut), and split by level the air was taken for the cut — "chatter at 1770.7 Hz", a machine line of the air,
     without a warning. The loud part has no tooth passing (2–3 dB over noise), the quiet part has (7–8 dB), and the
     air it leaves does not hold the cut's chatter: the level is upside down."""
-    rec = read_cut_record(REAL)
+    rec = real_record()
     n = int(20 * rec.rate_hz)
     x = phone_agc(rec.samples[:n], rec.rate_hz, attack_s, release_s)
     res = analyse_cut(x, rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=1.0)
@@ -1053,7 +1067,7 @@ def test_a_tooth_count_the_record_contradicts_is_warned():
         assert not _teeth_warning(analyse_cut(x, rate, rpm=6000, teeth=teeth, full_scale=1.0)), (teeth, wrong)
         w = _teeth_warning(analyse_cut(x, rate, rpm=6000, teeth=wrong, full_scale=1.0))
         assert len(w) == 1 and f"multiples of {teeth} ({teeth * 100:.1f} Hz" in w[0] and "check --teeth" in w[0], w
-    rec = read_cut_record(REAL)
+    rec = real_record()
     right = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=2, full_scale=rec.full_scale)
     assert not _teeth_warning(right)
     res = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=3, full_scale=rec.full_scale)
@@ -1117,7 +1131,7 @@ def test_a_spindle_not_at_speed_at_the_record_s_ends_is_left_out(before, after):
     3 s coast-down. Split by level, the quiet start was the air and the air at speed "cutting" — judged against
     nothing, its machine lines chattered ("chatter at 1069 Hz" from 2 s on, a 2330 Hz line in the air after the cut).
     Left out, the rest reads as the record alone: the same segments, shifted, and the same chatter."""
-    rec = read_cut_record(REAL)
+    rec = real_record()
     rate = rec.rate_hz
     x = rec.samples[:int(25 * rate)]
     air = rec.samples[int(25 * rate):int(40 * rate)]
@@ -1208,7 +1222,7 @@ def test_the_real_recording_twice_with_the_spindle_stopped_between():
     """The real recording's first 25 s (air, a cut that chatters, air), the spindle stopped (a 3 s coast-down of its
     air, 1.5 s of room noise, a 3 s run-up), and the same 25 s again: each copy reads as the record alone. Before, the
     second copy's air at speed was "chatter at 1069 Hz" and its air after the cut "chatter at 2330 Hz"."""
-    rec = read_cut_record(REAL)
+    rec = real_record()
     rate = rec.rate_hz
     x = rec.samples[:int(25 * rate)]
     air = rec.samples[int(25 * rate):int(40 * rate)]
@@ -1233,7 +1247,7 @@ def test_the_real_recording_s_stable_cutting_reads_stable_wherever_the_record_st
     dB with them: read as growth, the first second of cutting was "chatter at 596 / 1672 Hz" for 16 of 20 such
     starts (0–190 ms), though the record's own start reads it stable. Read against the forced lines' rise, 18 of 20
     read it stable (docs/design/shop.md, *A line that rises with the engagement*)."""
-    rec = read_cut_record(REAL)
+    rec = real_record()
     rate = rec.rate_hz
     for shift in (0.01, 0.02, 0.05, 0.15):
         res = analyse_cut(rec.samples[int(shift * rate):int(12 * rate)], rate, rpm=6500, teeth=2, full_scale=1.0)
