@@ -33,10 +33,27 @@ def timed(fn):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller map and fewer speeds for the boundary")
-    q = ap.parse_args().quick
+    ap.add_argument("--cut-only", action="store_true", help="only the simulated shop's one cut (a step loop's cost)")
+    a = ap.parse_args()
+    q = a.quick
     print(f"machine: {platform.platform()}, {platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} CPUs; python {platform.python_version()}, numpy {np.__version__}")
     print(f"date: {datetime.datetime.now().isoformat(timespec='seconds')}")
+
+    # 0. one cut of the simulated shop (toolpoint.shop.campaign.simulated_shop): few points, many steps, so the step
+    # loop's per-step overhead is the cost (the virtual campaigns and the slow tests make hundreds of such cuts)
+    from toolpoint.shop.campaign import simulated_shop
+    from toolpoint.shop.model import cornelius_2024, sdm_limits
+
+    pr = cornelius_2024(0.1)
+    th = pr.theta(np.zeros((1, pr.sigma.size)))[0]
+    a_lim = sdm_limits(pr, th, [20276.0])[0][0]
+    shop = simulated_shop(pr, force_noise=0.05)
+    cpus = [timed(lambda: shop(th, 20276.0, 0.85 * a_lim, np.random.default_rng(0)))[1] for _ in range(3)]
+    print(f"\none shop cut (Cornelius 2024 median tool, 20276 rpm, 0.85 × its SDM limit, 5 % force noise: the twin "
+          f"batch of 2 points, then `cut` on its microphone record): {min(cpus):.2f} s CPU (best of 3)")
+    if a.cut_only:
+        return
 
     # 1. per-point cost, 4 slices (30° helix, 12 mm tool), 40 revolutions, batches of increasing size
     tool = Tool(diameter_m=0.012, helix_deg=30, slices=4)

@@ -270,8 +270,16 @@ class _Cut:
         P = depth.size
         nbytes = 8 * M * phase.size * (7 if self.edge else 5) * (P if phase.shape[2] == 1 else 1)
         self.tables = None
+        self._steps = None
         if nbytes <= _TABLE_BYTES:
             self.tables = [self._angles(np.arange(M)[:, None, None, None])]
+            # each step's views, taken once: the step loop indexed the 6–8 tables anew at every step
+            self._steps = [tuple(t[j] for t in self.tables[0]) for j in range(M)]
+        # where each tooth reads the surface ring (R, N, L, P) at step i: row (i − delay) mod R of the next tooth, as
+        # flat indices into its first two axes, by i mod R; and the runout broadcast once
+        rows = (np.arange(self.R)[:, None] - self.delay[None, :]) % self.R
+        self._read = rows * N + self.nxt[None, :]
+        self._rho = self.rho[:, None, None]
 
     def _angles(self, i):
         """s, c, in-cut mask, force factors at step(s) i (midpoint angles, in-cut fraction of the step)."""
@@ -294,17 +302,17 @@ class _Cut:
 
     def at(self, i: int):
         """The tables of step i (i any integer; they repeat every revolution)."""
-        if self.tables is not None:
-            return [t[i % self.M] for t in self.tables[0]]
+        if self._steps is not None:
+            return self._steps[i % self.M]
         return self._angles(i % self.M)
 
     def step(self, i, x, y, buf):
         """Force (Fx, Fy) of step i from the displacement (x, y) (P,) and the surface ring ``buf``; updates buf."""
         tab = self.at(i)
         s, c, inside, fs, cx, cy = tab[:6]
-        nrm = s * x + c * y - self.rho[:, None, None]
-        rows = (i - self.delay) % self.R
-        prev = buf[rows, self.nxt]  # (N, L, P): what the previous tooth left here
+        nrm = s * x + c * y - self._rho
+        # (N, L, P): what the previous tooth left here
+        prev = buf.reshape((-1,) + buf.shape[2:]).take(self._read[i % self.R], axis=0)
         h = fs + prev - nrm
         cutting = inside & (h > 0)
         buf[i % self.R] = np.where(cutting, nrm, prev + fs)
@@ -339,8 +347,10 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
     m = dyn.poles.size
     L = geo.L
 
+    W0, W1 = W[:, 0:1], W[:, 1:2]
+
     def forced(fx, fy):
-        return W[:, 0:1] * fx + W[:, 1:2] * fy
+        return W0 * fx + W1 * fy
 
     # rigid tool, two revolutions from fresh material: the periodic rigid-tool force and surfaces
     buf = np.zeros((R, cut.teeth, L, P))
@@ -412,7 +422,7 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
         if i >= i0:
             rec_r[i - i0] = r
             rec_f[i - i0, 0], rec_f[i - i0, 1] = fx, fy
-        u = W[:, 0:1] * fx + W[:, 1:2] * fy
+        u = W0 * fx + W1 * fy
         eta = E * eta + G * u
         mid = (Cout @ (Eh * eta + Gh * u)).real
         r = (Cout @ eta).real
