@@ -269,12 +269,10 @@ class _Cut:
         self.edge = self.kte > 0 or self.kne > 0
         P = depth.size
         nbytes = 8 * M * phase.size * (7 if self.edge else 5) * (P if phase.shape[2] == 1 else 1)
-        self.tables = None
-        self._steps = None
+        self._steps = None  # each step's views of the tables, taken once (the step loop indexed them at every step)
         if nbytes <= _TABLE_BYTES:
-            self.tables = [self._angles(np.arange(M)[:, None, None, None])]
-            # each step's views, taken once: the step loop indexed the 6–8 tables anew at every step
-            self._steps = [tuple(t[j] for t in self.tables[0]) for j in range(M)]
+            tables = self._angles(np.arange(M)[:, None, None, None])
+            self._steps = [tuple(t[j] for t in tables) for j in range(M)]
         # where each tooth reads the surface ring (R, N, L, P) at step i: row (i − delay) mod R of the next tooth, as
         # flat indices into its first two axes, by i mod R; and the runout broadcast once
         rows = (np.arange(self.R)[:, None] - self.delay[None, :]) % self.R
