@@ -40,8 +40,9 @@ def main():
           f"{os.cpu_count()} CPUs; python {platform.python_version()}, numpy {np.__version__}")
     print(f"date: {datetime.datetime.now().isoformat(timespec='seconds')}")
 
-    # 0. one cut of the simulated shop (toolpoint.shop.campaign.simulated_shop): few points, many steps, so the step
-    # loop's per-step overhead is the cost (the virtual campaigns and the slow tests make hundreds of such cuts)
+    # 0. one cut of the simulated shop (toolpoint.shop.campaign.simulated_shop): few points, many steps, the case the
+    # compiled step loop is for (a NumPy loop paid ~1 µs per call whatever the points; the virtual campaigns and the
+    # slow tests make hundreds of such cuts). The first call of the process loads (or compiles) the kernels: not timed
     from toolpoint.shop.campaign import simulated_shop
     from toolpoint.shop.model import cornelius_2024, sdm_limits
 
@@ -49,6 +50,7 @@ def main():
     th = pr.theta(np.zeros((1, pr.sigma.size)))[0]
     a_lim = sdm_limits(pr, th, [20276.0])[0][0]
     shop = simulated_shop(pr, force_noise=0.05)
+    shop(th, 20276.0, 0.5 * a_lim, np.random.default_rng(1))  # loads the compiled kernels
     cpus = [timed(lambda: shop(th, 20276.0, 0.85 * a_lim, np.random.default_rng(0)))[1] for _ in range(3)]
     print(f"\none shop cut (Cornelius 2024 median tool, 20276 rpm, 0.85 × its SDM limit, 5 % force noise: the twin "
           f"batch of 2 points, then `cut` on its microphone record): {min(cpus):.2f} s CPU (best of 3)")

@@ -269,15 +269,15 @@ class _Cut:
         self.edge = self.kte > 0 or self.kne > 0
         P = depth.size
         nbytes = 8 * M * phase.size * (7 if self.edge else 5) * (P if phase.shape[2] == 1 else 1)
-        self._steps = None  # each step's views of the tables, taken once (the step loop indexed them at every step)
+        self._tables = None  # the whole revolution's tables, contiguous (the compiled step loop's input)
+        self._nbytes = nbytes
         if nbytes <= _TABLE_BYTES:
-            tables = self._angles(np.arange(M)[:, None, None, None])
-            self._steps = [tuple(t[j] for t in tables) for j in range(M)]
+            self._tables = self.tables(0, M)
         # where each tooth reads the surface ring (R, N, L, P) at step i: row (i − delay) mod R of the next tooth, as
-        # flat indices into its first two axes, by i mod R; and the runout broadcast once
+        # flat indices into its first two axes, by i mod R
         rows = (np.arange(self.R)[:, None] - self.delay[None, :]) % self.R
-        self._read = rows * N + self.nxt[None, :]
-        self._rho = self.rho[:, None, None]
+        self._read = np.require(rows * N + self.nxt[None, :], np.int64, "CW")
+        self._rho_flat = np.require(self.rho, float, "CW")
 
     def _angles(self, i):
         """s, c, in-cut mask, force factors at step(s) i (midpoint angles, in-cut fraction of the step)."""
@@ -298,30 +298,38 @@ class _Cut:
             out += [g * (self.kte * c + self.kne * s), g * (-self.kte * s + self.kne * c)]
         return out
 
+    def tables(self, a: int, b: int) -> list:
+        """The tables of steps a ≤ i < b (within one revolution), (b − a, N, L, P) contiguous each, the edge forces'
+        zero when the tool has none (the compiled loop's input)."""
+        P = self.slice_depth.size
+        shape = (b - a,) + self.phase.shape[:2] + (P,)
+        # writable C arrays, as every array the loop takes: one compiled signature (numba types read-only apart)
+        out = [np.require(np.broadcast_to(t, shape), None, "CW") for t in
+               self._angles(np.arange(a, b)[:, None, None, None])]
+        if not self.edge:
+            out += [np.zeros((1, 1, 1, 1))] * 2
+        return out
+
+    def chunks(self, i_from: int, i_to: int):
+        """(a, b, t0, tables) over steps i_from ≤ i < i_to: pieces within one revolution whose tables (row i − t0)
+        fit in ``_TABLE_BYTES`` — the revolution's own when they were precomputed."""
+        M = self.M
+        span = M if self._tables is not None else max(1, int(M * _TABLE_BYTES // max(self._nbytes, 1)))
+        i = i_from
+        while i < i_to:
+            r0 = (i // M) * M
+            b = min(i_to, i + span, r0 + M)
+            if self._tables is not None:
+                yield i, b, r0, self._tables
+            else:
+                yield i, b, i, self.tables(i - r0, b - r0)
+            i = b
+
     def at(self, i: int):
         """The tables of step i (i any integer; they repeat every revolution)."""
-        if self._steps is not None:
-            return self._steps[i % self.M]
+        if self._tables is not None:
+            return [t[i % self.M] for t in self._tables[:8 if self.edge else 6]]
         return self._angles(i % self.M)
-
-    def step(self, i, x, y, buf):
-        """Force (Fx, Fy) of step i from the displacement (x, y) (P,) and the surface ring ``buf``; updates buf."""
-        tab = self.at(i)
-        s, c, inside, fs, cx, cy = tab[:6]
-        nrm = s * x + c * y - self._rho
-        # (N, L, P): what the previous tooth left here
-        prev = buf.reshape((-1,) + buf.shape[2:]).take(self._read[i % self.R], axis=0)
-        h = fs + prev - nrm
-        cutting = inside & (h > 0)
-        buf[i % self.R] = np.where(cutting, nrm, prev + fs)
-        hc = np.where(cutting, h, 0.0)
-        fx = np.einsum("jlp,jlp->p", hc, cx)
-        fy = np.einsum("jlp,jlp->p", hc, cy)
-        if self.edge:
-            on = cutting.astype(float)
-            fx += np.einsum("jlp,jlp->p", on, tab[6])
-            fy += np.einsum("jlp,jlp->p", on, tab[7])
-        return fx, fy
 
 
 def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, feed, revolutions: int, S: int,
@@ -345,32 +353,27 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
     m = dyn.poles.size
     L = geo.L
 
-    W0, W1 = W[:, 0:1], W[:, 1:2]
+    from ._steps import modal_pass, rigid_steps, run_steps  # compiled on first use (numba), cached on disk
 
-    def forced(fx, fy):
-        return W0 * fx + W1 * fy
+    # writable C arrays of fixed dtypes, as the compiled loops take them (one signature each)
+    W0, W1, Cc = (np.require(z, complex, "CW") for z in (W[:, 0], W[:, 1], Cout))
+    E, G, Eh, Gh = (np.require(np.broadcast_to(z, (m, P)), complex, "CW") for z in (E, G, Eh, Gh))
+    read, rho = geo._read, geo._rho_flat
 
     # rigid tool, two revolutions from fresh material: the periodic rigid-tool force and surfaces
     buf = np.zeros((R, cut.teeth, L, P))
-    zero = np.zeros(P)
     Frig = np.zeros((M, 2, P))
-    for i in range(-2 * M, 0):
-        fx, fy = geo.step(i, zero, zero, buf)
-        Frig[i % M] = fx, fy
+    for a, b, t0, tab in geo.chunks(-2 * M, 0):
+        rigid_steps(a, b, t0, M, R, *tab, geo.edge, read, rho, buf, Frig)
     # periodic forced response of the discrete system: η_0 = Σ E^{M−1−i} G u_i / (1 − E^M)
     acc = np.zeros((m, P), complex)
-    for i in range(M):
-        acc = E * acc + G * forced(*Frig[i])
-    eta0 = acc / (1 - E**M)
-    eta = eta0.copy()
     r_pre = np.zeros((M, 2, P))  # displacement at the step starts of the revolution before t = 0
     mid_pre = np.zeros((M, 2, P))  # and at the midpoints (what the chip saw)
-    u_prev = forced(*Frig[M - 1])
-    for i in range(M):
-        r_pre[i] = (Cout @ eta).real
-        mid_pre[i] = (Cout @ (Eh * eta + Gh * u_prev)).real
-        u_prev = forced(*Frig[i])
-        eta = E * eta + G * u_prev
+    modal_pass(E, G, Eh, Gh, W0, W1, Cc, Frig, Frig[M - 1].copy(), acc, False, r_pre, mid_pre)
+    eta0 = acc / (1 - E**M)
+    eta = eta0.copy()
+    modal_pass(E, G, Eh, Gh, W0, W1, Cc, Frig, Frig[M - 1].copy(), eta, True, r_pre, mid_pre)
+    f_prev = Frig[M - 1].copy()  # the force held over the step before t = 0
     scale = np.maximum(np.abs(r_pre).max(axis=(0, 1)), 1e-15)  # displacement scale, m
     if start == "steady":
         # surfaces of the displaced periodic cut: the rigid ones moved by the displacement's projection
@@ -384,7 +387,7 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
         buf[:] = 0.0
         eta = np.zeros((m, P), complex)
         ring = np.zeros((Pf, 2, P))
-        u_prev = np.zeros((m, P), complex)
+        f_prev = np.zeros((2, P))
     rng = np.random.default_rng(seed)
     kick = rng.standard_normal((m, P0)) + 1j * rng.standard_normal((m, P0))
     kick = np.tile(kick, (1, P // P0))  # the twin gets the same kick
@@ -397,33 +400,22 @@ def _run(dyn: ModalDynamics, cut: CuttingConditions, tool: Tool, rpm, depth, fee
         amp[:P0] = force_noise / np.sqrt(2.0 * dt[:P0] * noise_band_hz)
         block = np.zeros((M, P))
 
-    n = revolutions * M
     i0 = (revolutions - record) * M
     rec_r = np.zeros((record * M + 1, 2, P))
     rec_f = np.zeros((record * M, 2, P))
     opr = np.zeros((revolutions + 1, 2, P))
     dev = np.zeros((revolutions, P))
-    r = (Cout @ eta).real
-    mid = (Cout @ (Eh * eta + Gh * u_prev)).real
-    for i in range(n):
-        if i % M == 0:
-            opr[i // M] = r
-        d = r - ring[i % Pf]
-        dev[i // M] += (d * d).sum(axis=0)
-        ring[i % Pf] = r
-        fx, fy = geo.step(i, mid[0], mid[1], buf)
+    r = np.require((Cout @ eta).real, float, "CW")
+    mid = np.require((Cout @ (Eh * eta + Gh * (W0[:, None] * f_prev[0] + W1[:, None] * f_prev[1]))).real, float, "CW")
+    eta, ring = np.require(eta, complex, "CW"), np.require(ring, float, "CW")
+    if not twin:
+        amp, block = np.zeros(P), np.zeros((M, P))
+    for rev in range(revolutions):
         if twin:
-            if i % M == 0:
-                block[:, :P0] = nrng.standard_normal((M, P0))
-            g = 1.0 + amp * block[i % M]
-            fx, fy = fx * g, fy * g
-        if i >= i0:
-            rec_r[i - i0] = r
-            rec_f[i - i0, 0], rec_f[i - i0, 1] = fx, fy
-        u = W0 * fx + W1 * fy
-        eta = E * eta + G * u
-        mid = (Cout @ (Eh * eta + Gh * u)).real
-        r = (Cout @ eta).real
+            block[:, :P0] = nrng.standard_normal((M, P0))
+        for a, b, t0, tab in geo.chunks(rev * M, (rev + 1) * M):
+            run_steps(a, b, t0, M, R, Pf, i0, *tab, geo.edge, read, rho, buf, E, G, Eh, Gh, W0, W1, Cc, eta, mid, r,
+                      ring, dev, opr, rec_r, rec_f, amp, block)
     opr[-1] = r
     rec_r[-1] = r
     out = dict(dt=dt, M=M, geo=geo, rec_r=rec_r, rec_f=rec_f, opr=opr, dev=np.sqrt(dev / M), scale=scale, i0=i0,
