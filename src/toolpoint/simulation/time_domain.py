@@ -72,7 +72,7 @@ FLOOR = 1e-11
 """Deviation (relative) below which growth is round-off, not chatter."""
 NOISE_BAND_HZ = 5000.0
 """Band B over which ``force_noise`` is the relative standard deviation of the cutting force, Hz."""
-_TABLE_BYTES = 96e6  # angle tables per revolution are precomputed below this size, else computed per step
+_TABLE_BYTES = 96e6  # angle tables per revolution are precomputed below this size, else for as many steps as fit
 
 
 @dataclass(frozen=True)
