@@ -76,6 +76,30 @@ def test_period_doubling_of_a_four_tooth_cutter_is_chatter_like_the_sdm():
     assert abs(res.chatter_hz[1] / sdm.chatter_hz[0] - 1) < 0.01
 
 
+def test_a_batch_too_large_for_the_tables_is_stepped_in_pieces_as_accurately(monkeypatch):
+    # A batch whose angle tables exceed _TABLE_BYTES is stepped in pieces whose tables are built as it goes: here
+    # pieces of a few steps that do not divide the revolution (a 10 kB budget: 31 of the slot's 256 steps a revolution).
+    # Against the same independent references as the whole-revolution tables: the SDM's limit and the
+    # frequency-domain SLE.
+    import toolpoint.simulation.time_domain as td
+
+    monkeypatch.setattr(td, "_TABLE_BYTES", 1e4)
+    rpm = np.array([7500.0, 16000.0])
+    sdm = sdm_lobes(MODE, None, SLOT, rpm=rpm).depth_m
+    res = simulate_milling(MODE, None, SLOT, rpm=np.r_[rpm, rpm], depth_m=np.r_[0.95 * sdm, 1.05 * sdm],
+                           revolutions=32, record_revolutions=2)
+    assert res.stable.tolist() == [True] * 2 + [False] * 2
+    cut = CuttingConditions(teeth=3, tangential_coeff=6e8, radial_ratio=0.3, radial_immersion=0.25, milling="up")
+    tool = Tool(diameter_m=0.012, helix_deg=30, slices=4, edge_tangential=2e4, edge_normal=1e4)
+    a = np.full(2, 0.2e-3)
+    res = simulate_milling(MX, MY, cut, rpm=[6000.0, 17000.0], depth_m=a, tool=tool, revolutions=12,
+                           record_revolutions=2)
+    fd = sle_frequency_domain(MX, MY, cut, rpm=[6000.0, 17000.0], depth_m=a, tool=tool)
+    assert res.stable.all()
+    assert np.all((np.abs(res.sle_m - fd) <= 0.5e-6) | (np.abs(res.sle_m - fd) <= 0.02 * np.abs(fd))), (res.sle_m, fd)
+    assert np.abs(fd).max() > 1e-6
+
+
 @pytest.mark.parametrize("milling,immersion", [("down", 0.25), ("up", 0.25), ("down", 1.0), ("up", 0.6)])
 @pytest.mark.parametrize("helix", [False, True])
 def test_sle_time_domain_matches_frequency_domain(milling, immersion, helix):

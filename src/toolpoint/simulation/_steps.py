@@ -21,7 +21,7 @@ import numpy as np
 @numba.njit(cache=True, nogil=True, inline="always")
 def _chip(k, w, p, x, y, s, c, inside, fs, cx, cy, ex, ey, edge, read, rho, buf):  # pragma: no cover - compiled
     """Force (F_x, F_y) of point p at table row k from the displacement (x, y) at the step's midpoint; writes the
-    surfaces it leaves into ring row w (``time_domain._Cut.step``)."""
+    surfaces it leaves into ring row w (equation (1) and (2) of :mod:`~toolpoint.simulation.time_domain`)."""
     N, L = buf.shape[1], buf.shape[2]
     sx = 0.0
     sy = 0.0
