@@ -212,6 +212,85 @@ def sdm_krylov(quick: bool) -> None:
               f"{np.max(np.abs(np.abs(got) / np.abs(want) - 1)):11.1e} {np.max(np.abs(got - want)):9.1e}")
 
 
+def _numpy_monodromy(sy, rpm, depth, m, s):
+    """Φ of the NumPy step loop the compiled one replaced (``toolpoint/stability/sdm.py`` of ``0859c25``): stacked
+    products over the points, each step's maps stored, the delayed terms of every step formed at once."""
+    n, d = sy.n, sy.d
+    H, L = sy.directional(m), sy.interp(m, s)
+    q1, B = L.shape[1], rpm.size
+    P, G0, G1, Pfree = sy.step_maps(rpm, m)
+    a = depth[:, None, None, None]
+    sub = "bnp,ipd->bind" if H.ndim == 3 else "bnp,bipd->bind"
+    U0, U1 = a * np.einsum(sub, G0, H), a * np.einsum(sub, G1, H)
+    C = sy.C if sy.C.ndim == 2 else sy.C[:, None]
+    CU0, CU1 = C @ U0, C @ U1
+    W = U1 @ np.linalg.inv(np.eye(d) + CU1)
+    right = np.concatenate([np.broadcast_to(C, CU0.shape[:2] + sy.C.shape[-2:]),
+                            (sy.C @ P)[:, None] - CU0 @ C], axis=2)
+    M = P[:, None] - np.concatenate([U0, W], axis=3) @ right
+    E0, E1 = U0 - W @ CU0, W
+    D = n + q1 * d
+    Y = np.zeros((B, n, D))
+    Y[:, :, :n] = np.eye(n)
+    Phi = np.empty((B, D, D))
+    Phi[:, n: n + d] = 0.0
+    Phi[:, n: n + d, :n] = sy.C
+    lo_c, Lw = sy.stencils(m, s)
+    w = Lw.shape[-1]
+    X = np.stack([E0, E1], axis=4).transpose(1, 0, 2, 3, 4).reshape(m, B * n * d, 2)
+    G = (X @ Lw).reshape(m, B, n, d, w).transpose(0, 1, 2, 4, 3).reshape(m, B, n, w * d)
+    act = n
+    for i in range(m):
+        c0 = n + lo_c[i] * d
+        Y[:, :, :act] = M[:, i] @ Y[:, :, :act]
+        Y[:, :, c0: c0 + w * d] += G[i]
+        act = max(act, c0 + w * d)
+        if (i + 1) % s == 0:
+            j = (i + 1) // s
+            Phi[:, n + j * d: n + (j + 1) * d] = sy.C @ Y
+    Phi[:, :n] = Pfree @ Y
+    return Phi
+
+
+def sdm_steps(quick: bool) -> None:
+    """The compiled step loop of the Floquet matrices against the NumPy loop it replaced: CPU per matrix, agreement.
+
+    Three symmetric modes like the campaign tool EM16-50 (as :func:`sdm_krylov`), 4 teeth at a/D 0.5 and slotting with
+    3 teeth, batches of 8 and 80 points at 0.8–1.2 × the limit: the sizes of a shop update's searches.
+    """
+    from toolpoint.stability import sdm as sdm_mod
+
+    modes = ModalModel([748.0, 1890.0, 2176.0], [0.03, 0.025, 0.02], [0.35, 0.06, 0.08])
+    reps = 3 if quick else 7
+    print("\n== Floquet matrices: the compiled step loop (numba) against the NumPy loop it replaced; "
+          f"3 modes x = y, best of {reps}, ms per matrix")
+    print(f"   {'cut':>22s} {'rpm':>6s} {'m':>4s} {'s':>2s} {'D':>4s} {'batch':>5s} {'NumPy':>7s} {'compiled':>8s} "
+          f"{'max |ΔΦ|/max|Φ|':>16s} {'max |Δρ|/ρ':>11s}")
+    for name, c in (("4 teeth, a/D 0.5", CuttingConditions(teeth=4, tangential_coeff=8e8, radial_ratio=0.3,
+                                                            radial_immersion=0.5)),
+                    ("3 teeth, slotting", CuttingConditions(teeth=3, tangential_coeff=8e8, radial_ratio=0.2,
+                                                             radial_immersion=1.0))):
+        sy = sdm_mod._System(sdm_mod.as_state_space(modes, modes), c)
+        rpm = np.array([6000.0, 15000.0])
+        lim = sdm_lobes(modes, modes, c, rpm=rpm).depth_m
+        m, s = sy.resolution(rpm, None, 1.0, sdm_mod.M_MAX, 1.1 * sy.f_max)
+        for r, a, mm, ss in zip(rpm, lim, m, s):
+            for b in (8, 80):
+                rr, aa = np.full(b, r), a * np.linspace(0.8, 1.2, b)
+                t_np, t_nb = [], []
+                for _ in range(reps):  # alternating, so the VM's drift falls on both
+                    t = time.process_time()
+                    ref = _numpy_monodromy(sy, rr, aa, int(mm), int(ss))
+                    t_np.append(time.process_time() - t)
+                    t = time.process_time()
+                    got = sy.monodromy(rr, aa, int(mm), int(ss))
+                    t_nb.append(time.process_time() - t)
+                dphi = np.max(np.abs(got - ref) / np.abs(ref).max(axis=(1, 2))[:, None, None])
+                rho0, rho1 = (np.abs(np.linalg.eigvals(x)).max(axis=1) for x in (ref, got))
+                print(f"   {name:>22s} {r:6.0f} {mm:4d} {ss:2d} {ref.shape[1]:4d} {b:5d} {1e3 * min(t_np) / b:7.3f} "
+                      f"{1e3 * min(t_nb) / b:8.3f} {dphi:16.1e} {np.max(np.abs(rho1 / rho0 - 1)):11.1e}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true",
@@ -222,6 +301,7 @@ def main() -> None:
     sdm_accuracy_table(quick)
     sdm_four_modes(quick)
     sdm_krylov(quick)
+    sdm_steps(quick)
     if args.sdm_only:
         return
     rep = 3 if quick else 10

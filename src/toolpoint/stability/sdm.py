@@ -394,53 +394,28 @@ class _System:
         ends, so z_{i+1} = P z_i + a(Γ0 − Γ1)H_i g_i + aΓ1 H_i g_{i+1}; the term in
         z_{i+1} is solved by the Woodbury identity,
         (I + U C)⁻¹ = I − U K C, U = aΓ1H_i, K = (I + C U)⁻¹ (d × d).
+        The steps run compiled, one point at a time (:func:`toolpoint.stability._sdm_steps.floquet`: in NumPy the
+        small stacked products cost their calls, not their arithmetic; ``docs/design/stability.md``).
         """
+        from ._sdm_steps import floquet  # compiled on first use (numba), cached on disk
+
         n, d = self.n, self.d
         H = self.directional(m)
-        L = self.interp(m, s)
-        q1 = L.shape[1]
+        q1 = self.interp(m, s).shape[1]
         B = rpm.size
         P, G0, G1, Pfree = self.step_maps(rpm, m) if maps is None else maps
-        a = depth[:, None, None, None]
-        # H (m, p, d) of one model, or (B, m, p, d) of a stack of models (then C is (B, d, n))
-        sub = "bnp,ipd->bind" if H.ndim == 3 else "bnp,bipd->bind"
-        U0 = a * np.einsum(sub, G0, H)  # (B, m, n, d): a(Γ0 − Γ1)H_i
-        U1 = a * np.einsum(sub, G1, H)  # aΓ1H_i
-        C = self.C if self.C.ndim == 2 else self.C[:, None]  # broadcast over the steps
-        # z_{i+1} = M_i z_i + E0_i r'_i + E1_i r'_{i+1} with S_i = I − W_i C, W_i = U1_i K_i:
-        # M_i = S_i (P − U0_i C) = P − U0_i C − W_i (C P − C U0_i C), E0_i = S_i U0_i, E1_i = S_i U1_i = W_i.
-        CU0, CU1 = C @ U0, C @ U1  # (B, m, d, d)
-        K = np.linalg.inv(np.eye(d) + CU1)
-        W = U1 @ K
-        right = np.concatenate([np.broadcast_to(C, CU0.shape[:2] + self.C.shape[-2:]),
-                                (self.C @ P)[:, None] - CU0 @ C], axis=2)  # (B, m, 2d, n)
-        M = P[:, None] - np.concatenate([U0, W], axis=3) @ right
-        E0, E1 = U0 - W @ CU0, W
         D = n + q1 * d
-        Y = np.zeros((B, n, D))
-        Y[:, :, :n] = np.eye(n)
-        Phi = np.empty((B, D, D))
-        Phi[:, n: n + d] = 0.0
-        Phi[:, n: n + d, :n] = self.C
         lo_c, Lw = self.stencils(m, s)
-        w = Lw.shape[-1]
-        # Delayed-displacement terms of every step at once: (m, B, n, w·d) over the window's nodes. One product per
-        # step over all points' rows (m matrix products of B·n·d rows), not one 2 × w product per point and row: a
-        # quarter of the CPU; the same bits on EM12-60 updates on an AVX2 VM (2026-12-02: BLAS kernels of other CPUs may
-        # round a 2-term sum differently); step-major, so G[i] is contiguous.
-        X = np.stack([E0, E1], axis=4).transpose(1, 0, 2, 3, 4).reshape(m, B * n * d, 2)
-        G = (X @ Lw).reshape(m, B, n, d, w).transpose(0, 1, 2, 4, 3).reshape(m, B, n, w * d)
-        act = n  # columns of Y that can be non-zero so far (z_0, then the nodes reached)
-        for i in range(m):  # loop over time steps of the cut (not over speeds or depths)
-            c0 = n + lo_c[i] * d
-            new = max(act, c0 + w * d)
-            Y[:, :, :act] = M[:, i] @ Y[:, :, :act]
-            Y[:, :, c0: c0 + w * d] += G[i]
-            act = new
-            if (i + 1) % s == 0:
-                j = (i + 1) // s
-                Phi[:, n + j * d: n + (j + 1) * d] = self.C @ Y
-        Phi[:, :n] = Pfree @ Y
+        Phi = np.empty((B, D, D))
+        Y = np.empty((B, n, D))
+        if any(np.iscomplexobj(x) for x in (P, G0, G1, Pfree, H, self.C)):
+            raise TypeError("the SDM's step maps are real (a real state-space model)")
+        # one compiled signature: C-contiguous float64, a leading point axis (H and C: one model's, or each point's)
+        args = [np.require(x, np.float64, "C") for x in (
+            np.broadcast_to(P, (B, n, n)), np.broadcast_to(G0, (B,) + G0.shape[-2:]),
+            np.broadcast_to(G1, (B,) + G1.shape[-2:]), np.broadcast_to(Pfree, (B, n, n)),
+            H if H.ndim == 4 else H[None], self.C if self.C.ndim == 3 else self.C[None], np.broadcast_to(depth, (B,)))]
+        floquet(*args, np.require(lo_c, np.int64, "C"), np.require(Lw, np.float64, "C"), int(s), Phi, Y)
         return (Phi, Y) if cut_end else Phi
 
     def multipliers(self, rpm, depth, m, s):
@@ -459,8 +434,10 @@ class _System:
                 mm, ss = divmod(int(kk), 1000)
                 idx = np.flatnonzero(key == kk)
                 D = self.n + (mm // ss + 1) * self.d
-                per_point = mm * self.n * (self.n + 2 * (INTERP_DEGREE + 2) * self.d) + self.n * D  # M, G, Y
-                chunk = max(1, _CHUNK_FLOATS // max(per_point, D * D))
+                # Φ and Y of each point (the compiled loop stores no step maps), its P, e^{A(T − t_c)}, Γ0, Γ1; and
+                # the critical multiplier's Krylov basis (KRYLOV_DIM + 1 vectors of D)
+                per_point = D * D + self.n * D + 2 * self.n * (self.n + self.d) + (KRYLOV_DIM + 1) * D
+                chunk = max(1, _CHUNK_FLOATS // per_point)
                 for c in range(0, idx.size, chunk):
                     j = idx[c: c + chunk]
                     crit[j] = critical_multipliers(self.monodromy(rpm[j], depth[j], mm, ss))
@@ -609,8 +586,8 @@ class _Stack:
                 idx = np.flatnonzero(key == kk)
                 D = n + (mm // ss + 1) * d
                 # as _System.multipliers, plus each point's own H
-                per_point = mm * n * (n + 2 * (INTERP_DEGREE + 2) * d) + n * D + mm * self.p * d
-                chunk = max(1, _CHUNK_FLOATS // max(per_point, D * D))
+                per_point = D * D + n * D + 2 * n * (n + d) + (KRYLOV_DIM + 1) * D + mm * self.p * d
+                chunk = max(1, _CHUNK_FLOATS // per_point)
                 for c in range(0, idx.size, chunk):
                     j = idx[c: c + chunk]
                     v = self.view(k[j], mm)
