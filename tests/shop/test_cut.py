@@ -395,6 +395,16 @@ def test_a_record_with_a_non_finite_sample_is_refused_through_the_api():
     assert e.value.field == "samples"
 
 
+
+def test_a_stereo_array_is_refused_through_the_api_not_read_as_samples():
+    # soundfile.read gives a stereo file as (T, 2); passed on as read it reached the splitting as a 2-D array and
+    # raised a NumPy broadcasting error (2026-12-04)
+    x, rate, *_ = shop_record(rpm=6000, teeth=4, air_s=0.3, cut_s=0.6, seed=5)
+    with pytest.raises(InputError, match=r"one channel, shape \(T,\); got shape \(\d+, 2\)") as e:
+        analyse_cut(np.stack([x, x], axis=1), rate, rpm=6000, teeth=4, source="rec.wav")
+    assert e.value.field == "samples"
+    assert analyse_cut(x, rate, rpm=6000, teeth=4).verdict in ("stable", "chatter")
+
 def test_records_one_column_needs_rate_and_uff58(tmp_path):
     import pyuff
 

@@ -487,6 +487,10 @@ def check_record(samples, rate_hz: float, rpm: float, teeth: int, *, full_scale:
     if not (math.isfinite(rate_hz) and rate_hz > 0):
         raise InputError(f"must be > 0 Hz, got {rate_hz!r}", file=source, field="rate_hz")
     x = np.asarray(samples, float)
+    if x.ndim != 1:  # a stereo file's (T, 2) from soundfile.read, passed on as read: its two channels are not samples
+        raise InputError(f"must be one channel, shape (T,); got shape {x.shape} (average a stereo microphone's "
+                         "channels or take one: `toolpoint cut` averages them, --channel picks one)", file=source,
+                         field="samples")
     if not np.all(np.isfinite(x)):  # a dropped DAQ sample, a NaN from a notebook: every spectrum would be NaN
         k = int(np.flatnonzero(~np.isfinite(x))[0])
         raise InputError(f"sample {k} (t = {k / rate_hz:.6g} s) is not finite", file=source, field="samples")
