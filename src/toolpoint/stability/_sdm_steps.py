@@ -35,8 +35,8 @@ def floquet(P, G0, G1, Pfree, H, C, depth, lo, Lw, s, Phi, Ycut):  # pragma: no 
     B, n, D = Ycut.shape
     m, p, d = H.shape[1], H.shape[2], H.shape[3]
     w = Lw.shape[2]
-    # one point's work arrays: Y and T (n × D; apart, so the compiler sees they do not overlap), M (n × n); by shape
-    # U0, U1, W, E0 (n × d), CP, R (d × n), CU0, A, K (d × d)
+    # one point's work arrays, reused for every point: Y and T (n × D), M (n × n); by shape U0, U1, W, E0 (n × d),
+    # CP, R (d × n), CU0, A, K (d × d)
     Y, T, M = np.zeros((n, D)), np.zeros((n, D)), np.zeros((n, n))
     nd, dn, dd = np.zeros((4, n, d)), np.zeros((2, d, n)), np.zeros((3, d, d))
     U0, U1, W, E0 = nd[0], nd[1], nd[2], nd[3]
