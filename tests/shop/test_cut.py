@@ -395,7 +395,6 @@ def test_a_record_with_a_non_finite_sample_is_refused_through_the_api():
     assert e.value.field == "samples"
 
 
-
 def test_a_stereo_array_is_refused_through_the_api_not_read_as_samples():
     # soundfile.read gives a stereo file as (T, 2); passed on as read it reached the splitting as a 2-D array and
     # raised a NumPy broadcasting error (2026-12-04)
@@ -404,6 +403,7 @@ def test_a_stereo_array_is_refused_through_the_api_not_read_as_samples():
         analyse_cut(np.stack([x, x], axis=1), rate, rpm=6000, teeth=4, source="rec.wav")
     assert e.value.field == "samples"
     assert analyse_cut(x, rate, rpm=6000, teeth=4).verdict in ("stable", "chatter")
+
 
 def test_records_one_column_needs_rate_and_uff58(tmp_path):
     import pyuff
