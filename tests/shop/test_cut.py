@@ -1090,8 +1090,8 @@ def test_the_speed_is_tracked_on_the_harmonics_that_hold_still():
     harmonics where those wander less over as many frames: both follow one spindle, and a set whose windows hold
     another family's lines wanders with it. The real recording (2 teeth at 6460 rpm by its lines) given the values
     its source project's plot script uses, 12500 rpm and 4 teeth, or 6567 rpm (its file name) and 3 teeth: the
-    4-tooth reading's weak 861, 1722 … Hz lines sit beside the chatter's aliases (852 Hz: 1067 − 215), the track
-    read the speed 0.9–1.4 % off during the chatter, the masks over that range hid the 1067 Hz line and "chatter at
+    windows of these readings' weak tooth harmonics hold the chatter's aliases (861 Hz beside 852 Hz, 1067 − 215),
+    the track wandered 0.9–1.4 % during the chatter, the masks over that range hid the 1067 Hz line and "chatter at
     599 Hz" was read. A maximum at a window's edge is no peak: a 2-tooth cut at 6460 rpm given 12500 rpm and 4
     teeth (its spindle, at 2 × 6460 by the 4-tooth reading, 3.4 % out of the range searched) was tracked on the
     flank of its 861 Hz line at the edge of a window, 12877 rpm, and read "chatter at 107.6 Hz", its own spindle
