@@ -159,7 +159,14 @@ The detector (:func:`analyse_cut`):
    (``alias_dominance`` of the strongest harmonic with an air cut, else ``dominance``), and **its family** stands
    too: a line at the same offset (to 1.5/T) beside a harmonic k ± N or k ± 2 N, ≥ 6 dB over its own mirror and over
    ln(24/α) × its local noise (a wander's smear grows with k; chatter's aliases f_c + j f_t keep δ). Chatter closer
-   to the harmonic than its main lobe, 2/T, is not resolved at this length: a longer cut resolves it.
+   to the harmonic than its main lobe, 2/T, is not resolved at this length: a longer cut resolves it. The offsets
+   are read from k f̄, f̄ the median of the harmonics' peaks over k: a line tens of dB over its harmonic pulls that
+   harmonic's peak towards it. When the frames *did* find chatter in a run of ≥ 0.5 s, the same long frame is read
+   over its chattering windows, and a line it finds beside a harmonic that is stronger there than the frames' line
+   becomes the windows' chatter line, its frequency and evidence (the verdict stands; the growth stays the frames'
+   line's, one of its family): chatter a few Hz from a spindle harmonic has every alias
+   f_c + j f_t the same few Hz from theirs, all masked, and the frames' strongest line was another of its family —
+   in heavy chatter often its second harmonic 2 f_c + j f_t (1252.2 Hz chatter reported at 2838.8 Hz).
 
    *Automatic gain control.* A phone or a recorder with gain control levels the record: within its attack time the
    cut is brought down to the air cut's loudness, and the air after the cut comes back up within its release time.
@@ -1261,8 +1268,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         opr = _once_per_rev(x[int(ta * rate):int(tb * rate)], rate, f_s)
         return CutSegment("cut", ta, tb, **seg, once_per_rev=opr)
 
-    def beside(ma, mb):
-        """The cutting run ma … mb read as one long frame beside the harmonics, or None (no chatter there)."""
+    def beside(ma, mb, against_hz=None):
+        """The cutting run ma … mb read as one long frame beside the harmonics, or None (no chatter there; or none
+        stronger in that frame than the line at ``against_hz``, the frames' chatter)."""
         # chatter a few Hz from a spindle harmonic lies inside its mask at the frames' resolution: the run read as one
         # long frame (module docstring, *Chatter beside a harmonic*) at the harmonics where the speed held within two
         # bins; the air cut is not lowered for a gain control here, as it is in _judge (a recorder whose gain fell
@@ -1274,7 +1282,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         # at most _NEAR_MAX_S of it, the middle (bins of 1/8 Hz are plenty; a 10 min run padded ×4 would not fit)
         mid, half = 0.5 * (ma + mb), 0.5 * min(mb - ma, _NEAR_MAX_S)
         near = _near_harmonic(x[int((mid - half) * rate):int((mid + half) * rate)], rate, air_x, f_s, teeth, lo,
-                              hi, df, alias_dominance if air_x is not None else dominance, rise_db, spread)
+                              hi, df, alias_dominance if air_x is not None else dominance, rise_db, spread,
+                              against_hz)
         if near is None:
             return None
         opr = _once_per_rev(x[int(ma * rate):int(mb * rate)], rate, f_s)
@@ -1304,10 +1313,24 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         bounds = np.linspace(ma, mb, nwin + 1)
         windows = [judge(wa, wb) for wa, wb in zip(bounds[:-1], bounds[1:])]
         merged = _merge(windows, judge)
-        if all(sg.verdict != "chatter" for sg in merged) and mb - ma >= _NEAR_MIN_S:
+        ch = [sg for sg in merged if sg.verdict == "chatter"]
+        if not ch and mb - ma >= _NEAR_MIN_S:
             near = beside(ma, mb)
             if near is not None:
                 merged = [near]
+        elif ch:
+            # chatter whose strongest line sits beside a spindle harmonic (inside its mask) is judged by the frames on
+            # another line of its family — an alias, or its second harmonic 2 f_c + j f_t, which heavy chatter makes:
+            # the chatter is the stronger line the long frame finds beside a harmonic, if there is one: its frequency
+            # and its evidence (strength, aliases, line) are what the later tests weigh and the warnings quote; the
+            # growth stays the frames' line's, one of its family
+            top = max(ch, key=lambda sg: sg.end_s - sg.start_s)
+            if ch[-1].end_s - ch[0].start_s >= _NEAR_MIN_S:
+                near = beside(ch[0].start_s, ch[-1].end_s, against_hz=top.chatter_hz)
+                if near is not None:
+                    line = {k: getattr(near, k) for k in ("chatter_hz", "peak_hz", "significance", "rise_db",
+                                                          "dominance", "n_alias", "line_db")}
+                    merged = [replace(sg, **line) if sg.verdict == "chatter" else sg for sg in merged]
         segments.extend(merged)
         if e_out:
             segments.append(CutSegment("exit", tb - e_out, tb, "transient"))
@@ -2397,7 +2420,8 @@ def _long_psd(seg, rate, n):
     return np.fft.rfftfreq(4 * n, 1.0 / rate), np.abs(z) ** 2 / (rate * float(np.sum(w * w)))
 
 
-def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, spread=0.0) -> dict | None:
+def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, spread=0.0,
+                   against_hz=None) -> dict | None:
     """Chatter a few Hz beside a spindle harmonic (module docstring, *Chatter beside a harmonic*): the cutting run
     ``seg`` read as one Hann frame of T s; ``air`` the air cut's samples (None: no air cut, and ``dominance`` is the
     plain one); ``spread`` the range of spindle frequencies (Hz) the run's frames ran at (0 when not tracked): a
@@ -2408,7 +2432,7 @@ def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, s
     freq, p = _long_psd(seg, rate, n)
     fa, pa = _long_psd(air, rate, min(n, air.size)) if air is not None else (None, None)
     step = freq[1] - freq[0]
-    cands, h_pows, searched = [], [], 0
+    cands, h_pows, f_per_k, searched = [], [], [], 0
     for k in range(1, _NEAR_HARMONICS * teeth + 1):
         f_k = k * f_s
         mask = 2 * df + _MASK_REL * f_k  # where the frames' test does not look
@@ -2425,6 +2449,7 @@ def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, s
         i_h = int(near[np.argmax(p[near])])
         f_h = float(freq[i_h])
         h_pows.append(float(p[i_h]))
+        f_per_k.append(f_h / k)
         for side in (1.0, -1.0):
             off = side * (fq - f_h)
             # beyond the harmonic's Hann main lobe (2 bins of the unpadded frame), a peak of its own
@@ -2466,11 +2491,19 @@ def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, s
     fam_t = math.log(4 * 3 * 2 / _ALPHA)
     # the regenerative family f_c + j f_t: the same offset (to 1.5 bins of the unpadded frame) beside the harmonics
     # k ± N, k ± 2N, each over its own mirror — a speed's wander or an amplitude modulation gives neither
+    # (offsets from k f̄, f̄ the harmonics' median spacing: a chatter line far stronger than its harmonic pulls that
+    # harmonic's peak towards it, and the offset from the peak then differs from its family's)
+    f_bar = float(np.median(f_per_k))
+    off_bar = {id(c): float(freq[c["i"]]) - c["k"] * f_bar for c in ok}
     fam = [c for c in ok if c is not c0 and (c["k"] - c0["k"]) % teeth == 0 and abs(c["k"] - c0["k"]) <= 2 * teeth
-           and abs(c["off"] - c0["off"]) <= 1.5 / T and c["asym"] >= _NEAR_FAMILY_DB and c["z"] >= fam_t]
+           and abs(off_bar[id(c)] - off_bar[id(c0)]) <= 1.5 / T and c["asym"] >= _NEAR_FAMILY_DB and c["z"] >= fam_t]
     dom = c0["pow"] / max(h_pows)
     if not fam or dom < dominance or sig <= 1.0:
         return None
+    if against_hz is not None:  # only a line stronger than the frames' chatter line, read in the same long frame
+        at = np.abs(freq - against_hz) <= 2.0 / T
+        if at.any() and c0["pow"] <= float(p[at].max()):
+            return None
     i = c0["i"]
     f_c = float(freq[i] + _parabola(p, i) * step)
     return dict(verdict="chatter", chatter_hz=f_c, peak_hz=f_c, significance=float(sig), rise_db=c0["rise"],
