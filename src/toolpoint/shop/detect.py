@@ -2473,7 +2473,7 @@ def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, s
                 (np.abs(fq - freq[i]) >= 2.0 / T)
             mean = float(np.median(pq[loc])) / math.log(2.0) if loc.any() else float("inf")
             searched += reg.size
-            cands.append(dict(k=k, i=i, off=float(freq[i] - f_h), pow=float(p[i]), asym=asym, line=line, rise=rise,
+            cands.append(dict(k=k, i=i, pow=float(p[i]), asym=asym, line=line, rise=rise,
                               z=float(p[i] / mean)))
     if not cands or not h_pows:
         return None
@@ -2494,9 +2494,10 @@ def _near_harmonic(seg, rate, air, f_s, teeth, lo, hi, df, dominance, rise_db, s
     # (offsets from k f̄, f̄ the harmonics' median spacing: a chatter line far stronger than its harmonic pulls that
     # harmonic's peak towards it, and the offset from the peak then differs from its family's)
     f_bar = float(np.median(f_per_k))
-    off_bar = {id(c): float(freq[c["i"]]) - c["k"] * f_bar for c in ok}
+    d0 = float(freq[c0["i"]]) - c0["k"] * f_bar
     fam = [c for c in ok if c is not c0 and (c["k"] - c0["k"]) % teeth == 0 and abs(c["k"] - c0["k"]) <= 2 * teeth
-           and abs(off_bar[id(c)] - off_bar[id(c0)]) <= 1.5 / T and c["asym"] >= _NEAR_FAMILY_DB and c["z"] >= fam_t]
+           and abs(float(freq[c["i"]]) - c["k"] * f_bar - d0) <= 1.5 / T and c["asym"] >= _NEAR_FAMILY_DB
+           and c["z"] >= fam_t]
     dom = c0["pow"] / max(h_pows)
     if not fam or dom < dominance or sig <= 1.0:
         return None
