@@ -1,6 +1,6 @@
 """A chattering cut's growth rate: can a record tell how far past the limit a cut was, and what would it be worth?
 
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_growth.py [--only estimator|real|oracle|kappa] [--truths 3]
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/bench_growth.py [--only estimator|real|oracle|kappa|ring] [--truths 3]
         [--library-prior OUT:TOOL] [--agc] [--seed-start 20] [--seeds 20]
 
 Just past the limit, chatter grows as e^{σ t} with σ = κ ln(a / a_lim) (κ: :func:`toolpoint.shop.model.growth_rate`),
@@ -25,7 +25,10 @@ null}'`` (docs/design/shop.md, *A chattering cut's growth rate*).
    measurement good to 25 %) in the likelihood: ln N(σ_m; κ(θ) ln(a / a_lim(θ)), (0.3 σ_m)²), 5 % outliers uniform
    on [0, 3 σ_m]. The upper bound of what a reading would give; the update is patched in this script only.
 
-4. ``kappa``: no simulation — at random truths × 10 speeds the SDM's own σ at a = a_SDM e^x against κ x, with the
+4. ``ring``: a stable cut's ring (:func:`toolpoint.shop.growth.ring_decay`) against the closed form −ζω_n of a mode
+   driven by white noise, seven modes × 12 seeds, and its CPU per fit.
+
+5. ``kappa``: no simulation — at random truths × 10 speeds the SDM's own σ at a = a_SDM e^x against κ x, with the
    zero-order κ and with the SDM's slope at its limit: why ``update`` reads x_m from the SDM's growth curve
    (``shop.update._sdm_growth_x``) rather than from a slope, where the SDM's limit lies > 10 % from the zero-order one.
 
@@ -272,9 +275,43 @@ def bench_oracle(seeds, seed_start):
     U.log_likelihood = original
 
 
+def bench_ring(seeds=12):
+    """``ring_decay`` against the closed form σ = −ζω_n of a mode driven by white noise (the records of
+    ``tests/shop/test_ring.py``, over a 6000 rpm spindle line and sensor noise), seven modes × ``seeds`` seeds: the
+    median ratio, the ln scatter, how often ±1.96 ln sd holds the truth, and the CPU per fit."""
+    from scipy.signal import lfilter
+
+    from toolpoint.shop.growth import ring_decay
+
+    rate = 20000.0
+    print(f"\n## ring: noise-driven modes, {seeds} seeds each (σ read / −ζω_n)")
+    cpu_all, n_all = 0.0, 0
+    for fn, zeta, dur in ((650, 0.003, 2.0), (1250, 0.01, 0.8), (1730, 0.004, 0.5), (650, 0.003, 8.0),
+                          (900, 0.02, 3.0), (2400, 0.001, 4.0), (500, 0.05, 2.0)):
+        true, e, held = -zeta * 2 * np.pi * fn, [], 0
+        for s in range(seeds):
+            rng = np.random.default_rng(s)
+            w = 2 * np.pi * fn
+            r, th = math.exp(-zeta * w / rate), w * math.sqrt(1 - zeta ** 2) / rate
+            y = lfilter([1.0], [1.0, -2 * r * math.cos(th), r * r], rng.standard_normal(int(dur * rate)))
+            t = np.arange(y.size) / rate
+            y = y / y.std() + 3 * np.sin(2 * np.pi * 100 * t) + 0.05 * rng.standard_normal(y.size)
+            c0 = time.process_time()
+            g = ring_decay(y, rate, rpm=6000, teeth=4, line_hz=fn + 2.0, start_s=0.0, end_s=dur)
+            cpu_all += time.process_time() - c0
+            n_all += 1
+            if g.rate_per_s is not None:
+                e.append(math.log(g.rate_per_s / true))
+                held += bool(g.ln_sd is not None and abs(e[-1]) <= 1.96 * g.ln_sd)
+        e = np.array(e)
+        print(f"  {fn} Hz, ζ {zeta}, {dur} s: read {e.size}/{seeds}, median ratio {math.exp(np.median(e)):.3f}, "
+              f"ln scatter {e.std():.3f}, ±1.96 ln sd held {held}/{e.size}")
+    print(f"  CPU per fit {cpu_all / n_all * 1e3:.0f} ms (mean of {n_all})")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--only", choices=("estimator", "real", "oracle", "kappa"))
+    ap.add_argument("--only", choices=("estimator", "real", "oracle", "kappa", "ring"))
     ap.add_argument("--truths", type=int, default=3)
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=20)
@@ -288,6 +325,8 @@ def main():
         bench_real()
     if args.only in (None, "estimator"):
         bench_estimator(args.truths, 6, args.library_prior, args.agc)
+    if args.only in (None, "ring"):
+        bench_ring()
     if args.only == "kappa":
         bench_kappa(args.truths, args.library_prior)
     if args.only == "oracle":  # the whole loop twice: hours, only when asked
