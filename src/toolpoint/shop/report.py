@@ -207,12 +207,14 @@ def away_note(cuts) -> str:
     # the 180 truths ran before the held-out samples were weighted by the cuts at the recommended speed: the same cuts).
     # Since the per-sample ratio fit: EM12-60 30 of 600 updates on 100 fresh truths (0.050 ± 0.011), EM16-50 2,
     # EM28-80 5 and the two-mode case 2 of 120 (2026-12-02; docs/design/shop.md, *EM12-60's recommended depth on 40
-    # more fresh truths*)
+    # more fresh truths*). On fresh truths 200–219 of six tools (2026-12-04, *Where the targets stand on fresh truths
+    # 200–219*): 1 of 120 (the two-mode case) to 10 of 120 (EM28-80, 8 %; EM12-60 8 of 120), 26 of 600 in all — the
+    # note said 2–5 % until then, which those truths exceeded on two tools
     return (f"the band is tested by your cuts at {min(rpm):.0f}–{max(rpm):.0f} rpm; away from those speeds it rests "
             "on the model alone — in virtual campaigns it held the true limit at 85–96 % of those speeds on average "
             "(it claims 90 %), yet at under 90 % of all speeds for 15–40 % of the tools, and the true limit lay under "
-            "the recommended depth after 2–5 % of the updates by tool (it claims 5 %; docs/design/shop.md): make a "
-            "test cut at a speed before trusting the band there")
+            "the recommended depth after 1–8 % of the updates by tool on fresh truths (it claims 5 %; "
+            "docs/design/shop.md): make a test cut at a speed before trusting the band there")
 
 
 def _growth_cell(c) -> str:
