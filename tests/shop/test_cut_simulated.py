@@ -293,3 +293,28 @@ def test_a_bad_hump_bar_is_refused():
         with pytest.raises(InputError) as e:
             analyse_cut(x, 44100.0, rpm=6000, teeth=4, hump_db=bad)
         assert e.value.field == "hump_db"
+
+
+def test_a_stable_verdict_on_a_cut_too_short_to_read_beside_the_harmonics_is_warned(tmp_path):
+    """The README's `simulate` example (the 1-DOF slot, 2 teeth, 13800 rpm) at 1.5 mm, where toolpoint.simulation
+    chatters at 910 Hz beside the 920 Hz spindle harmonic. Over the command's default 40 revolutions (0.14 s of cut)
+    that chatter lies inside the harmonic's mask and the cut is too short for the long frame beside the harmonics:
+    `cut` read "stable" without a word (2026-12-04). A stable verdict on so short a cut now says what it cannot see;
+    over 250 revolutions the same cut reads chatter, without that warning."""
+    import json
+
+    from toolpoint.cli.main import main
+
+    model = ["--mode-x", "922:1.34e6:0.011", "--mode-y", "922:1.34e6:0.011", "--teeth", "2", "--tangential-coeff",
+             "6e8", "--radial-ratio", "0.333", "--immersion", "1", "--rpm", "13800", "--depth-mm", "1.5"]
+    for revs in ("40", "250"):
+        wav, sim, out = tmp_path / f"{revs}.wav", tmp_path / f"{revs}.json", tmp_path / f"cut{revs}.json"
+        assert main(["simulate", *model, "--revolutions", revs, "--out", str(sim), "--audio", str(wav)]) == 0
+        assert not json.loads(sim.read_text())["stable"]  # the simulation chatters, at both lengths
+        assert main(["cut", str(wav), "--rpm", "13800", "--teeth", "2", "--out", str(out)]) == 0
+        doc = json.loads(out.read_text())
+        short = [w for w in doc["criterion"]["warnings"] if "cannot be read beside" in w]
+        if revs == "40":
+            assert doc["verdict"] == "chatter" or short, doc["verdict"]
+        else:
+            assert doc["verdict"] == "chatter" and not short

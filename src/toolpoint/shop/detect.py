@@ -261,6 +261,7 @@ _STEADY_WARN_DB = 6.0  # dB: a chatter line of a record without an air cut that 
 _HUMP_DB = 15.0  # a strong chatter line this little over the bins 3–4 away is a hump; its ring is read
 _UNHEARD_LINE_DB = 20.0  # a record whose spindle harmonics do not stand out keeps a chatter line this far out
 _MASKED_WARN = 0.95  # a stable verdict with this much of the band under the spindle harmonics' masks is warned of
+_SHORT_MASKED_WARN = 1 / 3  # … and with this much where the cut is too short to be read beside the harmonics
 _ELSEWHERE_REL = 0.25  # nominal speeds up to this far off are checked for (the range measured)
 _ELSEWHERE_DB = 13.0  # … where the tooth-passing harmonics stand this far over the floor (mean of the four lowest)
 _ELSEWHERE_GAIN_DB = 10.0  # … and this much higher than within the tolerance: warned (see _speed_elsewhere)
@@ -1299,6 +1300,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         ta_, tb_ = max(air_runs, key=lambda r: r[1] - r[0])
         air_x = x[int(ta_ * rate):int(min(tb_, ta_ + _NEAR_MAX_S) * rate)]
     has_air = ref is not None  # entry and exit exist when the record shows the tool going in and out
+    longest_run = 0.0  # s: the longest cutting run judged (entry and exit left out)
     for ta, tb, v in runs:
         if not v:
             segments.append(CutSegment("air", ta, tb, "air"))
@@ -1309,6 +1311,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         if e_in:
             segments.append(CutSegment("entry", ta, ta + e_in, "transient"))
         ma, mb = ta + e_in, tb - e_out
+        longest_run = max(longest_run, mb - ma)
         nwin = max(1, int((mb - ma) / window_s))
         bounds = np.linspace(ma, mb, nwin + 1)
         windows = [judge(wa, wb) for wa, wb in zip(bounds[:-1], bounds[1:])]
@@ -1382,6 +1385,14 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         warns.append(f"the spindle harmonics lie {f_s:.3g} Hz apart at {60 * f_s:.0f} rpm and their masks cover "
                      f"{100 * masked:.0f} % of the band: chatter that falls in them is not heard, so 'stable' says "
                      "little here; judge this cut by its surface or by ear")
+    if verdict == "stable" and masked >= _SHORT_MASKED_WARN and 0 < longest_run < _NEAR_MIN_S:
+        # a short record's frames are short and its masks wide, and a run this short is not read as one long frame
+        # beside the harmonics: the README's 1-DOF slot at 1.5 mm (2 × its limit) over 40 revolutions, 0.14 s of
+        # cutting, masks of ±46 Hz over 40 % of the band, chattered at 910 Hz beside the 920 Hz harmonic and read
+        # "stable" without a word (over 250 revolutions: chatter)
+        warns.append(f"the cut lasted only {longest_run:.2f} s: the spindle harmonics' masks cover "
+                     f"{100 * masked:.0f} % of the band and a cut shorter than {_NEAR_MIN_S:g} s cannot be read "
+                     "beside them, so chatter there goes unheard and 'stable' says little; cut for at least 1 s")
     low = min((sg.air_gain_db for sg in judged), default=0.0)
     if low <= _GAIN_WARN_DB:
         warns.append(f"the cut's noise floor lies {-low:.1f} dB under the air cut's over 90 % of the band: the "
