@@ -1385,10 +1385,10 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         warns.append(f"the spindle harmonics lie {f_s:.3g} Hz apart at {60 * f_s:.0f} rpm and their masks cover "
                      f"{100 * masked:.0f} % of the band: chatter that falls in them is not heard, so 'stable' says "
                      "little here; judge this cut by its surface or by ear")
-    if verdict == "stable" and masked >= _SHORT_MASKED_WARN and 0 < longest_run < _NEAR_MIN_S:
+    if verdict == "stable" and _SHORT_MASKED_WARN <= masked < _MASKED_WARN and 0 < longest_run < _NEAR_MIN_S:
         # a short record's frames are short and its masks wide, and a run this short is not read as one long frame
         # beside the harmonics: the README's 1-DOF slot at 1.5 mm (2 × its limit) over 40 revolutions, 0.14 s of
-        # cutting, masks of ±46 Hz over 40 % of the band, chattered at 910 Hz beside the 920 Hz harmonic and read
+        # cutting, masks of ±46 Hz over 43 % of the band, chattered at 910 Hz beside the 920 Hz harmonic and read
         # "stable" without a word (over 250 revolutions: chatter)
         warns.append(f"the cut lasted only {longest_run:.2f} s: the spindle harmonics' masks cover "
                      f"{100 * masked:.0f} % of the band and a cut shorter than {_NEAR_MIN_S:g} s cannot be read "
