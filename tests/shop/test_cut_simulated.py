@@ -295,6 +295,7 @@ def test_a_bad_hump_bar_is_refused():
         assert e.value.field == "hump_db"
 
 
+@pytest.mark.slow  # two simulations and two analyses through the CLI (~3 s): the fast tier read 172 s on 2026-12-04
 def test_a_stable_verdict_on_a_cut_too_short_to_read_beside_the_harmonics_is_warned(tmp_path):
     """The README's `simulate` example (the 1-DOF slot, 2 teeth, 13800 rpm) at 1.5 mm, where toolpoint.simulation
     chatters at 910 Hz beside the 920 Hz spindle harmonic. Over the command's default 40 revolutions (0.14 s of cut)
