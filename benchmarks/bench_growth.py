@@ -279,8 +279,7 @@ def bench_ring(seeds=12):
     """``ring_decay`` against the closed form σ = −ζω_n of a mode driven by white noise (the records of
     ``tests/shop/test_ring.py``, over a 6000 rpm spindle line and sensor noise), seven modes × ``seeds`` seeds: the
     median ratio, the ln scatter, how often ±1.96 ln sd holds the truth, and the CPU per fit."""
-    from scipy.signal import lfilter
-
+    from shop_synth import noise_driven_mode
     from toolpoint.shop.growth import ring_decay
 
     rate = 20000.0
@@ -290,12 +289,7 @@ def bench_ring(seeds=12):
                           (900, 0.02, 3.0), (2400, 0.001, 4.0), (500, 0.05, 2.0)):
         true, e, held = -zeta * 2 * np.pi * fn, [], 0
         for s in range(seeds):
-            rng = np.random.default_rng(s)
-            w = 2 * np.pi * fn
-            r, th = math.exp(-zeta * w / rate), w * math.sqrt(1 - zeta ** 2) / rate
-            y = lfilter([1.0], [1.0, -2 * r * math.cos(th), r * r], rng.standard_normal(int(dur * rate)))
-            t = np.arange(y.size) / rate
-            y = y / y.std() + 3 * np.sin(2 * np.pi * 100 * t) + 0.05 * rng.standard_normal(y.size)
+            y = noise_driven_mode(fn, zeta, dur, s, rate)
             c0 = time.process_time()
             g = ring_decay(y, rate, rpm=6000, teeth=4, line_hz=fn + 2.0, start_s=0.0, end_s=dur)
             cpu_all += time.process_time() - c0

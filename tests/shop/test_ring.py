@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
-from shop_synth import shop_record
+from shop_synth import noise_driven_mode, shop_record
 from toolpoint.errors import InputError
 from toolpoint.io.records import read_cut_record
 from toolpoint.shop import analyse_cut
@@ -18,15 +18,8 @@ RATE = 20000.0
 
 
 def _sdof(fn, zeta, dur, seed):
-    """A mode (f_n Hz, ζ) driven by white force noise — the exact discrete resonator, poles r e^{±iθ},
-    r = e^{−ζω_n/rate}: its response's autocorrelation decays as e^{−ζω_n |τ|} — over a spindle's harmonic (6000 rpm)
-    and sensor noise."""
-    rng = np.random.default_rng(seed)
-    w = 2 * np.pi * fn
-    r, th = math.exp(-zeta * w / RATE), w * math.sqrt(1 - zeta ** 2) / RATE
-    y = lfilter([1.0], [1.0, -2 * r * math.cos(th), r * r], rng.standard_normal(int(dur * RATE)))
-    t = np.arange(y.size) / RATE
-    return y / y.std() + 3 * np.sin(2 * np.pi * 100 * t) + 0.05 * rng.standard_normal(y.size)
+    """A noise-driven mode at RATE (tests/shop_synth.noise_driven_mode; its ring's closed form σ = −ζω_n)."""
+    return noise_driven_mode(fn, zeta, dur, seed, RATE)
 
 
 @pytest.mark.parametrize("fn, zeta, dur", [(650.0, 0.003, 2.0),
@@ -172,7 +165,6 @@ def test_a_bump_of_the_noise_is_no_ring():
     ring stands 26 dB and more over it and is passed on."""
     from types import SimpleNamespace
 
-    from scipy.signal import lfilter
 
     from toolpoint.shop.growth import RING_MIN_PEAK_DB
     from toolpoint.shop.update import ring_fields

@@ -451,12 +451,12 @@ def ring_decay(samples, rate_hz: float, *, rpm: float, teeth: int, line_hz: floa
         S = 2 * F[0].real - r[0].real
         on = S > 0.0
         E = np.where(on, S, 0.0) + v * n0
-        gw = np.where(on, 1.0 / E - Iu / (E * E), 0.0)
+        dE = 1.0 / E - Iu / (E * E)  # ∂/∂E of the likelihood's terms
         dS = 2 * F.real
         dS[0] -= r[0].real
         g = np.empty(4)
-        g[:3] = dS @ gw
-        g[3] = n0 * float(np.sum(1.0 / E - Iu / (E * E)))
+        g[:3] = dS @ np.where(on, dE, 0.0)
+        g[3] = n0 * float(np.sum(dE))
         return float(np.sum(np.log(E) + Iu / E)), g
 
     n0 = max(float(np.median(Iu)), math.exp(lo_n))  # the floor's scale (v = 1 at the start)
