@@ -57,9 +57,24 @@ def seeds(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
-def heavy(seeds, tmp_path_factory):
+def camp(seeds, tmp_path_factory):
+    """The seeds' campaign with its holder as a model (no inverse RCSA of the measured holder, ~3.5 s: a library
+    run then costs ~0.1 s a tool). The measured holder's path runs where ``seeds / "camp"`` is given."""
+    import shutil
+
+    d = tmp_path_factory.mktemp("fastcamp") / "camp"
+    shutil.copytree(seeds / "camp", d)
+    toml = (d / "campaign.toml").read_text()
+    head, tail = toml.split("[holders.ER40]")[0], toml.split("[identify]", 1)[1]
+    (d / "campaign.toml").write_text(head + '[holders.ER40]\nmodel = "truth/spindle_holder.toml"\n[identify]' + tail)
+    return d
+
+
+@pytest.fixture(scope="session")
+def heavy(seeds, camp, tmp_path_factory):
     """Valid inputs of the heavier commands, built once: a coarse assembly (20–3000 Hz, 20 Hz) with its
-    tool-point and holder-tip FRFs, a 2-tool campaign, a 1-tool library and its finished output folder."""
+    tool-point and holder-tip FRFs, a 2-tool campaign, a 1-tool library and its finished output folder (made with
+    the model holder of ``camp``)."""
     from test_properties import _quiet_main
 
     from toolpoint.campaign.synth import synthesise
@@ -77,7 +92,7 @@ def heavy(seeds, tmp_path_factory):
         f.write_text("".join(lines[:1] + lines[1::8]))
     lines = (ROOT / "examples" / "tool_library.csv").read_text().splitlines(keepends=True)
     (d / "lib.csv").write_text("".join(lines[:2]))
-    assert _quiet_main(["library", d / "lib.csv", "--campaign", seeds / "camp", "--models",
+    assert _quiet_main(["library", d / "lib.csv", "--campaign", camp, "--models",
                         seeds / "results" / "models", "--out", d / "libout", "--workers", "1", "--samples", "8",
                         "--rpm-points", "20"]) == 0
     return d

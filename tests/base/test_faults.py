@@ -149,17 +149,6 @@ def test_csv_cells_never_formulas_and_read_back_as_written(text):
     assert csv_unsafe(cell) == text
 
 
-@pytest.fixture(scope="module")
-def camp(seeds, tmp_path_factory):
-    """The seeds' campaign with its holder as a model (no inverse RCSA: a library run costs ~0.1 s a tool)."""
-    d = tmp_path_factory.mktemp("fastcamp") / "camp"
-    shutil.copytree(seeds / "camp", d)
-    toml = (d / "campaign.toml").read_text()
-    head, tail = toml.split("[holders.ER40]")[0], toml.split("[identify]", 1)[1]
-    (d / "campaign.toml").write_text(head + '[holders.ER40]\nmodel = "truth/spindle_holder.toml"\n[identify]' + tail)
-    return d
-
-
 def _write_library(path: Path, ids, **cells) -> None:
     row = dict(diameter_mm="12", overhang_mm="50", teeth="3", holder="ER40", tangential_coeff_n_mm2="",
                radial_ratio="", material="al7075", radial_immersion="0.5", milling="down", rpm_min="4000",

@@ -159,6 +159,7 @@ def test_gp_baseline_saved_and_rebuilt_exactly(campaign):
         assert gps[t].predict([[60.0, 200.0]])[1][0] > 3 * inside
 
 
+@pytest.mark.slow  # ~4 s: 200 epochs of two 21-rule models (the fast tier kept under 3 min)
 def test_paper_grid_3x7(tmp_path):
     """The defaults are the paper's: 3x7 Gaussian MFs, 21 rules, linear consequents, 200 epochs."""
     folder = write_identified(tmp_path, identified_rows())

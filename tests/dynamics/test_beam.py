@@ -21,11 +21,12 @@ def free_free_frequencies(seg: Segment, n: int, fmax: float) -> list[float]:
     sec = seg.section()
 
     def det21(f):
-        T = transfer_matrix(sec, seg.length, [2 * np.pi * f])[0]
-        return np.linalg.det(T[2:, :2]).real
+        T = transfer_matrix(sec, seg.length, 2 * np.pi * np.atleast_1d(f))
+        d = np.linalg.det(T[:, 2:, :2]).real
+        return d if np.ndim(f) else d[0]
 
     fs = np.linspace(1.0, fmax, 6000)
-    d = np.array([det21(f) for f in fs])
+    d = det21(fs)  # the scan for sign changes over all frequencies at once
     idx = np.nonzero(np.sign(d[:-1]) != np.sign(d[1:]))[0]
     return [brentq(det21, fs[i], fs[i + 1], xtol=1e-10) for i in idx[:n]]
 

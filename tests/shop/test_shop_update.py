@@ -88,6 +88,7 @@ def test_growth_rate_matches_the_semi_discretisation():
     assert 0.5 < k1 / (0.005 * 2 * np.pi * 750) < 2, k1
 
 
+@pytest.mark.slow  # ~2 s: full SDM searches (the fast tier kept under 3 min)
 def test_reference_ratios_started_near_the_first_agree_with_the_full_search():
     """The SDM/ZOA ratios of the reference samples after the first (bracketed from the first's ratio by
     sdm_limit_near) against each sample's own upward SDM search at every speed (sdm_limits, over the same speeds):
@@ -168,6 +169,7 @@ def test_the_label_growth_against_the_time_domain_a_longer_cut_hears_slow_chatte
         assert not long.stable and long.chatter_hz == pytest.approx(750.0, rel=0.01), (seed, long)
 
 
+@pytest.mark.slow  # ~3 s: a CLI update and time-domain cuts (the fast tier kept under 3 min)
 def test_the_next_cut_lasts_long_enough_for_slow_chatter_to_be_heard(tmp_path, capsys):
     """The next cut's duration with ``update``'s ``audible_margin`` 0.05: t = G̃ / (κ₂₅ · 0.05) at its speed, so
     chatter 5 % past the limit grows by e^G̃ within it — the duration the time-domain test above hears (on one 750 Hz
@@ -413,6 +415,7 @@ def test_the_label_growth_read_from_each_samples_own_sdm():
         with pytest.raises(InputError, match="growth_by"):
             update(pr, one, rng=np.random.default_rng(0), **bad)
 
+@pytest.mark.slow  # ~4 s: updates with the references' SDM (the fast tier kept under 3 min)
 def test_the_sampling_reads_the_label_growth_from_the_references_sdm(monkeypatch):
     """``growth_by="sdm"`` in the sampling: the references' κ at each cut is G / (t x_b), x_b where their SDM growth
     ln ρ / T first reaches G / t — checked against ``sdm_spectral_radius`` at the SDM limit bisected on it directly;
@@ -592,6 +595,7 @@ damping = 0.0288
 """
 
 
+@pytest.mark.slow  # 6–7 s: three CLI updates with their plots and reports (the fast tier kept under 3 min)
 def test_cli_update_writes_files_and_report(tmp_path, capsys):
     prior = tmp_path / "prior.toml"
     prior.write_text(PRIOR_TOML)
@@ -1665,6 +1669,7 @@ def test_a_campaign_makes_each_cut_as_long_as_proposed(monkeypatch):
     assert all(d is not None and d >= 2.0 for d in made), made
 
 
+@pytest.mark.slow  # ~3 s: two virtual campaigns (the fast tier kept under 3 min)
 def test_a_campaign_without_a_stop_makes_the_same_cuts_and_reports_calibration():
     """``stop=False`` (the benchmark's calibration runs): the same cuts as a campaign that stops, up to its stop,
     the same ``converged_after``, and per update whether the truth lies under the recommended depth (checked here
@@ -1753,6 +1758,7 @@ def test_a_record_at_another_speed_than_its_row_s_rpm(tmp_path):
     assert not out.exists()
 
 
+@pytest.mark.slow  # ~5 s: the lobe samples' own SDM limits (the fast tier kept under 3 min)
 def test_the_band_at_the_pocket_is_made_of_the_lobe_samples_own_sdm_limits():
     """Before any cut (``forward="sdm"``): at the speeds ``own_pocket`` names, about the most productive one, the band's
     5 / 50 / 95 % are those of the lobe samples' own SDM limits — against an independent full search
