@@ -1091,7 +1091,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             # 5000 and 6538 rpm, 3 teeth, their tooth harmonics 15–22 dB out and the comb over 40 harmonics 1.0–1.8 dB)
             heard = score[best] > 0.5 or harmonics_heard(mean_p, floor, frames.size, f_s)
             spindle_found = bool(heard) and 4 <= best < score.size - 4  # a main lobe: 4 steps
-            comb = (float(score[best]) * 10 / math.log(10), f_s, bool(heard))  # dB, Hz, heard: the refusal's words
+            # dB, Hz, heard, the chatter line whose family the comb was (or None): the refusal's words
+            comb = (float(score[best]) * 10 / math.log(10), f_s, bool(heard), None)
             if not spindle_found:
                 f_s = f_nom
                 # a speed given in rev/s (Hz) where rpm was asked: the comb at 60 × the nominal (the real recording at
@@ -1105,13 +1106,19 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                     if s60.max() > 0.5:
                         rev_s = float(g0s[int(np.argmax(s60))])
             else:
-                f_s = _refine_speed(freq, logp, floor, inband, f_s, f_nom, teeth, rpm_tolerance, df)
+                f_s, agreed = _refine_speed(freq, logp, floor, inband, f_s, f_nom, teeth, rpm_tolerance, df)
+                # a comb within the mask's reach of the speed given moves nothing, whatever lines made it
+                doubt = not agreed and abs(f_s / f_nom - 1) > _MASK_REL
+                fam = (_family_comb(freq, logp, floor, inband, f_s, f_nom, teeth, rpm_tolerance, df, hi) if doubt
+                       else None)
+                if fam is not None:  # the comb was a chatter's family: the speed is not heard apart from it
+                    spindle_found, f_s, comb = False, f_nom, comb[:3] + (fam,)
             elsewhere = _speed_elsewhere(freq, logp, floor, f_nom, teeth, rpm_tolerance, df)
         else:  # the speed as given: its comb is read there alone
             f_s, elsewhere = f_nom, None
             sc = float(_comb_score(freq, logp, floor, np.array([f_nom]), min(hi, 40 * f_nom))[0])
             spindle_found = sc > 0.5 or harmonics_heard(mean_p, floor, frames.size, f_nom)
-            comb = (sc * 10 / math.log(10), f_nom, spindle_found)
+            comb = (sc * 10 / math.log(10), f_nom, spindle_found, None)
         return f_s, spindle_found, rev_s, elsewhere, comb
 
     f_s, spindle_found, rev_s, elsewhere, comb = spindle(cutting)
@@ -1152,7 +1159,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
 
     def tracked(frames):
         """(the speed track (times s, Hz) or None, its wander, the spindle frequency Hz) over these frames."""
-        if rpm_tolerance > 0 and frames.size >= 3:
+        if rpm_tolerance > 0 and frames.size >= 3 and comb[3] is None:  # a chatter's family: not the speed's lines
             Pt, tt, ft, it, dft = track_spectra(frames)
             tracks = [_track_speed(Pt, tt, ft, it, f_comb, o, rpm_tolerance, dft)
                       for o in ((teeth * np.arange(1, 5), np.arange(1, 5)) if teeth > 1 else (np.arange(1, 5),))]
@@ -1230,6 +1237,11 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             why = (f"; the tooth-passing harmonics stand {elsewhere[1]:.0f} dB over the floor at "
                    f"{60 * elsewhere[0]:.0f} rpm ({100 * (elsewhere[0] / f_nom - 1):+.1f} %): give the speed the "
                    "spindle ran at (an override?) or widen --rpm-tolerance")
+        elif comb[3] is not None:
+            why = (f" apart from the lines of the chatter near {comb[3]:.0f} Hz (with its aliases and second harmonic "
+                   f"they make a comb at {60 * comb[1]:.0f} rpm, {100 * (comb[1] / f_nom - 1):+.1f} %, "
+                   f"{comb[0]:.1f} dB over the floor; without them none stands out): the speed is not heard; an air "
+                   "cut before the cut, or the cut's start before chatter grows, lets it be read")
         elif rpm_tolerance > 0 and comb[2]:  # the best within the range lay at its edge: where is it?
             _, logp, floor = spectrum(cutting)
             ftop = min(hi, 40 * f_nom)
@@ -2017,15 +2029,54 @@ def _refine_speed(freq, logp, floor, inband, f0, f_nom, teeth, tol, df):
     the largest group of these that agree within ``_TRACK_AGREE`` gives the speed, as in :func:`_track_speed` (the
     tooth-passing harmonics first: a chatter family does not move them), if it lies within ``tol`` of the nominal
     ``f_nom``. With fewer than two agreeing, the comb's ``f0`` stands (windows of ±3 % around each line followed heavy
-    chatter's lines: up to 5 % off on the simulated records)."""
+    chatter's lines: up to 5 % off on the simulated records). Returns (f_s Hz, whether two harmonics agreed)."""
     for orders in (teeth * np.arange(1, 5), np.arange(1, 9)):
         est = _harmonic_peaks(freq, logp, floor, inband, f0, orders, df)
         grp = _agreeing(est)
         if grp.size >= 2:
             f_s = float(grp.mean())
             if abs(f_s / f_nom - 1) <= tol:
-                return f_s
-    return f0
+                return f_s, True
+    return f0, False
+
+
+def _family_comb(freq, logp, floor, inband, f_s, f_nom, teeth, tol, df, hi):
+    """The strongest line's frequency (Hz) where the comb found at ``f_s`` stands out on that line's family alone,
+    else None.
+
+    Developed chatter f_c a few Hz from a tooth-passing harmonic j f_t, with its aliases f_c + i f_t and its own
+    second harmonic's 2 f_c + i f_t, makes lines at (j + i) f_t + δ: within the main lobe of a comb of spacing
+    f_t + δ/(j + i), a fraction of a percent off, that stands out as the spindle's (``_comb_search``) where the
+    cut's own tooth passing is buried under the chatter's. The README's ``simulate`` example at 1.5 mm over 250
+    revolutions (910 Hz chatter, 2 f_t = 920 Hz, no runout) read the spindle 0.6 % slow this way, masked the chatter
+    as its harmonic and reported a flank of it, 898.7 Hz. Here the bins within ±1.5 bins of the family of the
+    strongest line in the band are set to the floor and the comb searched again over the same range: where it no
+    longer stands out (the comb test of :func:`analyse_cut`), the family was the comb. Asked only where no two
+    harmonics' own peaks agree on the speed (:func:`_refine_speed`): where they do, the speed is read from them; where
+    the comb lies more than ``_MASK_REL`` from the speed given (nearer, it moves nothing: an accelerometer pocket
+    record of EM28-80 whose comb of a chatter's family lay 0.02 % from the speed given was refused, not judged, when
+    asked there); and only of a strongest line more than half a bin from every line of the comb (a line of the comb
+    itself, a stable cut's tooth passing, has the comb for its family)."""
+    band = np.flatnonzero(inband)
+    ex = logp - floor
+    j = int(band[int(np.argmax(ex[band]))])
+    if j == 0 or j >= freq.size - 1:
+        return None
+    f_top = float(freq[j] + _vertex(logp[j - 1], logp[j], logp[j + 1]) * df)
+    if abs(f_top - round(f_top / f_s) * f_s) <= 0.5 * df:
+        return None  # the strongest line is one of the comb's own: its family is the comb, whatever made it
+    f_t = teeth * f_s
+    i = np.arange(-int(2 * f_top / f_t) - 1, int(hi / f_t) + 2)
+    lines = np.r_[f_top + i * f_t, 2 * f_top + i * f_t]
+    lines = lines[(lines > freq[band[0]] - 2 * df) & (lines < freq[band[-1]] + 2 * df)]
+    near = np.zeros(freq.size, bool)
+    for c in lines:
+        near[max(0, int(math.ceil((c - 1.5 * df) / df))):int(math.floor((c + 1.5 * df) / df)) + 1] = True
+    f0s, score, _ = _comb_search(freq, np.where(near, floor, logp), floor, f_nom, tol, df, hi)
+    best = int(np.argmax(score))
+    if score[best] > 0.5 and 4 <= best < score.size - 4:
+        return None
+    return f_top
 
 
 def _agreeing(est) -> np.ndarray:
