@@ -576,9 +576,9 @@ def test_the_spectra_computed_in_chunks_are_those_of_all_frames_at_once():
 def test_running_out_of_memory_is_one_line_and_writes_nothing(tmp_path, capsys, monkeypatch):
     """A record too long for the machine's memory (a whole session's recording): one line saying so and what to make
     smaller, exit 2, no traceback, no output file."""
-    import toolpoint.shop as shop
-
     import soundfile as sf
+
+    import toolpoint.shop as shop
 
     x, rate, *_ = shop_record(rpm=6000, teeth=4, seed=1)
     rec = tmp_path / "r.wav"  # as audio: a CSV of the 4 s took 2 s to write and read, and the read is not the subject
