@@ -600,8 +600,10 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                              f"change from the prior's band, paired by truth, {d.mean():+.3f} ± {se_d:.3f}; ")
                           + f"truths ≥ 0.90: {np.mean(cov >= 0.9):.2f}), near the cuts (±3 %) "
                           + ("-" if np.all(np.isnan(near)) else f"{np.nanmean(near):.3f}")
-                          + f", away {np.nanmean(away):.3f}; width at the recommended speed median {wid:.2f}",
-                          flush=True)
+                          + f", away {np.nanmean(away):.3f}; missed below the 5 % limit "
+                          + f"{np.mean([r.miss_low[n] for r in runs]):.3f}, above the 95 % "
+                          + f"{np.mean([r.miss_high[n] for r in runs]):.3f}; width at the recommended speed median "
+                          + f"{wid:.2f}", flush=True)
 
 
 def bench_sampler():

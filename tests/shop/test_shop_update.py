@@ -814,6 +814,8 @@ def test_virtual_campaign_converges_with_few_chatters():
     assert r.converged_after is not None and r.converged_after <= 8
     assert r.chatter_cuts <= 2
     assert r.width[-1] <= 0.2 and r.coverage[-1] >= 0.9
+    # every speed is inside the band, under its 5 % limit or over its 95 %: the misses say on which side it failed
+    assert np.allclose(np.add(r.coverage, r.miss_low) + np.asarray(r.miss_high), 1.0)
     assert isinstance(ModalPrior, type)
 
 

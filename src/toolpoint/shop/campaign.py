@@ -56,6 +56,9 @@ class CampaignResult:
     coverage_near, coverage_away : tuple of float
         After each update: the coverage over the speeds within ±3 % of a cut made so far (nan before the first
         cut) and over the others.
+    miss_low, miss_high : tuple of float
+        After each update: the share of speeds whose true limit lies below the band's 5 % limit (the band
+        over-confident on the unsafe side) and above its 95 % limit.
     """
 
     theta_true: np.ndarray
@@ -68,6 +71,8 @@ class CampaignResult:
     below_recommended: tuple = ()
     coverage_near: tuple = ()
     coverage_away: tuple = ()
+    miss_low: tuple = ()
+    miss_high: tuple = ()
 
 
 def zoa_shop(prior: ModalPrior):
@@ -182,7 +187,7 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
     shop = zoa_shop(prior) if shop is None else shop
     if theta_true is None:
         theta_true = prior.theta((rng.standard_normal(prior.sigma.size) * (prior.sigma > 0))[None, :])[0]
-    cuts, cov_h, wid_h, cpu, below, near_h, away_h = [], [], [], [], [], [], []
+    cuts, cov_h, wid_h, cpu, below, near_h, away_h, low_h, high_h = [], [], [], [], [], [], [], [], []
     converged = None
     true_lim = None
     for n in range(max_cuts + 1):
@@ -191,8 +196,11 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
             true_lim = (_limits(prior, theta_true[None, :], prior.freq_grid(), post.rpm)[0] if true_limit is None
                         else np.asarray(true_limit(theta_true, post.rpm), float))
         q = post.limit_q_m
-        inside = (q[0] <= true_lim * 1.0000001) & (true_lim <= q[2] * 1.0000001)
+        low, high = true_lim * 1.0000001 < q[0], q[2] * 1.0000001 < true_lim
+        inside = ~low & ~high
         cov = float(inside.mean())
+        low_h.append(float(low.mean()))
+        high_h.append(float(high.mean()))
         j = int(np.argmin(np.abs(post.rpm - post.recommended["rpm"])))
         wid = float((q[2, j] - q[0, j]) / q[1, j])
         cov_h.append(cov)
@@ -214,4 +222,4 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
         cuts.append(shop(theta_true, nc["rpm"], nc["depth_m"], rng, nc["duration_s"]))
     chat = sum(not c.stable for c in (cuts if converged is None else cuts[:converged]))
     return CampaignResult(np.asarray(theta_true), tuple(cuts), converged, chat, tuple(cov_h), tuple(wid_h),
-                          tuple(cpu), tuple(below), tuple(near_h), tuple(away_h))
+                          tuple(cpu), tuple(below), tuple(near_h), tuple(away_h), tuple(low_h), tuple(high_h))
