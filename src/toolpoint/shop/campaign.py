@@ -196,8 +196,8 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
             true_lim = (_limits(prior, theta_true[None, :], prior.freq_grid(), post.rpm)[0] if true_limit is None
                         else np.asarray(true_limit(theta_true, post.rpm), float))
         q = post.limit_q_m
-        low, high = true_lim * 1.0000001 < q[0], q[2] * 1.0000001 < true_lim
-        inside = ~low & ~high
+        inside = (q[0] <= true_lim * 1.0000001) & (true_lim <= q[2] * 1.0000001)
+        low, high = true_lim * 1.0000001 < q[0], q[2] * 1.0000001 < true_lim  # a NaN limit: neither, and not inside
         cov = float(inside.mean())
         low_h.append(float(low.mean()))
         high_h.append(float(high.mean()))
