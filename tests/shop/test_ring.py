@@ -165,7 +165,6 @@ def test_a_bump_of_the_noise_is_no_ring():
     ring stands 26 dB and more over it and is passed on."""
     from types import SimpleNamespace
 
-
     from toolpoint.shop.growth import RING_MIN_PEAK_DB
     from toolpoint.shop.update import ring_fields
 
