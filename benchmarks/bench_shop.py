@@ -2,7 +2,7 @@
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
         [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard|bracket|prior-pocket]
-        [--shops zoa,noisy,sim]
+        [--shops zoa,noisy,sdm,sim]
         [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
         [--update '{"n_samples": 500, "lobe_samples": 200, "forward": "sdm"}'] [--cut-truth-seed 20] [--seed-level 0.01]
@@ -26,9 +26,12 @@ CPU time (time.process_time), not wall time: the machine is shared.
    ``inside``: records taken inside a chattering cut, without air cut (windows of the real recording's chattering
    stretch; synthetic cuts whose chatter waxes and wanes).
 2. ``update``: virtual campaigns (truth drawn from the prior, the next cut from the ``info`` rule) on the
-   Cornelius et al. 2024 two-mode case and on the toolpoint example tool, over ``--seeds`` seeds, with two shops:
+   Cornelius et al. 2024 two-mode case and on the toolpoint example tool, over ``--seeds`` seeds, with the shops
    ``zoa`` (cuts labelled by the true zero-order limit: the update's own model), ``noisy`` (the true limit
-   blurred by 3 % per cut, chatter frequency measured to 0.5 %) and ``sim`` (each cut
+   blurred by 3 % per cut, chatter frequency measured to 0.5 %), ``sdm`` (the same with the truth's SDM limit and
+   chatter frequency: the whole loop's truth without the simulation and the detector — with ``--update
+   '{"label_offset": [0, 0], "label_growth": [0, 0]}'`` the labels are exactly what the likelihood assumes, a check
+   of the SDM forward path's calibration) and ``sim`` (each cut
    simulated in the time domain by toolpoint.simulation (``simulated_shop``), heard by the tests' shop microphone
    (tests/milling_sim.py: fans, spindle lines, room noise, air cut), judged by
    ``analyse_cut``: the whole loop). Targets: ≤ 6 cuts (median) until the 5–95 %
@@ -570,6 +573,8 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                                      + ("" if c.growth_per_s is None else f"[σ {c.growth_per_s:.3g}/s]")
                                      for c, x in zip(r.cuts, rel))
                           + f"; width {np.round(r.width, 2).tolist()}; coverage {np.round(r.coverage, 2).tolist()}"
+                          + (f"; missed below the 5 % / above the 95 % after the last {r.miss_low[-1]:.2f} / "
+                             f"{r.miss_high[-1]:.2f}" if r.miss_low else "")
                           + ("; truth below the recommended depth after "
                              + ",".join(str(n) for n, b in enumerate(r.below_recommended) if b)
                              if any(r.below_recommended) else ""),
