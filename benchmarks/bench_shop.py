@@ -30,8 +30,8 @@ CPU time (time.process_time), not wall time: the machine is shared.
    ``zoa`` (cuts labelled by the true zero-order limit: the update's own model), ``noisy`` (the true limit
    blurred by 3 % per cut, chatter frequency measured to 0.5 %), ``sdm`` (the same with the truth's SDM limit and
    chatter frequency: the whole loop's truth without the simulation and the detector — with ``--update
-   '{"label_offset": [0, 0], "label_growth": [0, 0]}'`` the labels are exactly what the likelihood assumes, a check
-   of the SDM forward path's calibration) and ``sim`` (each cut
+   '{"label_offset": [0, 0], "label_growth": [0, 0]}'`` the labels follow the likelihood's model (their 3 % blur
+   within its 5 % boundary width), a check of the SDM forward path's calibration) and ``sim`` (each cut
    simulated in the time domain by toolpoint.simulation (``simulated_shop``), heard by the tests' shop microphone
    (tests/milling_sim.py: fans, spindle lines, room noise, air cut), judged by
    ``analyse_cut``: the whole loop). Targets: ≤ 6 cuts (median) until the 5–95 %
