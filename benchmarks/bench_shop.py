@@ -1,7 +1,7 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard|bracket|prior-pocket]
+        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard|bracket|prior-pocket|exact]
         [--shops zoa,noisy,sdm,sim]
         [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
@@ -58,6 +58,9 @@ CPU time (time.process_time), not wall time: the machine is shared.
    with exact labels — the floor the label offset sets on the loop's width target, however well the cuts are placed.
 8. ``prior-pocket``: the prior's band (``update`` with no cut) near its recommended speed, where the first cuts go,
    against the SDM limits of 400 truths drawn from the prior: the share below its 5 % and above its 95 % line.
+9. ``exact`` (only when asked; ``--seeds`` truths from ``--seed-start``, ``--cases``): ``update``'s SDM-path
+   posterior against an exact-likelihood SMC (each sample's own SDM limit at the cut speeds) on the ``sdm`` shop with
+   δ = G = 0 — what its approximations cost in coverage, against the 0.90 an exact posterior holds on average.
 """
 
 from __future__ import annotations
@@ -825,6 +828,76 @@ def bench_prior_pocket(cases, library_prior=None, truths=400, seed=123):
               + f" mm; {time.process_time() - c0:.0f} s CPU", flush=True)
 
 
+def bench_exact(cases, library_prior=None, truths=20, seed_start=250, particles=400, band_samples=100):
+    """``update``'s ``forward="sdm"`` posterior against an exact-likelihood one, on the ``sdm`` shop with the label
+    model holding (δ = G = 0): each truth's campaign of six cuts without a stop, then the last update (its own seed)
+    and a tempered SMC of ``particles`` samples whose likelihood takes each sample's own SDM limit at the cut speeds
+    (``sdm_limit_near``'s default search, not a ratio of references or a fit) — the same labels, width, label noise
+    and frequency term. Each band against the truth's SDM limit on every fifth speed of the grid: the reported band,
+    and the 5–95 % range of ``band_samples`` samples' own SDM limits (the full search) of either posterior. A
+    posterior exact under a likelihood that holds covers 0.90 on average over truths drawn from the prior; the paired
+    difference says what ``update``'s approximations cost. Only with ``--only exact``: about 3 min CPU per truth."""
+    from toolpoint.shop import update as U
+    from toolpoint.shop.model import sdm_limits
+
+    off = dict(label_offset=(0, 0), label_growth=(0, 0))
+    print(f"\n## exact: update's SDM posterior against an exact-likelihood SMC ({particles} samples), sdm shop, "
+          f"δ = G = 0, 6 cuts, truths {seed_start}…{seed_start + truths - 1}; bands on every 5th grid speed "
+          f"({band_samples} samples' own SDM limits)")
+    for name, pr in _priors(library_prior).items():
+        if name not in cases:
+            continue
+        P, f = pr.sigma.size, pr.freq_grid()
+        free = np.r_[pr.sigma > 0, False, False]
+        cov = {"reported": [], "update own": [], "exact own": []}
+        lows = {k: [] for k in cov}
+        c0 = time.process_time()
+        for seed in range(seed_start, seed_start + truths):
+            r = virtual_campaign(pr, rng=np.random.default_rng(seed), shop=sdm_shop(pr), max_cuts=6,
+                                 true_limit=sdm_limit(pr), n_samples=1000, lobe_samples=400, stop=False, **off)
+            cuts = list(r.cuts)
+            post = update(pr, cuts, rng=np.random.default_rng(10_000 + seed), n_samples=1000, lobe_samples=400, **off)
+            g = post.rpm[::5]
+            truth = sdm_limits(pr, r.theta_true, g, chatter=False)[0]
+            u, inv, _ = U._cut_speeds(np.array([c.rpm for c in cuts]))
+
+            def own_ratio(z, u=u, inv=inv):  # each sample's own ln(a_SDM / a_ZOA) at the cuts (S, C)
+                return U._sdm_own_log_ratio(pr, z[:, :P], u, f, np.full(u.size, 0.1))[:, inv]
+
+            kw = dict(boundary_width=0.05, label_noise=0.002, freq_sigma=0.02, freq_hz=f, freq_outlier=0.05,
+                      miss_rate=0.0, label_offset=(0.0, 0.0), label_growth=(0.0, 0.0), cut_duration_s=1.0,
+                      growth_error=None, ratio_fit=own_ratio)
+            rs = np.random.default_rng(20_000 + seed)
+            z_ex = U._sample(pr, U._draw_z(rs, particles, free), cuts, kw, "smc", 3, rs, [], [])
+            rb = np.random.default_rng(30_000 + seed)
+
+            def own_band(z):
+                zs = z[rb.choice(z.shape[0], band_samples, replace=False), :P]
+                own = np.array([sdm_limits(pr, th, g, chatter=False)[0] for th in pr.theta(zs)])
+                return np.quantile(own, [0.05, 0.95], axis=0)
+
+            bands = {"reported": post.limit_q_m[[0, 2], ::5], "update own": own_band(post.z),
+                     "exact own": own_band(z_ex)}
+            line = []
+            for k, q in bands.items():
+                lo, hi = float(np.mean(truth < q[0])), float(np.mean(truth > q[1]))
+                cov[k].append(1 - lo - hi)
+                lows[k].append(lo)
+                line.append(f"{k} {lo:.3f}/{hi:.3f}")
+            print(f"  truth {seed}: {sum(not c.stable for c in cuts)} chattering of {len(cuts)}; under the 5 % / over "
+                  "the 95 %: " + ", ".join(line), flush=True)
+        n = len(cov["reported"])
+
+        def se(v):
+            return float(np.std(v, ddof=1) / math.sqrt(len(v))) if len(v) > 1 else float("nan")
+
+        print(f"{name}: coverage (claims 0.90) " + "; ".join(
+            f"{k} {np.mean(v):.3f} ± {se(v):.3f} (under the 5 % {np.mean(lows[k]):.3f})" for k, v in cov.items())
+            + f"; exact − reported, paired {np.mean(np.subtract(cov['exact own'], cov['reported'])):+.3f} ± "
+            f"{se(np.subtract(cov['exact own'], cov['reported'])):.3f}; {n} truths, "
+            f"{time.process_time() - c0:.0f} s CPU", flush=True)
+
+
 def bench_sdm_bands(truths=40, grids=(41, 21), update_kw=None):
     """``forward="sdm"`` against the truth's own SDM limit (not zero-order × reference ratio): Cornelius σ 0.12,
     truths from the prior (their own rng: every setting sees the same truths), three cuts at grid speeds labelled
@@ -865,7 +938,7 @@ def main():
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", choices=("cut", "teeth", "twocut", "inside", "update", "sampler", "forward", "ceiling",
-                                       "sdm-bands", "heard", "bracket", "prior-pocket"))
+                                       "sdm-bands", "heard", "bracket", "prior-pocket", "exact"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -933,6 +1006,8 @@ def main():
         import json
 
         bench_sdm_bands(12 if a.quick else 40, update_kw=json.loads(a.update))
+    if a.only == "exact":  # not in the full run: about 3 min CPU per truth
+        bench_exact(a.cases.split(","), a.library_prior, 2 if a.quick else a.seeds, a.seed_start)
     if a.only in (None, "update"):
         import json
 
