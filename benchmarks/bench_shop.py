@@ -840,6 +840,9 @@ def bench_exact(cases, library_prior=None, truths=20, seed_start=250, particles=
     from toolpoint.shop import update as U
     from toolpoint.shop.model import sdm_limits
 
+    import inspect
+
+    dflt = {k: v.default for k, v in inspect.signature(update).parameters.items()}
     off = dict(label_offset=(0, 0), label_growth=(0, 0))
     print(f"\n## exact: update's SDM posterior against an exact-likelihood SMC ({particles} samples), sdm shop, "
           f"δ = G = 0, 6 cuts, truths {seed_start}…{seed_start + truths - 1}; bands on every 5th grid speed "
@@ -864,9 +867,10 @@ def bench_exact(cases, library_prior=None, truths=20, seed_start=250, particles=
             def own_ratio(z, u=u, inv=inv):  # each sample's own ln(a_SDM / a_ZOA) at the cuts (S, C)
                 return U._sdm_own_log_ratio(pr, z[:, :P], u, f, np.full(u.size, 0.1))[:, inv]
 
-            kw = dict(boundary_width=0.05, label_noise=0.002, freq_sigma=0.02, freq_hz=f, freq_outlier=0.05,
-                      miss_rate=0.0, label_offset=(0.0, 0.0), label_growth=(0.0, 0.0), cut_duration_s=1.0,
-                      growth_error=None, ratio_fit=own_ratio)
+            kw = dict({k: dflt[k] for k in ("boundary_width", "label_noise", "freq_sigma", "freq_outlier", "miss_rate",
+                                            "cut_duration_s")},
+                      freq_hz=f, label_offset=(0.0, 0.0), label_growth=(0.0, 0.0), growth_error=None,
+                      ratio_fit=own_ratio)  # update's own likelihood settings, but for the ratio
             rs = np.random.default_rng(20_000 + seed)
             z_ex = U._sample(pr, U._draw_z(rs, particles, free), cuts, kw, "smc", 3, rs, [], [])
             rb = np.random.default_rng(30_000 + seed)
