@@ -15,7 +15,8 @@ from toolpoint.errors import InputError
 from toolpoint.shop.campaign import virtual_campaign
 from toolpoint.shop.model import ModalPrior, cornelius_2024, limit_at_speeds, receptance
 from toolpoint.shop.prior import prior_from_library, read_modal_prior
-from toolpoint.shop.update import OWN_MIN_ESS, TestCut, _own_temper, log_likelihood, read_test_cuts, update
+from toolpoint.shop.update import (OWN_MIN_ESS, TestCut, _band_levels, _own_temper, _quantiles_at, log_likelihood,
+                                   read_test_cuts, update)
 from toolpoint.stability.zoa_batch import zoa_limits
 
 # the command line's tests of parsing, files and messages run the cheaper zero-order model (the default is "sdm":
@@ -643,6 +644,8 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     assert "data:image/png;base64," in html and "src='http" not in html and "<script src" not in html
     lobes = np.genfromtxt(out / "lobes.csv", delimiter=",", names=True)
     assert np.all(lobes["p05_mm"] <= lobes["p50_mm"]) and np.all(lobes["p50_mm"] <= lobes["p95_mm"])
+    # the zero-order model has no references' ratios to allow for: the band is read at 5 % and 95 %
+    assert np.all(lobes["p05_level"] == 0.05) and np.all(lobes["p95_level"] == 0.95)
     # the stable cut at 20000 rpm, 0.5 mm: the posterior 5 % limit there is near or above it
     k = np.argmin(np.abs(lobes["rpm"] - 20000))
     assert lobes["p05_mm"][k] > 0.45 and lobes["p95_mm"][k] < 0.95
@@ -1480,6 +1483,53 @@ def test_the_ratio_fit_recovers_a_quadratic_and_holds_its_range():
     kw = _at(dict(boundary_width=0.05, ratio_fit=fit), znew)
     assert "ratio_fit" not in kw and kw["log_ratio"].shape == (50, 3)
     assert _at(dict(boundary_width=0.05), znew) == dict(boundary_width=0.05)
+
+
+def test_per_speed_quantiles_are_numpys():
+    """The band's quantiles at per-speed levels equal numpy's at the same level, nan and inf columns included."""
+    rng = np.random.default_rng(5)
+    x = rng.lognormal(size=(400, 6))
+    x[:, 2] = np.inf  # no lobe reaches the speed
+    x[:5, 3] = np.inf
+    x[3, 4] = np.nan
+    for lv in ([0.05, 0.5, 0.95], [0.0, 1.0, 0.013]):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            want = np.quantile(x, lv, axis=0)
+            got = _quantiles_at(x, np.array(lv)[:, None] * np.ones((1, 6)))
+        np.testing.assert_allclose(got, want, equal_nan=True)
+
+
+@pytest.mark.parametrize("tau, plain_lo, plain_hi", [(0.0, 0.045, 0.058), (0.1, 0.055, 0.068)])
+def test_the_band_allows_for_its_few_references(tau, plain_lo, plain_hi):
+    """Lobes built as ``update`` builds them away from the cut speeds — each sample's zero-order limit (ln sd 0.2)
+    times one of four references' ratios (offsets ln sd ``tau``) — and a truth drawn from the population (ln sd
+    √(0.2² + tau²)): the widened 5 % and 95 % lines miss it 0.05 of the time each (3 × 1500 draws: ± 0.01), where the
+    plain ones miss it more often once the references spread; with identical references the levels stay ~5 %."""
+    rng = np.random.default_rng(7)
+    n, m, R, G = 1500, 400, 4, 3
+    miss = np.zeros(2)
+    plain = np.zeros(2)
+    levels = []
+    for _ in range(n):
+        offs = rng.normal(0.0, tau, (R, G))
+        rows = rng.integers(R, size=m)
+        lim = np.exp(rng.normal(0.0, 0.2, (m, G)) + offs[rows])
+        truth = np.exp(rng.normal(0.0, math.hypot(0.2, tau), G))
+        lv = _band_levels(lim, rows, R)
+        q = _quantiles_at(lim, lv)
+        q0 = np.quantile(lim, [0.05, 0.95], axis=0)
+        miss += [np.sum(truth < q[0]), np.sum(truth > q[1])]
+        plain += [np.sum(truth < q0[0]), np.sum(truth > q0[1])]
+        levels.append(lv[0])
+    miss /= n * G
+    plain /= n * G
+    assert np.all(np.abs(miss - 0.05) <= 0.01), miss
+    assert plain_lo <= plain.mean() <= plain_hi, plain
+    if tau == 0:
+        assert abs(np.median(levels) - 0.05) < 0.003
+    else:
+        assert np.median(levels) < 0.047 and plain.mean() - miss.mean() > 0.005
 
 
 def test_own_sdm_weights_are_tempered_only_as_far_as_the_samples_need():

@@ -2,7 +2,9 @@
 
 In the output folder (written atomically, all or none of each file):
 
-* ``lobes.csv`` — ``rpm, p05_mm, p50_mm, p95_mm, prior_p05_mm, prior_p50_mm, prior_p95_mm``;
+* ``lobes.csv`` — ``rpm, p05_mm, p50_mm, p95_mm, prior_p05_mm, prior_p50_mm, prior_p95_mm, p05_level,
+  p95_level`` (the lobe samples' quantile levels the posterior's 5 % and 95 % lines were read at, widened for the
+  few references the band rests on: :func:`~toolpoint.shop.update._band_levels`);
 * ``p_stable.csv`` — first row ``depth_mm\\rpm`` and the speeds, then one row per depth (mm) of P(stable);
 * ``parameters.csv`` — ``name, unit, prior_p05, prior_p50, prior_p95, post_p05, post_p50, post_p95``
   (K_t in N/mm²);
@@ -138,10 +140,14 @@ def write_update(post: Posterior, out_dir) -> list:
     paths = []
     with atomic_open(out / "lobes.csv", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["rpm", "p05_mm", "p50_mm", "p95_mm", "prior_p05_mm", "prior_p50_mm", "prior_p95_mm"])
+        w.writerow(["rpm", "p05_mm", "p50_mm", "p95_mm", "prior_p05_mm", "prior_p50_mm", "prior_p95_mm",
+                    "p05_level", "p95_level"])
+        lv = (np.array([[0.05], [0.95]]) * np.ones((1, post.rpm.size)) if post.band_levels is None
+              else post.band_levels)
         for g in range(post.rpm.size):
             w.writerow([f"{post.rpm[g]:.6g}"] + [f"{mm * v:.6g}" for v in post.limit_q_m[:, g]]
-                       + [f"{mm * v:.6g}" for v in post.prior_limit_q_m[:, g]])
+                       + [f"{mm * v:.6g}" for v in post.prior_limit_q_m[:, g]]
+                       + [f"{lv[0, g]:.4f}", f"{lv[1, g]:.4f}"])
     paths.append(out / "lobes.csv")
     with atomic_open(out / "p_stable.csv", newline="") as fh:
         w = csv.writer(fh)

@@ -61,7 +61,8 @@ is plain sampling–importance resampling from the prior, kept to measure agains
 
 Lobes: the posterior samples' zero-order limits on a speed grid (:func:`~toolpoint.stability.zoa_batch.zoa_limits`),
 corrected by the semi-discretisation (``forward="sdm"``, the default: a machine's cuts follow the SDM), their
-5/50/95 % quantiles and P(stable) = share of samples whose limit exceeds a depth.
+5/50/95 % lines (the outer two read further out where the few references' SDM/ZOA ratios the lobes rest on
+spread: :func:`_band_levels`) and P(stable) = share of samples whose limit exceeds a depth.
 
 Recommended point: the speed that maximises n · a₀₅(n) (removal rate at a fixed feed per tooth and width)
 at the depth a₀₅ (P(stable) = 0.95); with ``forward="sdm"`` the depth is lowered to the own SDM 5 % limit, at
@@ -116,7 +117,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.special import log_ndtr, logsumexp
+from scipy.special import log_ndtr, logsumexp, ndtr, ndtri
 
 from ..errors import InputError
 from ..stability.zoa_batch import zoa_limits
@@ -718,7 +719,9 @@ class Posterior:
         Mean Metropolis acceptance (SMC; nan for SIR).
     rpm : ndarray, shape (G,)
     limit_q_m : ndarray, shape (3, G)
-        5/50/95 % quantiles of the limit.
+        5/50/95 % lines of the limit: the lobe samples' median, and their quantiles at ``band_levels``, so that a
+        limit drawn from the posterior falls under the first (over the last) 5 % of the time although the band
+        rests on a few references' SDM/ZOA ratios (:func:`_band_levels`; ``update``'s ``band_noise``).
     depth_m : ndarray, shape (D,)
     p_stable : ndarray, shape (D, G)
     prior_limit_q_m : ndarray, shape (3, G)
@@ -764,6 +767,9 @@ class Posterior:
     own_pocket_rpm : tuple of float
         The speeds (rpm) at which the lobe samples' own SDM limits replaced the references' ratio near the most
         productive speed (:func:`update`'s ``own_pocket``); empty where none did.
+    band_levels : ndarray, shape (2, G), optional
+        The quantile levels of the lobe samples that ``limit_q_m``'s first and last lines are, per speed: 0.05 and
+        0.95 where the references do not spread (or ``band_noise`` is off), further out where they do.
     """
 
     prior: ModalPrior
@@ -791,6 +797,7 @@ class Posterior:
     lobe_z: np.ndarray | None = None
     own_sdm_power: float | None = None
     own_pocket_rpm: tuple = ()
+    band_levels: np.ndarray | None = None
 
     @property
     def theta(self) -> np.ndarray:
@@ -840,7 +847,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            audible_margin: float = 0.025, max_cut_duration_s: float = 5.0,
            growth_error: tuple | None = GROWTH_ERROR, ring_error: tuple | None = RING_ERROR,
            precursor: tuple | None = PRECURSOR, own_sdm: bool = True, growth_by: str = "zoa",
-           own_pocket: int = POCKET_SPEEDS) -> Posterior:
+           own_pocket: int = POCKET_SPEEDS, band_noise: bool = True) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -1091,6 +1098,11 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         *The band at the pocket from the samples' own SDM limits*). It costs one search per lobe sample at each
         speed, all together (6.4 s CPU for 400 samples at five speeds on EM16-50). 0: the references' ratios
         alone (as before 2026-12-01, night).
+    band_noise : bool, default True
+        ``forward="sdm"`` with at least two references: the band's 5 % and 95 % lines are read at per-speed levels
+        that allow for the few references' ratio curves the lobes rest on away from the cut speeds — the
+        jackknife over the references (:func:`_band_levels`; ``Posterior.band_levels``). False: at 0.05 and 0.95
+        (as before 2026-12-05, night). Measured: ``docs/design/shop.md``, *The references' noise in the band*.
 
     Returns
     -------
@@ -1181,6 +1193,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     if not (isinstance(own_pocket, (int, float, np.integer, np.floating)) and float(own_pocket).is_integer()
             and 0 <= own_pocket <= 50):
         raise InputError(f"must be a whole number in [0, 50], got {own_pocket!r}", field="own_pocket")
+    if not isinstance(band_noise, (bool, np.bool_)):
+        raise InputError(f"must be true or false, got {band_noise!r}", field="band_noise")
     cuts = tuple(cuts)
     f = prior.freq_grid()
     P = prior.sigma.size
@@ -1262,19 +1276,25 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     lim = _limits(prior, prior.theta(z[pick, :P]), f, grid)
     own_ess = own_power = None
     pocket_rpm = ()
+    rows = None  # each lobe sample's reference (their noise in the band: _band_levels)
     if log_ratio_grid is not None:  # each lobe sample corrected by one reference's SDM/ZOA ratio
         rows = rng.integers(log_ratio_grid.shape[0], size=m)
         lim = lim * np.exp(log_ratio_grid[rows])
         if own_sdm and kw_sdm is not None:
-            pick, lim, own_ess, own_power = _own_reweight(prior, z, pick, lim, cuts, kw_sdm, lr_at_cuts[rows],
-                                                          grid, f, boundary_width, rng, growth_by)
+            pick, lim, own_ess, own_power, idx = _own_reweight(prior, z, pick, lim, cuts, kw_sdm, lr_at_cuts[rows],
+                                                               grid, f, boundary_width, rng, growth_by)
+            rows = rows[idx]
         if own_pocket > 0:  # the band's upper tail at the productive speeds from the samples' own limits
             lim, pocket_rpm = _pocket_own(prior, z[pick, :P], f, grid, lim, int(own_pocket),
                                           cut_rpm=(np.array([c.rpm for c in cuts]) if own_sdm and kw_sdm is not None
                                                    else None))
     zp = rng.standard_normal((m, P)) * free[:P]
     lim_prior = _limits(prior, prior.theta(zp), f, grid)
-    q = np.quantile(lim, [0.05, 0.5, 0.95], axis=0)
+    if band_noise and rows is not None and log_ratio_grid.shape[0] > 1:
+        levels = _band_levels(lim, rows, log_ratio_grid.shape[0])
+    else:
+        levels = np.array([[0.05], [0.95]]) * np.ones((1, grid.size))
+    q = _quantiles_at(lim, np.stack([levels[0], np.full(grid.size, 0.5), levels[1]]))
     qp = np.quantile(lim_prior, [0.05, 0.5, 0.95], axis=0)
     top = 1.5 * float(np.max(np.where(np.isfinite(q[2]), q[2], 0.0)))
     top = top if top > 0 else 1e-3
@@ -1345,7 +1365,61 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                                                                            np.full(len(cuts), np.nan))),
                      tuple(float(v) if np.isfinite(v) else None for v in (rx[2] if rx is not None else
                                                                            np.full(len(cuts), np.nan))),
-                     kw.get("precursor"), noisy, own_ess, z[pick], own_power, pocket_rpm)
+                     kw.get("precursor"), noisy, own_ess, z[pick], own_power, pocket_rpm, levels)
+
+
+def _quantiles_at(lim, levels):
+    """Quantiles of the lobes ``lim`` (m, G) at per-speed levels ``levels`` (L, G), (L, G): linear between order
+    statistics as ``numpy.quantile``'s default; nan where a speed holds a nan."""
+    m = lim.shape[0]
+    srt = np.sort(lim, axis=0)
+    pos = np.clip(levels, 0.0, 1.0) * (m - 1)
+    lo = np.floor(pos).astype(int)
+    hi = np.minimum(lo + 1, m - 1)
+    a = np.take_along_axis(srt, lo, axis=0)
+    b = np.take_along_axis(srt, hi, axis=0)
+    with np.errstate(invalid="ignore"):
+        out = np.where(b == a, np.where(np.isinf(a), np.nan, a), a + (pos - lo) * (b - a))  # as numpy's lerp
+    return np.where(np.isnan(lim).any(axis=0)[None, :], np.nan, out)
+
+
+def _band_levels(lim, rows, n_ref: int, p: float = 0.05):
+    """Per-speed quantile levels (2, G) of the band's outer lines from the lobes ``lim`` (m, G), each row carrying
+    reference ``rows`` (m,) of ``n_ref``: such that a limit drawn from the posterior lies below the lower line (above
+    the upper) with probability ``p`` although the band rests on only ``n_ref`` references' SDM/ZOA ratio curves.
+
+    Away from the cut speeds a lobe sample's limit is its zero-order limit times one reference's ratio, and the
+    error of a few references is shared by all samples: with the references' ratios spread by τ at a speed, the
+    mixture of R of them lies off the population's by a variance τ²/R and is narrower than it by τ²/R (the mean
+    square deviation of R draws from their mean is τ² (R − 1)/R). The jackknife over the references estimates τ²/R
+    at each speed: with q_(−r) the ``p`` quantile of the rows not carrying reference r,
+    σ² = (R − 1)/R Σ_r (ln q_(−r) − mean)² (and so for 1 − ``p``); at the cut speeds, where the rows were moved to
+    their own SDM limits, the references no longer matter and σ is small. With s = |ln q_p − ln q₅₀| / z
+    (z = Φ⁻¹(1 − p)) the band's spread on that side, a limit a ~ N(ln q₅₀, s² + σ²) falls under the line
+    ln q₅₀ − z s + ε, ε ~ N(0, σ²), with probability Φ(−z s / √(s² + 2σ²)), not p; the level Φ(−z √(1 + 2σ²/s²))
+    makes it p again (normal in ln a; R − 1 degrees of freedom make the true level a little lower still).
+
+    Checked on lobes built that way (``tests/shop/test_shop_update.py``: ln a = N(0, 0.2²) + one of four references'
+    N(0, 0.1²) offsets, 400 rows): the plain 5 % line misses a fresh draw 0.060 of the time, these levels' 0.050.
+    Why: over six `update` seeds on the same cuts the band's 5 % line scattered by ln sd 0.035–0.069 away from the
+    cut speeds and 0.006–0.023 within 2 % of them (EM12-60, eight truths), and the band held the truth 0.04 less
+    often than an exact posterior's (``docs/design/shop.md``, *The references' noise in the band*)."""
+    z = float(-ndtri(p))
+    G = lim.shape[1]
+    groups = [rows != r for r in range(n_ref)]
+    groups = [g for g in groups if g.sum() >= 2 and (~g).any()]
+    levels = np.stack([np.full(G, p), np.full(G, 1 - p)])
+    if len(groups) < 2:
+        return levels
+    R = len(groups)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lu = np.log(np.quantile(lim, [p, 0.5, 1 - p], axis=0))
+        jk = np.log(np.stack([np.quantile(lim[g], [p, 1 - p], axis=0) for g in groups]))  # (R, 2, G)
+        var = (R - 1) / R * np.sum((jk - jk.mean(axis=0)) ** 2, axis=0)  # (2, G)
+        s2 = ((lu[[0, 2]] - lu[1]) / z) ** 2
+        ratio = np.where(np.isfinite(var / s2) & (s2 > 0), var / s2, 0.0)
+    lev = ndtr(-z * np.sqrt(1 + 2 * ratio))
+    return np.stack([lev[0], 1 - lev[1]])
 
 
 def _option(value, field: str, form: str, ok, need: str) -> tuple:
@@ -1787,8 +1861,8 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
     the grid by :func:`_interp_near`). ``lr_now`` (m, C): the ratio each lobe sample's lobes carry at the cuts.
     Returns the new ``pick`` and ``lim`` (rows repeat), the weights' effective sample size — 0 where no weight is
     finite (no sample can explain the cuts with its own limits; the likelihood's floors make that unreachable), the
-    lobe samples then left as they were — and the power the weights were tempered to (:func:`_own_temper`; None
-    where none was finite).
+    lobe samples then left as they were —, the power the weights were tempered to (:func:`_own_temper`; None
+    where none was finite) and the rows of the old lobe samples the new ones are (m,).
 
     Why: each lobe sample carries one reference's SDM/ZOA ratio, and the references' ratios at a speed spread by
     ln sd 0.05–0.19 on EM16-50, so the band at a cut speed could not be narrower than that spread however the cuts
@@ -1816,13 +1890,13 @@ def _own_reweight(prior, z, pick, lim, cuts, kw, lr_now, grid, f, boundary_width
           - log_likelihood(prior, th, cuts, **dict(kw, **extra)))
     lw = np.where(np.isfinite(lw), lw, -np.inf)
     if not np.isfinite(lw).any():
-        return pick, lim, 0.0, None
+        return pick, lim, 0.0, None, np.arange(pick.size)
     alpha = _own_temper(lw, OWN_MIN_ESS * lw.size)
     lw = alpha * lw
     w = np.exp(lw - lw.max())
     idx = _systematic(w / w.sum(), rng)
     lim = lim[idx] * np.exp(_interp_near(own[idx] - lr_now[idx][:, first], grid, u))
-    return pick[idx], lim, _ess(lw), alpha
+    return pick[idx], lim, _ess(lw), alpha, idx
 
 
 def _pocket_own(prior, zp, f, grid, lim, n: int, span: float = 0.03, cut_rpm=None):
