@@ -1100,9 +1100,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         alone (as before 2026-12-01, night).
     band_noise : bool, default True
         ``forward="sdm"`` with at least two references: the band's 5 % and 95 % lines are read at per-speed levels
-        that allow for the few references' ratio curves the lobes rest on away from the cut speeds — the
-        jackknife over the references (:func:`_band_levels`; ``Posterior.band_levels``). False: at 0.05 and 0.95
-        (as before 2026-12-05, night). Measured: ``docs/design/shop.md``, *The references' noise in the band*.
+        that allow for the few references' ratio curves the lobes rest on away from the cut speeds and for the
+        samples' own Monte Carlo noise — jackknives over the references and over samples dealt at random
+        (:func:`_band_levels`; ``Posterior.band_levels``; one permutation drawn from ``rng``). False: at 0.05 and
+        0.95 (as before 2026-12-05, night). Measured: ``docs/design/shop.md``, *The references' noise in the band*.
 
     Returns
     -------
