@@ -15,8 +15,8 @@ from toolpoint.errors import InputError
 from toolpoint.shop.campaign import virtual_campaign
 from toolpoint.shop.model import ModalPrior, cornelius_2024, limit_at_speeds, receptance
 from toolpoint.shop.prior import prior_from_library, read_modal_prior
-from toolpoint.shop.update import (OWN_MIN_ESS, TestCut, _band_levels, _own_temper, _quantiles_at, log_likelihood,
-                                   read_test_cuts, update)
+from toolpoint.shop.update import (OWN_MIN_ESS, TestCut, _band_levels, _own_temper, _p_chatter_claimed, _quantiles_at,
+                                   log_likelihood, read_test_cuts, update)
 from toolpoint.stability.zoa_batch import zoa_limits
 
 # the command line's tests of parsing, files and messages run the cheaper zero-order model (the default is "sdm":
@@ -1505,12 +1505,14 @@ def test_the_band_allows_for_its_few_references(tau, plain_lo, plain_hi):
     """Lobes built as ``update`` builds them away from the cut speeds — each sample's zero-order limit (ln sd 0.2)
     times one of four references' ratios (offsets ln sd ``tau``) — and a truth drawn from the population (ln sd
     √(0.2² + tau²)): the widened 5 % and 95 % lines miss it 0.05 of the time each (3 × 1500 draws: ± 0.01), where the
-    plain ones miss it more often once the references spread; with identical references the levels stay ~5 %."""
+    plain ones miss it more often once the references spread; with identical references the levels stay ~5 %.
+    The P(stable) map claims what the band does: 0.95 on its 5 % line, and the probability it gives the truth's own
+    limit of chatter is uniform (a calibrated map; the lobe samples' plain share is not, once the references spread)."""
     rng = np.random.default_rng(7)
     n, m, R, G = 1500, 400, 4, 3
     miss = np.zeros(2)
     plain = np.zeros(2)
-    levels = []
+    levels, pit, pit0 = [], [], []
     for _ in range(n):
         offs = rng.normal(0.0, tau, (R, G))
         rows = rng.integers(R, size=m)
@@ -1522,9 +1524,19 @@ def test_the_band_allows_for_its_few_references(tau, plain_lo, plain_hi):
         miss += [np.sum(truth < q[0]), np.sum(truth > q[1])]
         plain += [np.sum(truth < q0[0]), np.sum(truth > q0[1])]
         levels.append(lv[0])
+        np.testing.assert_allclose(_p_chatter_claimed(lv, lv), [[0.05] * G, [0.95] * G], atol=1e-9)
+        under = 1.0 - (lim > truth).mean(axis=0)
+        pit.append(_p_chatter_claimed(under[None, :], lv)[0])
+        pit0.append(under)
     miss /= n * G
     plain /= n * G
     assert np.all(np.abs(miss - 0.05) <= 0.01), miss
+    pit, pit0 = np.ravel(pit), np.ravel(pit0)
+    for x, tol in ((0.05, 0.01), (0.25, 0.015), (0.5, 0.015), (0.75, 0.015), (0.95, 0.01)):
+        assert abs(np.mean(pit <= x) - x) <= tol, (x, np.mean(pit <= x))
+    if tau > 0:  # the plain share claims too much at both ends
+        lo, hi = np.mean(pit0 <= 0.05), np.mean(pit0 <= 0.95)
+        assert lo > 0.055 and hi < 0.945, (lo, hi)
     assert plain_lo <= plain.mean() <= plain_hi, plain
     if tau == 0:
         assert abs(np.median(levels) - 0.05) < 0.003

@@ -724,6 +724,9 @@ class Posterior:
         rests on a few references' SDM/ZOA ratios (:func:`_band_levels`; ``update``'s ``band_noise``).
     depth_m : ndarray, shape (D,)
     p_stable : ndarray, shape (D, G)
+        P(stable) at each depth and speed: the lobe samples' share above the depth, moved toward 0.5 as the band's
+        lines are widened (:func:`_p_chatter_claimed`), so that it is 0.95 on the band's 5 % line (the share itself
+        where the levels are 0.05/0.95).
     prior_limit_q_m : ndarray, shape (3, G)
         The prior's quantiles, for comparison.
     recommended : dict
@@ -1300,10 +1303,12 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     top = 1.5 * float(np.max(np.where(np.isfinite(q[2]), q[2], 0.0)))
     top = top if top > 0 else 1e-3
     depths = np.linspace(0, top, n_depths + 1)[1:]
-    p_st = (lim[None, :, :] > depths[:, None, None]).mean(axis=1)
+    # P(stable) as the band claims it: the lobe samples' share above each depth, widened as the band's lines are
+    p_st = 1.0 - _p_chatter_claimed(1.0 - (lim[None, :, :] > depths[:, None, None]).mean(axis=1), levels)
     q05 = np.where(np.isfinite(q[0]), q[0], np.nan)
     j = int(np.nanargmax(grid * q05))
-    rec = {"rpm": float(grid[j]), "depth_m": float(q05[j]), "p_stable": float(np.mean(lim[:, j] > q05[j])),
+    p_rec = 1.0 - float(_p_chatter_claimed(np.array([[1.0 - np.mean(lim[:, j] > q05[j])]]), levels[:, j:j + 1])[0, 0])
+    rec = {"rpm": float(grid[j]), "depth_m": float(q05[j]), "p_stable": p_rec,
            "limit_p05_m": float(q05[j]), "own_sdm_p05_m": None, "own_sdm_held_out": None,
            "limit_p50_m": float(q[1, j]), "limit_p95_m": float(q[2, j])}
     # once a cut has chattered the bracket has its upper side: the remaining cuts may be bounded lower
@@ -1438,6 +1443,24 @@ def _band_levels(lim, rows, n_ref: int, sample, rng, p: float = 0.05):
         ratio = np.where(np.isfinite(ratio) & (s2 > 0), ratio, 0.0)
     lev = ndtr(-z * np.sqrt(1 + ratio))
     return np.stack([lev[0], 1 - lev[1]])
+
+
+def _p_chatter_claimed(under, levels, p: float = 0.05):
+    """The probability of chatter claimed at depths under which a share ``under`` (D, G) of the lobe samples' limits
+    lie, consistent with the band read at ``levels`` (2, G; :func:`_band_levels`), (D, G).
+
+    The band's 5 % line is the lobe samples' quantile at level ℓ = Φ(−z √(1 + r)) (z = Φ⁻¹(1 − ``p``)): the samples
+    spread by s in ln a on that side, the truth by √(s² + v), r = v/s² the references' and the Monte Carlo noise
+    the samples do not show. At a depth under which a share u of the samples lies, ln a = ln q₅₀ + s Φ⁻¹(u), the
+    truth lies under it with probability Φ(s Φ⁻¹(u) / √(s² + v)) = Φ(Φ⁻¹(u) / √(1 + r)) — ``p`` at the band's
+    line, u itself where the levels are ``p`` and 1 − ``p`` (r = 0); the lower side's r under the median, the upper
+    side's over it. 0 and 1 stay 0 and 1: under every sample (over every one) the samples say no more."""
+    z = float(-ndtri(p))
+    k_lo = -ndtri(np.clip(levels[0], 1e-12, p)) / z  # √(1 + r) of each side, ≥ 1
+    k_hi = ndtri(np.clip(levels[1], 1 - p, 1 - 1e-12)) / z
+    x = ndtri(np.clip(under, 0.0, 1.0))
+    with np.errstate(invalid="ignore"):
+        return ndtr(x / np.where(x < 0, k_lo, k_hi))
 
 
 def _option(value, field: str, form: str, ok, need: str) -> tuple:
