@@ -15,7 +15,7 @@ from toolpoint.errors import InputError
 from toolpoint.shop.campaign import virtual_campaign
 from toolpoint.shop.model import ModalPrior, cornelius_2024, limit_at_speeds, receptance
 from toolpoint.shop.prior import prior_from_library, read_modal_prior
-from toolpoint.shop.update import (OWN_MIN_ESS, TestCut, _band_levels, _own_temper, _p_chatter_claimed, _quantiles_at,
+from toolpoint.shop.update import (OWN_MIN_ESS, TestCut, _band_levels, _own_temper, _p_chatter_map, _quantiles_at,
                                    log_likelihood, read_test_cuts, update)
 from toolpoint.stability.zoa_batch import zoa_limits
 
@@ -1506,8 +1506,9 @@ def test_the_band_allows_for_its_few_references(tau, plain_lo, plain_hi):
     times one of four references' ratios (offsets ln sd ``tau``) — and a truth drawn from the population (ln sd
     √(0.2² + tau²)): the widened 5 % and 95 % lines miss it 0.05 of the time each (3 × 1500 draws: ± 0.01), where the
     plain ones miss it more often once the references spread; with identical references the levels stay ~5 %.
-    The P(stable) map claims what the band does: 0.95 on its 5 % line, and the probability it gives the truth's own
-    limit of chatter is uniform (a calibrated map; the lobe samples' plain share is not, once the references spread)."""
+    The P(stable) map claims what the band does: 0.95 on its 5 % line (within a sample's step), and the probability it
+    gives the truth's own limit of chatter is uniform (a calibrated map; the lobe samples' plain share is not, once
+    the references spread)."""
     rng = np.random.default_rng(7)
     n, m, R, G = 1500, 400, 4, 3
     miss = np.zeros(2)
@@ -1524,10 +1525,10 @@ def test_the_band_allows_for_its_few_references(tau, plain_lo, plain_hi):
         miss += [np.sum(truth < q[0]), np.sum(truth > q[1])]
         plain += [np.sum(truth < q0[0]), np.sum(truth > q0[1])]
         levels.append(lv[0])
-        np.testing.assert_allclose(_p_chatter_claimed(lv, lv), [[0.05] * G, [0.95] * G], atol=1e-9)
-        under = 1.0 - (lim > truth).mean(axis=0)
-        pit.append(_p_chatter_claimed(under[None, :], lv)[0])
-        pit0.append(under)
+        # on the lines within a sample's step of the share (1/400, magnified up to ~3× where the levels are low)
+        np.testing.assert_allclose(_p_chatter_map(lim, q, lv), [[0.05] * G, [0.95] * G], atol=0.01)
+        pit.append(_p_chatter_map(lim, truth[None, :], lv)[0])
+        pit0.append(1.0 - (lim > truth).mean(axis=0))
     miss /= n * G
     plain /= n * G
     assert np.all(np.abs(miss - 0.05) <= 0.01), miss
@@ -1542,6 +1543,24 @@ def test_the_band_allows_for_its_few_references(tau, plain_lo, plain_hi):
         assert abs(np.median(levels) - 0.05) < 0.003
     else:
         assert np.median(levels) < 0.047 and plain.mean() - miss.mean() > 0.005
+
+
+def test_the_p_stable_map_runs_on_beyond_the_samples():
+    """Under the lowest lobe sample the samples' share says P(chatter) 0; where the band's lines were widened far
+    (level 0.001) the band's own normal model does not: the map goes on from the lowest sample and falls to 0 only as
+    the depth does, monotonically, and so above the highest. At plain levels it is the share among the samples."""
+    rng = np.random.default_rng(2)
+    lim = np.exp(rng.normal(0.0, 0.2, (400, 1)))
+    lo, hi = lim.min(), lim.max()
+    wide = np.array([[0.001], [0.999]])
+    d = np.r_[1e-9, np.geomspace(0.2 * lo, 0.999 * lo, 30), np.geomspace(1.001 * lo, 0.999 * hi, 50),
+              np.geomspace(1.001 * hi, 5 * hi, 30), 1e9]
+    pc = _p_chatter_map(lim, d, wide)[:, 0]
+    assert np.all(np.diff(pc) >= 0) and pc[0] < 1e-9 and pc[-1] > 1 - 1e-9
+    assert pc[30] > 0.02 and pc[81] < 0.98, (pc[30], pc[81])  # just under the lowest (over the highest) sample
+    plain = _p_chatter_map(lim, d[31:81], np.array([[0.05], [0.95]]))[:, 0]
+    np.testing.assert_allclose(plain, 1.0 - (lim[:, 0] > d[31:81, None]).mean(axis=1), atol=1e-12)
+    assert _p_chatter_map(lim, d[:31], np.array([[0.05], [0.95]]))[:, 0].max() < 0.002  # ~1/(2 × 400) at most
 
 
 def test_own_sdm_weights_are_tempered_only_as_far_as_the_samples_need():

@@ -725,8 +725,8 @@ class Posterior:
     depth_m : ndarray, shape (D,)
     p_stable : ndarray, shape (D, G)
         P(stable) at each depth and speed: the lobe samples' share above the depth, moved toward 0.5 as the band's
-        lines are widened (:func:`_p_chatter_claimed`), so that it is 0.95 on the band's 5 % line (the share itself
-        where the levels are 0.05/0.95).
+        lines are widened (:func:`_p_chatter_claimed`, :func:`_p_chatter_map`), so that it is 0.95 on the band's 5 %
+        line (the share itself where the levels are 0.05/0.95 and the depth lies among the samples).
     prior_limit_q_m : ndarray, shape (3, G)
         The prior's quantiles, for comparison.
     recommended : dict
@@ -1304,10 +1304,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     top = top if top > 0 else 1e-3
     depths = np.linspace(0, top, n_depths + 1)[1:]
     # P(stable) as the band claims it: the lobe samples' share above each depth, widened as the band's lines are
-    p_st = 1.0 - _p_chatter_claimed(1.0 - (lim[None, :, :] > depths[:, None, None]).mean(axis=1), levels)
+    p_st = 1.0 - _p_chatter_map(lim, depths, levels)
     q05 = np.where(np.isfinite(q[0]), q[0], np.nan)
     j = int(np.nanargmax(grid * q05))
-    p_rec = 1.0 - float(_p_chatter_claimed(np.array([[1.0 - np.mean(lim[:, j] > q05[j])]]), levels[:, j:j + 1])[0, 0])
+    p_rec = 1.0 - float(_p_chatter_map(lim[:, j:j + 1], [q05[j]], levels[:, j:j + 1])[0, 0])
     rec = {"rpm": float(grid[j]), "depth_m": float(q05[j]), "p_stable": p_rec,
            "limit_p05_m": float(q05[j]), "own_sdm_p05_m": None, "own_sdm_held_out": None,
            "limit_p50_m": float(q[1, j]), "limit_p95_m": float(q[2, j])}
@@ -1445,7 +1445,7 @@ def _band_levels(lim, rows, n_ref: int, sample, rng, p: float = 0.05):
     return np.stack([lev[0], 1 - lev[1]])
 
 
-def _p_chatter_claimed(under, levels, p: float = 0.05):
+def _p_chatter_claimed(under, levels, p: float = 0.05, x=None):
     """The probability of chatter claimed at depths under which a share ``under`` (D, G) of the lobe samples' limits
     lie, consistent with the band read at ``levels`` (2, G; :func:`_band_levels`), (D, G).
 
@@ -1454,13 +1454,43 @@ def _p_chatter_claimed(under, levels, p: float = 0.05):
     the samples do not show. At a depth under which a share u of the samples lies, ln a = ln q₅₀ + s Φ⁻¹(u), the
     truth lies under it with probability Φ(s Φ⁻¹(u) / √(s² + v)) = Φ(Φ⁻¹(u) / √(1 + r)) — ``p`` at the band's
     line, u itself where the levels are ``p`` and 1 − ``p`` (r = 0); the lower side's r under the median, the upper
-    side's over it. 0 and 1 stay 0 and 1: under every sample (over every one) the samples say no more."""
+    side's over it. ``x`` (D, G): the normal scores Φ⁻¹(u) where the caller has them beyond the samples
+    (:func:`_p_chatter_map`); else from ``under``, 0 and 1 staying 0 and 1."""
     z = float(-ndtri(p))
     k_lo = -ndtri(np.clip(levels[0], 1e-12, p)) / z  # √(1 + r) of each side, ≥ 1
     k_hi = ndtri(np.clip(levels[1], 1 - p, 1 - 1e-12)) / z
-    x = ndtri(np.clip(under, 0.0, 1.0))
+    if x is None:
+        x = ndtri(np.clip(under, 0.0, 1.0))
     with np.errstate(invalid="ignore"):
         return ndtr(x / np.where(x < 0, k_lo, k_hi))
+
+
+def _p_chatter_map(lim, depths, levels, p: float = 0.05):
+    """P(chatter) claimed at ``depths`` ((D,) or (D, G), m) from the lobes ``lim`` (m, G) read at the band's
+    ``levels`` (2, G), (D, G): :func:`_p_chatter_claimed` of the samples' share under each depth, and beyond the
+    samples the normal model that reading rests on. Under the lowest sample the share says 0, yet where the lines
+    were widened far (levels down to 0.001 where the references disagree) the band's own model gives a limit there
+    a few per cent: the score runs on from Φ⁻¹(1/(2m)) at the lowest sample by ln(a_min / a) / s, s the samples'
+    spread on that side ((ln q₅₀ − ln q_p) / z), and so above the highest — so that P(chatter) falls to 0 only as the
+    depth does. Speeds whose lobes hold a nan keep the share alone (as ``update`` did before 2026-12-05)."""
+    m = lim.shape[0]
+    d = np.asarray(depths, float)
+    d = d[:, None] if d.ndim == 1 else d
+    under = 1.0 - (lim[None, :, :] > d[:, None, :]).mean(axis=1)
+    z = float(-ndtri(p))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lq = np.log(np.quantile(lim, [p, 0.5, 1 - p], axis=0))
+        s_lo, s_hi = (lq[1] - lq[0]) / z, (lq[2] - lq[1]) / z
+        ld = np.log(d)
+        x = ndtri(np.clip(under, 0.0, 1.0))
+        x_lo = ndtri(0.5 / m) - (np.log(lim.min(axis=0)) - ld) / s_lo
+        x_hi = ndtri(1 - 0.5 / m) + (ld - np.log(lim.max(axis=0))) / s_hi
+        ok_lo = np.isfinite(s_lo) & (s_lo > 0)
+        ok_hi = np.isfinite(s_hi) & (s_hi > 0)
+        x = np.where((under <= 0) & ok_lo & ~np.isnan(x_lo), np.minimum(x_lo, ndtri(0.5 / m)), x)
+        x = np.where((under >= 1) & ok_hi & ~np.isnan(x_hi), np.maximum(x_hi, ndtri(1 - 0.5 / m)), x)
+    x = np.where(np.isnan(lim).any(axis=0)[None, :], ndtri(np.clip(under, 0.0, 1.0)), x)
+    return _p_chatter_claimed(under, levels, p, x=x)
 
 
 def _option(value, field: str, form: str, ok, need: str) -> tuple:
