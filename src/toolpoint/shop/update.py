@@ -62,7 +62,8 @@ is plain sampling–importance resampling from the prior, kept to measure agains
 Lobes: the posterior samples' zero-order limits on a speed grid (:func:`~toolpoint.stability.zoa_batch.zoa_limits`),
 corrected by the semi-discretisation (``forward="sdm"``, the default: a machine's cuts follow the SDM), their
 5/50/95 % lines (the outer two read further out where the few references' SDM/ZOA ratios the lobes rest on
-spread: :func:`_band_levels`) and P(stable) = share of samples whose limit exceeds a depth.
+spread: :func:`_band_levels`) and P(stable): the share of samples whose limit exceeds a depth, moved toward 0.5
+as those lines were (:func:`_p_chatter_map`).
 
 Recommended point: the speed that maximises n · a₀₅(n) (removal rate at a fixed feed per tooth and width)
 at the depth a₀₅ (P(stable) = 0.95); with ``forward="sdm"`` the depth is lowered to the own SDM 5 % limit, at
@@ -1482,14 +1483,14 @@ def _p_chatter_map(lim, depths, levels, p: float = 0.05):
         lq = np.log(np.quantile(lim, [p, 0.5, 1 - p], axis=0))
         s_lo, s_hi = (lq[1] - lq[0]) / z, (lq[2] - lq[1]) / z
         ld = np.log(d)
-        x = ndtri(np.clip(under, 0.0, 1.0))
+        x0 = ndtri(np.clip(under, 0.0, 1.0))  # the share's own score
         x_lo = ndtri(0.5 / m) - (np.log(lim.min(axis=0)) - ld) / s_lo
         x_hi = ndtri(1 - 0.5 / m) + (ld - np.log(lim.max(axis=0))) / s_hi
         ok_lo = np.isfinite(s_lo) & (s_lo > 0)
         ok_hi = np.isfinite(s_hi) & (s_hi > 0)
-        x = np.where((under <= 0) & ok_lo & ~np.isnan(x_lo), np.minimum(x_lo, ndtri(0.5 / m)), x)
+        x = np.where((under <= 0) & ok_lo & ~np.isnan(x_lo), np.minimum(x_lo, ndtri(0.5 / m)), x0)
         x = np.where((under >= 1) & ok_hi & ~np.isnan(x_hi), np.maximum(x_hi, ndtri(1 - 0.5 / m)), x)
-    x = np.where(np.isnan(lim).any(axis=0)[None, :], ndtri(np.clip(under, 0.0, 1.0)), x)
+    x = np.where(np.isnan(lim).any(axis=0)[None, :], x0, x)
     return _p_chatter_claimed(under, levels, p, x=x)
 
 
