@@ -540,7 +540,7 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
     for case in cases:
         prior = priors[case]
         for shop_name in shops:
-            conv, chat, over, cpu, fails, runs = [], [], [], [], 0, []
+            conv, chat, over, cpu, fails, runs, rels = [], [], [], [], 0, [], []
             for seed in range(seed_start, seed_start + seeds):
                 # a sound file's full scale is 1; an accelerometer's record is in m/s²
                 det = detector if sensor == "microphone" else {"full_scale": None, **(detector or {})}
@@ -565,6 +565,7 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                        c.depth_m / float(limit_at_speeds(prior, r.theta_true[None, :], [c.rpm])[0][0, 0])
                        for c in r.cuts]
                 over.append(sum(x > 1 for x in rel[:len(made)]))
+                rels.append(rel)
                 cpu.extend(r.update_cpu_s)
                 fails += r.converged_after is None
                 if verbose:
@@ -612,6 +613,38 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                           + f"{np.mean([r.miss_low[n] for r in runs]):.3f}, above the 95 % "
                           + f"{np.mean([r.miss_high[n] for r in runs]):.3f}; width at the recommended speed median "
                           + f"{wid:.2f}", flush=True)
+                    # the P(stable) map at the truth's own limit: P(chatter) claimed there is uniform over truths and
+                    # speeds where the map is calibrated (the share at or under x is x)
+                    pits = [r.p_chatter_at_truth[n][np.isfinite(r.p_chatter_at_truth[n])] for r in runs]
+                    sh = np.array([[np.mean(q <= x) if q.size else np.nan for x in _PIT_AT] for q in pits])
+                    sh_se = np.nanstd(sh, axis=0, ddof=1) / math.sqrt(len(runs)) if len(runs) > 1 else sh[0] * np.nan
+                    print("      map's P(chatter) at the truth's limit, share of speeds at or under "
+                          + " / ".join(f"{x:g}" for x in _PIT_AT) + ": "
+                          + " / ".join(f"{m:.3f}" for m in np.nanmean(sh, axis=0))
+                          + " (± " + " / ".join(f"{e:.3f}" for e in sh_se) + ", standard error over the truths; "
+                          + f"{sum(q.size for q in pits)} speeds)", flush=True)
+                _next_cut_calibration(runs, rels)
+
+
+_PIT_AT = (0.05, 0.1, 0.25, 0.5, 0.75, 0.9, 0.95)
+
+
+def _next_cut_calibration(runs, rels):
+    """Each proposed cut's claimed P(chatter) against what it did: chatter heard, and its depth over the truth's
+    limit (physical chatter), binned by the claim (a claim above the rule's risk is a step: ``next_cut["stepped"]``)."""
+    p = np.array([q for r in runs for q in r.next_p_chatter])
+    heard = np.array([not c.stable for r in runs for c in r.cuts])
+    over = np.array([x > 1 for rel in rels for x in rel])
+    print("      next cuts' claimed P(chatter) against the outcome (claimed mean; heard chatter; depth over the true "
+          "limit), by claim:", flush=True)
+    for lo, hi in ((0.0, 0.1), (0.1, 0.2), (0.2, 0.31), (0.31, 1.01)):
+        k = (p >= lo) & (p < hi)
+        if k.any():
+            se = math.sqrt(max(p[k].mean() * (1 - p[k].mean()), 1e-12) / k.sum())
+            print(f"        [{lo:.2f}, {min(hi, 1):.2f}): {k.sum():3d} cuts, claimed {p[k].mean():.3f} (binomial sd "
+                  f"{se:.3f}); heard {heard[k].mean():.3f}; over the truth {over[k].mean():.3f}", flush=True)
+    print(f"        all: {p.size} cuts, claimed {p.mean():.3f}; heard {heard.mean():.3f}; over the truth "
+          f"{over.mean():.3f}", flush=True)
 
 
 def bench_sampler():

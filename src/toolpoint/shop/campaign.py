@@ -73,6 +73,8 @@ class CampaignResult:
     coverage_away: tuple = ()
     miss_low: tuple = ()
     miss_high: tuple = ()
+    p_chatter_at_truth: tuple = ()
+    next_p_chatter: tuple = ()
 
 
 def zoa_shop(prior: ModalPrior):
@@ -188,6 +190,7 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
     if theta_true is None:
         theta_true = prior.theta((rng.standard_normal(prior.sigma.size) * (prior.sigma > 0))[None, :])[0]
     cuts, cov_h, wid_h, cpu, below, near_h, away_h, low_h, high_h = [], [], [], [], [], [], [], [], []
+    pit_h, p_next = [], []
     converged = None
     true_lim = None
     for n in range(max_cuts + 1):
@@ -200,6 +203,7 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
         low, high = true_lim * 1.0000001 < q[0], q[2] * 1.0000001 < true_lim  # a NaN limit: neither, and not inside
         cov = float(inside.mean())
         low_h.append(float(low.mean()))
+        pit_h.append(post.p_chatter(true_lim))
         high_h.append(float(high.mean()))
         j = int(np.argmin(np.abs(post.rpm - post.recommended["rpm"])))
         wid = float((q[2, j] - q[0, j]) / q[1, j])
@@ -218,8 +222,10 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
         if n == max_cuts:
             break
         nc = post.next_cut
+        p_next.append(float(nc["p_chatter"]))
         # at least as long as proposed: the duration the rule's expected outcomes assumed
         cuts.append(shop(theta_true, nc["rpm"], nc["depth_m"], rng, nc["duration_s"]))
     chat = sum(not c.stable for c in (cuts if converged is None else cuts[:converged]))
     return CampaignResult(np.asarray(theta_true), tuple(cuts), converged, chat, tuple(cov_h), tuple(wid_h),
-                          tuple(cpu), tuple(below), tuple(near_h), tuple(away_h), tuple(low_h), tuple(high_h))
+                          tuple(cpu), tuple(below), tuple(near_h), tuple(away_h), tuple(low_h), tuple(high_h),
+                          tuple(pit_h), tuple(p_next))

@@ -774,6 +774,9 @@ class Posterior:
     band_levels : ndarray, shape (2, G), optional
         The quantile levels of the lobe samples that ``limit_q_m``'s first and last lines are, per speed: 0.05 and
         0.95 where the references do not spread (or ``band_noise`` is off), further out where they do.
+    lobe_limit_m : ndarray, shape (m, G), optional
+        The lobe samples' limits at each speed, m: what ``limit_q_m`` and ``p_stable`` are read from
+        (:meth:`p_chatter` reads the map at any depth).
     """
 
     prior: ModalPrior
@@ -802,6 +805,43 @@ class Posterior:
     own_sdm_power: float | None = None
     own_pocket_rpm: tuple = ()
     band_levels: np.ndarray | None = None
+    lobe_limit_m: np.ndarray | None = None
+
+    def p_chatter(self, depth_m) -> np.ndarray:
+        """P(chatter) that the map claims at ``depth_m`` (m) at each of the speeds ``rpm``: 1 − ``p_stable`` read at
+        any depth rather than the map's grid (:func:`_p_chatter_map`).
+
+        Parameters
+        ----------
+        depth_m : float or array_like, shape (G,) or (D, G)
+            One depth at every speed, a depth per speed, or D depths per speed, m.
+
+        Returns
+        -------
+        ndarray, shape (G,) or (D, G)
+            The probability that the limit at that speed lies at or under the depth.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from toolpoint.shop.model import cornelius_2024
+        >>> from toolpoint.shop.update import update
+        >>> prior = cornelius_2024()
+        >>> post = update(prior, [], rng=np.random.default_rng(0), n_samples=200, lobe_samples=100,
+        ...               forward="zoa")
+        >>> p = post.p_chatter(post.limit_q_m[0])  # on the band's 5 % line
+        >>> bool(np.all(np.abs(p - 0.05) < 0.02))
+        True
+        """
+        if self.lobe_limit_m is None:
+            raise ValueError("this posterior keeps no lobe samples' limits (lobe_limit_m)")
+        d = np.asarray(depth_m, float)
+        one = d.ndim <= 1
+        d = np.broadcast_to(d, (1, self.rpm.size) if one else (d.shape[0], self.rpm.size))
+        lv = (np.array([[0.05], [0.95]]) * np.ones((1, self.rpm.size)) if self.band_levels is None
+              else self.band_levels)
+        p = _p_chatter_map(self.lobe_limit_m, d, lv)
+        return p[0] if one else p
 
     @property
     def theta(self) -> np.ndarray:
@@ -1372,7 +1412,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                                                                            np.full(len(cuts), np.nan))),
                      tuple(float(v) if np.isfinite(v) else None for v in (rx[2] if rx is not None else
                                                                            np.full(len(cuts), np.nan))),
-                     kw.get("precursor"), noisy, own_ess, z[pick], own_power, pocket_rpm, levels)
+                     kw.get("precursor"), noisy, own_ess, z[pick], own_power, pocket_rpm, levels, lim)
 
 
 def _quantiles_at(lim, levels):
