@@ -1563,6 +1563,30 @@ def test_the_p_stable_map_runs_on_beyond_the_samples():
     assert _p_chatter_map(lim, d[:31], np.array([[0.05], [0.95]]))[:, 0].max() < 0.002  # ~1/(2 × 400) at most
 
 
+def test_the_posterior_reads_its_map_at_any_depth():
+    """``Posterior.p_chatter`` is the P(stable) map read at any depth: 1 − ``p_stable`` on the map's own depths, the
+    band's quantile levels on its lines, per-speed depths read at their own speed, and a scalar at every speed."""
+    pr = cornelius_2024(0.1)
+    cuts = [TestCut(18000.0, 0.4e-3, True), TestCut(18000.0, 0.6e-3, False, 1300.0)]
+    post = update(pr, cuts, rng=np.random.default_rng(4), n_samples=300, lobe_samples=150, forward="zoa")
+    np.testing.assert_allclose(post.p_chatter(np.repeat(post.depth_m[:, None], post.rpm.size, axis=1)),
+                               1.0 - post.p_stable, atol=1e-12)
+    lo, hi = post.p_chatter(post.limit_q_m[0]), post.p_chatter(post.limit_q_m[2])
+    ok = np.isfinite(post.limit_q_m[0])
+    lim = post.lobe_limit_m
+    assert lim.shape == (150, post.rpm.size)
+    # one reference (forward="zoa"): the levels are 0.05 / 0.95 and the map the samples' share itself — near the
+    # lines within a few samples' step (1/150; resampled samples repeat)
+    assert np.all(post.band_levels == np.array([[0.05], [0.95]]))
+    np.testing.assert_allclose(lo[ok], (lim[:, ok] <= post.limit_q_m[0, ok]).mean(axis=0), atol=1e-12)
+    assert np.all(np.abs(lo[ok] - 0.05) <= 0.015) and np.all(np.abs(hi[ok] - 0.95) <= 0.015)
+    share = (lim <= 0.5e-3).mean(axis=0)  # among the samples the share; beyond them the band's normal model
+    inner = ok & (share > 0) & (share < 1)
+    assert inner.sum() > 20
+    np.testing.assert_allclose(post.p_chatter(0.5e-3)[inner], share[inner], atol=1e-12)
+    assert post.p_chatter(1e-9).max() < 1e-6 and post.p_chatter(1.0).min() > 1 - 1e-6
+
+
 def test_own_sdm_weights_are_tempered_only_as_far_as_the_samples_need():
     """The own-SDM weights' power: 1 where the weights leave enough samples effective; else the largest power that
     keeps the ESS at the floor — computed here independently, as the ESS Σw² form on a fine grid of powers."""
@@ -1782,6 +1806,12 @@ def test_a_campaign_without_a_stop_makes_the_same_cuts_and_reports_calibration()
     assert b.coverage[0] == pytest.approx(np.mean((q[0] <= truth * 1.0000001) & (truth <= q[2] * 1.0000001)))
     for near, away, cov in zip(b.coverage_near[1:], b.coverage_away[1:], b.coverage[1:]):
         assert 0 <= near <= 1 and 0 <= away <= 1 and min(near, away) <= cov + 1e-12 <= max(near, away) + 2e-12
+    # the map's P(chatter) at the truth's limit: under the 5 % line it claims under 0.05, over the 95 % over 0.95
+    pit = b.p_chatter_at_truth[0]
+    assert len(b.p_chatter_at_truth) == 5 and pit.shape == truth.shape
+    np.testing.assert_allclose(pit, post.p_chatter(truth), atol=1e-12)
+    assert np.all(pit[truth * 1.0000001 < q[0]] <= 0.05 + 1e-9) and np.all(pit[truth > q[2] * 1.0000001] >= 0.95)
+    assert len(b.next_p_chatter) == 4 and b.next_p_chatter[0] == post.next_cut["p_chatter"]
 
 
 def test_cli_update_says_when_a_cut_lies_off_the_lobes_or_its_chatter_off_the_modes(tmp_path, capsys):
