@@ -41,7 +41,8 @@ CPU time (time.process_time), not wall time: the machine is shared.
    (a truth's coverage is one draw: its speeds are not independent; ±0.02–0.05 over 20 truths), and its change from
    the prior's band paired by truth; the P(stable) map's P(chatter) at the truth's own limit (the share of speeds at
    or under 0.05 … 0.95: the same numbers where the map is calibrated); and, over all the campaigns, each proposed
-   cut's claimed P(chatter) against the chatter heard and its depth over the true limit.
+   cut's claimed P(chatter) against the chatter heard and its depth over the true limit; and the share of truths whose
+   parameters the printed 5–95 % ranges held.
 3. ``forward``: CPU of one call of the likelihood's forward model (``limit_at_speeds``, 500 samples, 6 speeds).
 4. ``ceiling``: what the convergence test asks of an exactly calibrated band. The prior's own 5–95 % band
    (zero-order lobes of ``lobe_samples`` prior samples) against 1000 truths drawn from the same prior: the mean
@@ -625,10 +626,24 @@ def bench_update(seeds, quick, shops=("zoa", "noisy", "sim"), cases=("cornelius"
                           + " / ".join(f"{m:.3f}" for m in np.nanmean(sh, axis=0))
                           + " (± " + " / ".join(f"{e:.3f}" for e in sh_se) + ", standard error over the truths; "
                           + f"{sum(q.size for q in pits)} speeds)", flush=True)
+                    _parameter_calibration(prior, runs, n)
                 _next_cut_calibration(runs, rels)
 
 
 _PIT_AT = (0.05, 0.1, 0.25, 0.5, 0.75, 0.9, 0.95)
+
+
+def _parameter_calibration(prior, runs, n):
+    """The printed 5–95 % range of each parameter after n cuts against the truth's value: the share of truths it
+    held, and under / over it (0.90, 0.05 / 0.05 where calibrated; binomial sd ~0.07 over 20 truths)."""
+    rank = np.array([r.parameter_rank[n] for r in runs])  # (truths, P)
+    free = np.isfinite(rank).all(axis=0)
+    lo, hi = rank < 0.05, rank > 0.95
+    print("      parameters' 5–95 % range held the truth (under / over): "
+          + "; ".join(f"{name} {1 - lo[:, k].mean() - hi[:, k].mean():.2f} "
+                      f"({lo[:, k].mean():.2f}/{hi[:, k].mean():.2f})" for k, name in enumerate(prior.names) if free[k])
+          + f"; all {1 - lo[:, free].mean() - hi[:, free].mean():.3f} ({lo[:, free].mean():.3f}/"
+          + f"{hi[:, free].mean():.3f})", flush=True)
 
 
 def _next_cut_calibration(runs, rels):

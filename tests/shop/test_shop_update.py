@@ -1812,6 +1812,13 @@ def test_a_campaign_without_a_stop_makes_the_same_cuts_and_reports_calibration()
     np.testing.assert_allclose(pit, post.p_chatter(truth), atol=1e-12)
     assert np.all(pit[truth * 1.0000001 < q[0]] <= 0.05 + 1e-9) and np.all(pit[truth > q[2] * 1.0000001] >= 0.95)
     assert len(b.next_p_chatter) == 4 and b.next_p_chatter[0] == post.next_cut["p_chatter"]
+    # the printed parameter ranges against the truth: the share of the posterior's parameter samples under it
+    rank = (post.parameter_samples < b.theta_true[None, :]).mean(axis=0)
+    np.testing.assert_allclose(b.parameter_rank[0], np.where(pr.sigma > 0, rank, np.nan), atol=0, equal_nan=True)
+    q = post.parameter_quantiles()
+    for k, name in enumerate(pr.names):  # inside the printed 5–95 % range where the rank lies within 0.05–0.95
+        if pr.sigma[k] > 0 and 0.06 < rank[k] < 0.94:
+            assert q[name][1][0] <= b.theta_true[k] <= q[name][1][2], (name, rank[k])
 
 
 def test_cli_update_says_when_a_cut_lies_off_the_lobes_or_its_chatter_off_the_modes(tmp_path, capsys):

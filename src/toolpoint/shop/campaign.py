@@ -75,6 +75,7 @@ class CampaignResult:
     miss_high: tuple = ()
     p_chatter_at_truth: tuple = ()
     next_p_chatter: tuple = ()
+    parameter_rank: tuple = ()
 
 
 def zoa_shop(prior: ModalPrior):
@@ -190,7 +191,7 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
     if theta_true is None:
         theta_true = prior.theta((rng.standard_normal(prior.sigma.size) * (prior.sigma > 0))[None, :])[0]
     cuts, cov_h, wid_h, cpu, below, near_h, away_h, low_h, high_h = [], [], [], [], [], [], [], [], []
-    pit_h, p_next = [], []
+    pit_h, p_next, rank_h = [], [], []
     converged = None
     true_lim = None
     for n in range(max_cuts + 1):
@@ -204,6 +205,8 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
         cov = float(inside.mean())
         low_h.append(float(low.mean()))
         pit_h.append(post.p_chatter(true_lim))
+        rank = (post.parameter_samples < np.asarray(theta_true)[None, :]).mean(axis=0)
+        rank_h.append(np.where(prior.sigma > 0, rank, np.nan))
         high_h.append(float(high.mean()))
         j = int(np.argmin(np.abs(post.rpm - post.recommended["rpm"])))
         wid = float((q[2, j] - q[0, j]) / q[1, j])
@@ -228,4 +231,4 @@ def virtual_campaign(prior: ModalPrior, *, rng: np.random.Generator, shop=None, 
     chat = sum(not c.stable for c in (cuts if converged is None else cuts[:converged]))
     return CampaignResult(np.asarray(theta_true), tuple(cuts), converged, chat, tuple(cov_h), tuple(wid_h),
                           tuple(cpu), tuple(below), tuple(near_h), tuple(away_h), tuple(low_h), tuple(high_h),
-                          tuple(pit_h), tuple(p_next))
+                          tuple(pit_h), tuple(p_next), tuple(rank_h))

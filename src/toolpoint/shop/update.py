@@ -848,14 +848,22 @@ class Posterior:
         """Posterior samples of the parameters (S, P), SI."""
         return self.prior.theta(self.z[:, :self.prior.sigma.size])
 
+    @property
+    def parameter_samples(self) -> np.ndarray:
+        """The posterior samples of the parameters (S, P), SI, that :meth:`parameter_quantiles` reads: the lobe
+        samples where they were weighted by their own SDM limits (``own_sdm_ess``; the posterior the lobes are made
+        of), else ``theta``."""
+        z = self.lobe_z if self.own_sdm_ess is not None else self.z
+        return self.prior.theta(z[:, :self.prior.sigma.size])
+
     def parameter_quantiles(self) -> dict:
-        """name → (prior 5/50/95 %, posterior 5/50/95 %) of each parameter (SI): of the lobe samples where they were
-        weighted by their own SDM limits (``own_sdm_ess``; the posterior the lobes are made of), else of ``z``."""
+        """name → (prior 5/50/95 %, posterior 5/50/95 %) of each parameter (SI), the posterior's of
+        :attr:`parameter_samples`."""
         zq = np.array([-1.6448536269514729, 0.0, 1.6448536269514729])
         prior_q = np.exp(self.prior.log_median[None, :] + zq[:, None] * self.prior.sigma[None, :])
         P = self.prior.sigma.size
         z = self.lobe_z if self.own_sdm_ess is not None else self.z
-        post_q = np.quantile(self.prior.theta(z[:, :P]), [0.05, 0.5, 0.95], axis=0)
+        post_q = np.quantile(self.parameter_samples, [0.05, 0.5, 0.95], axis=0)
         out = {n: (tuple(prior_q[:, k]), tuple(post_q[:, k])) for k, n in enumerate(self.prior.names)}
         mu, sd = self.label_offset
         off = mu + sd * z[:, P]
