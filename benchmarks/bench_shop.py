@@ -40,9 +40,9 @@ CPU time (time.process_time), not wall time: the machine is shared.
    With ``--no-stop``, after each number of cuts: the band's mean coverage over the truths with its standard error
    (a truth's coverage is one draw: its speeds are not independent; ±0.02–0.05 over 20 truths), and its change from
    the prior's band paired by truth; the P(stable) map's P(chatter) at the truth's own limit (the share of speeds at
-   or under 0.05 … 0.95: the same numbers where the map is calibrated); and, over all the campaigns, each proposed
-   cut's claimed P(chatter) against the chatter heard and its depth over the true limit; and the share of truths whose
-   parameters the printed 5–95 % ranges held.
+   or under 0.05 … 0.95: the same numbers where the map is calibrated); the share of truths whose parameters the
+   printed 5–95 % ranges held; and, over all the campaigns, each proposed cut's claimed P(chatter) against the chatter
+   heard and its depth over the true limit.
 3. ``forward``: CPU of one call of the likelihood's forward model (``limit_at_speeds``, 500 samples, 6 speeds).
 4. ``ceiling``: what the convergence test asks of an exactly calibrated band. The prior's own 5–95 % band
    (zero-order lobes of ``lobe_samples`` prior samples) against 1000 truths drawn from the same prior: the mean
