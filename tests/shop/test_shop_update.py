@@ -1585,6 +1585,7 @@ def test_the_posterior_reads_its_map_at_any_depth():
     assert inner.sum() > 20
     np.testing.assert_allclose(post.p_chatter(0.5e-3)[inner], share[inner], atol=1e-12)
     assert post.p_chatter(1e-9).max() < 1e-6 and post.p_chatter(1.0).min() > 1 - 1e-6
+    assert np.all(np.isnan(post.p_chatter(np.nan)))  # a speed whose depth is unknown gets no claim
 
 
 def test_own_sdm_weights_are_tempered_only_as_far_as_the_samples_need():

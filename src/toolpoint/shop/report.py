@@ -142,8 +142,7 @@ def write_update(post: Posterior, out_dir) -> list:
         w = csv.writer(fh)
         w.writerow(["rpm", "p05_mm", "p50_mm", "p95_mm", "prior_p05_mm", "prior_p50_mm", "prior_p95_mm",
                     "p05_level", "p95_level"])
-        lv = (np.array([[0.05], [0.95]]) * np.ones((1, post.rpm.size)) if post.band_levels is None
-              else post.band_levels)
+        lv = post.levels
         for g in range(post.rpm.size):
             w.writerow([f"{post.rpm[g]:.6g}"] + [f"{mm * v:.6g}" for v in post.limit_q_m[:, g]]
                        + [f"{mm * v:.6g}" for v in post.prior_limit_q_m[:, g]]

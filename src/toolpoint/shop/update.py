@@ -838,10 +838,16 @@ class Posterior:
         d = np.asarray(depth_m, float)
         one = d.ndim <= 1
         d = np.broadcast_to(d, (1, self.rpm.size) if one else (d.shape[0], self.rpm.size))
-        lv = (np.array([[0.05], [0.95]]) * np.ones((1, self.rpm.size)) if self.band_levels is None
-              else self.band_levels)
-        p = _p_chatter_map(self.lobe_limit_m, d, lv)
+        p = np.where(np.isfinite(d), _p_chatter_map(self.lobe_limit_m, d, self.levels), np.nan)  # no depth: no claim
         return p[0] if one else p
+
+    @property
+    def levels(self) -> np.ndarray:
+        """The quantile levels (2, G) the band's 5 % and 95 % lines were read at: ``band_levels``, or 0.05 / 0.95 at
+        every speed where there are none."""
+        if self.band_levels is not None:
+            return self.band_levels
+        return np.array([[0.05], [0.95]]) * np.ones((1, self.rpm.size))
 
     @property
     def theta(self) -> np.ndarray:
