@@ -1144,6 +1144,28 @@ def test_a_weak_steady_chatter_family_is_warned_of_and_a_strong_one_is_not():
             assert "1137.2 Hz" in said[0] and "-20 dB" in said[0]
 
 
+def test_a_tone_family_under_the_alias_bar_is_chatter_and_a_tone_with_sidebands_at_the_tooth_passing_only_is_not():
+    """A steady line 32 dB under the strongest tooth-passing harmonic (under the alias rule's 27 dB), 26 dB over its
+    neighbours and new with the cut: with its regenerative family f + j f_t at j = ±1 and ±2 it is chatter (the
+    tone-family rule: saturated chatter under a resonant harmonic, docs/design/shop.md, *Chatter under a resonant
+    harmonic*); with lines at ±f_t alone — a stray tone the tooth passing amplitude-modulates — it stays stable."""
+    rpm, teeth, f0 = 9000.0, 4, 1733.0
+    f_t = teeth * rpm / 60
+    for fam, want in (((-1, 1), "stable"), ((-2, -1, 1, 2), "chatter")):
+        x, rate, t0, t1 = shop_record(rpm=rpm, teeth=teeth, noise=0.02, seed=3)
+        t = np.arange(x.size) / rate
+        on = np.clip((t - t0) / 0.05, 0, 1) * np.clip((t1 - t) / 0.05, 0, 1)
+        y = np.sin(2 * np.pi * f0 * t) + sum(0.3 * np.sin(2 * np.pi * (f0 + j * f_t) * t + j) for j in fam)
+        r = analyse_cut(x + 0.006 * on * y, rate, rpm=rpm, teeth=teeth, full_scale=1.0)
+        cut = max((s for s in r.segments if s.kind == "cut"), key=lambda s: s.end_s - s.start_s)
+        assert abs(cut.peak_hz - f0) < 1.0 and cut.dominance < r.criterion["alias_dominance"]
+        assert cut.line_db >= 20 and cut.n_alias == len(fam)
+        assert r.verdict == want, fam
+        if want == "chatter":
+            assert abs(r.chatter_hz - f0) < 1.0
+            assert any("rests on a weak line" in w for w in r.criterion["warnings"])
+
+
 def _spin(air, rate, seconds, up):
     """The real recording's own air cut played at a speed rising from 0.1 × to 1 × (``up``) or falling from 1 × to
     0.1 ×, its level with it (0.3 → 1 or 1 → 0.3): the spindle running up or coasting down, every machine line

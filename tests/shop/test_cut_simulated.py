@@ -149,6 +149,19 @@ def test_a_table_the_record_contradicts_through_a_wrong_tooth_count_says_why(tmp
         in msg, msg
 
 
+def _heard_in_the_shop(mm, c, rpm, depth_m):
+    """One cut of ``depth_m`` (m) at ``rpm`` simulated by the package (toolpoint.simulation: 250 revolutions, kicked
+    at 1 % of the forced response, as the virtual campaigns' shop) and judged from the tests' shop microphone:
+    (simulation result, ``analyse_cut``'s result)."""
+    from toolpoint.simulation import simulate_milling
+
+    res = simulate_milling(mm, mm, c, rpm=[rpm], depth_m=[depth_m], revolutions=250, seed=5, seed_level=0.01)
+    t = res.time_s[0] - res.time_s[0][0]
+    d, f = res.displacement_m[0], res.force_n[0]
+    y, rate, *_ = microphone((t, d[:, 0], d[:, 1], f[:, 0], f[:, 1]), rpm=rpm, teeth=c.teeth, seed=7)
+    return res, analyse_cut(y, rate, rpm=rpm, teeth=c.teeth, full_scale=1.0)
+
+
 @pytest.mark.slow  # 5–8 s: the fast tier stays under 3 min
 def test_chatter_a_few_hz_beside_the_tooth_passing_at_a_pocket_s_top_is_heard():
     """At the top of a pocket the tooth passing sits on the mode and the chatter grows a few Hz beside it, inside the
@@ -157,7 +170,6 @@ def test_chatter_a_few_hz_beside_the_tooth_passing_at_a_pocket_s_top_is_heard():
     and 35 % past the SDM limit (σ 4.4 and 125 /s) were judged stable before the long-frame test; now chatter, within
     1 % of the simulation's own chatter frequency (658.1, 658.9 Hz). 10 % under the limit: stable. The package's
     simulation (toolpoint.simulation, the virtual campaigns'), heard by the tests' shop microphone."""
-    from toolpoint.simulation import simulate_milling
     from toolpoint.stability import CuttingConditions, sdm_lobes
 
     mm = ModalModel(np.array([660.9237707]), np.array([0.00266763]), np.array([1.0756753]))
@@ -166,16 +178,39 @@ def test_chatter_a_few_hz_beside_the_tooth_passing_at_a_pocket_s_top_is_heard():
     rpm = 9919.46
     a_lim = float(sdm_lobes(mm, mm, c, rpm=np.array([rpm])).depth_m[0])
     for x, want in ((-0.1, "stable"), (0.1, "chatter"), (0.3, "chatter")):
-        res = simulate_milling(mm, mm, c, rpm=[rpm], depth_m=[a_lim * np.exp(x)], revolutions=250, seed=5,
-                               seed_level=0.01)
-        t = res.time_s[0] - res.time_s[0][0]
-        d, f = res.displacement_m[0], res.force_n[0]
-        y, rate, *_ = microphone((t, d[:, 0], d[:, 1], f[:, 0], f[:, 1]), rpm=rpm, teeth=4, seed=7)
-        r = analyse_cut(y, rate, rpm=rpm, teeth=4, full_scale=1.0)
+        res, r = _heard_in_the_shop(mm, c, rpm, a_lim * np.exp(x))
         assert r.verdict == want, (x, r.chatter_hz)
         if want == "chatter":
             assert res.stable[0] is not True and abs(r.chatter_hz / float(res.chatter_hz[0]) - 1) < 0.01
             assert abs(r.chatter_hz - 4 * r.rpm / 60) < 8  # beside the tooth passing, inside its mask
+
+
+@pytest.mark.slow  # ~6 s
+def test_saturated_chatter_under_a_resonant_tooth_passing_harmonic_is_heard():
+    """At a deep pocket the third tooth-passing harmonic sits on the tool's 712 Hz mode (3559 rpm, f_t 237.3 Hz): a
+    two-mode tool like EM25-55's (a `library` tool of the campaign; truth 40 of bench_shop's pocket records: 711.8 /
+    1774.9 Hz, ζ 0.40 / 1.74 %; 4 teeth, 10 % immersion, down milling). 15 % past the SDM limit the simulation
+    chatters (ρ 1.10 per tooth period) and saturates at once: a steady family at 1812 Hz + j f_t, 40 dB over its
+    neighbours and 54 dB over the air, but 30 dB under the resonant harmonic, under the alias rule's 27 dB — judged
+    stable before the tone-family rule. Now chatter, within 1 % of the simulation's chatter frequency modulo its
+    aliases; 15 % under the limit, stable. The SDM is the independent judge (toolpoint.simulation, heard by the tests'
+    shop microphone)."""
+    from toolpoint.stability import CuttingConditions, sdm_lobes
+
+    mm = ModalModel(np.array([711.82371464, 1774.91830734]), np.array([0.00399477, 0.01737974]),
+                    np.array([1.30278254, 0.5054243]))
+    c = CuttingConditions(teeth=4, tangential_coeff=1922997669.428954, radial_ratio=0.369422810626068,
+                          radial_immersion=0.1, milling="down")
+    rpm = 3559.12
+    a_lim = float(sdm_lobes(mm, mm, c, rpm=np.array([rpm])).depth_m[0])
+    for rel, want in ((0.85, "stable"), (1.15, "chatter")):
+        res, r = _heard_in_the_shop(mm, c, rpm, a_lim * rel)
+        assert r.verdict == want, (rel, r.chatter_hz)
+        if want == "chatter":
+            cut = max((s for s in r.segments if s.kind == "cut"), key=lambda s: s.end_s - s.start_s)
+            assert cut.dominance < 0.002 and cut.n_alias >= 3 and cut.line_db >= 20  # the case the rule is for
+            alias = float(res.chatter_hz[0]) + 4 * rpm / 60 * np.arange(-3, 4)
+            assert res.stable[0] is not True and np.min(np.abs(r.chatter_hz - alias)) / r.chatter_hz < 0.01
 
 
 @pytest.mark.slow  # ~4 s

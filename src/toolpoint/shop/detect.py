@@ -84,15 +84,26 @@ The detector (:func:`analyse_cut`):
      chatter is a family f_c + j f_t (the tooth passing modulates it, Insperger et al. 2003), a stray tone
      (fan, pump, feed drive) is one line. Only where the record holds an air cut (without one, "new" cannot
      be told, and the on/off of the cut inside the judged part leaves sidebands k f_t ± δ that look like a
-     family). Where the tool spends little of the revolution in the cut,
-     chatter saturates weak (the tool leaves the cut) and spreads into its aliases; the measured effect of
-     both ratios on simulated records over a speed × depth grid is in ``docs/design/shop.md``. Under the cutting
+     family). Where these tests find no chatter anywhere in the record, each cut part is read once more for a
+     **tone family**, strong at any power down to ``_TONE_DOMINANCE`` (10⁻⁴, −40 dB): the line stands
+     ≥ ``_TONE_DB`` (20 dB) over the bins 3–4 either side and three or four of its aliases f ± f_t, f ± 2 f_t
+     are significant new lines too. At a resonant pocket (a tooth-passing harmonic on the mode) the forced
+     line is so strong that saturated chatter tens of µm deep lies 27–31 dB under it (``docs/design/shop.md``,
+     *Chatter under a resonant harmonic*); a tone amplitude-modulated by the tooth passing (a feed drive
+     loaded by the cut) has its sidebands at ±f_t only. A second pass, so that where the first finds chatter
+     its line stands (heavy chatter's far aliases are tone families too). Where the tool spends little of the
+     revolution in the cut, chatter saturates weak (the tool leaves the cut) and spreads into its aliases; the
+     measured effect of both ratios on simulated records over a speed × depth grid is in ``docs/design/shop.md``.
+     Under the cutting
      force's noise a stable cut near its limit makes the same family (``docs/design/shop.md``, *Cutting noise*), so
      a chatter verdict that rests on a line weaker than ``dominance``, whose growth was not read, has the line's
      **ring** read (:func:`toolpoint.shop.growth.ring_decay`): a chatter's limit cycle is a steady tone, a stable
      cut's ring decays at the closed loop's rate σ. A line that decays at ≥ 20 /s and ≥ 10/T (T the part read),
-     to a ln sd ≤ 0.5, is a ring: the part is judged again without the alias bar (a chatter on a spindle harmonic —
-     a flip lobe's — that the weak line hid is still found) and said so; else the verdict stands, warned of
+     to a ln sd ≤ 0.5, is a ring — unless the line stands ≥ ``_TONE_DB`` over the bins 3–4 either side, which a
+     Lorentzian does only when it decays at ≤ ~5 /s (the line's contrast bounds its decay, and the ring's reading
+     is then wrong: it read 44–163 /s on saturated chatter families 40–43 dB out). A ring's part is judged again
+     without the alias bar (a chatter on a spindle harmonic — a flip lobe's — that the weak line hid is still
+     found) and said so; else the verdict stands, warned of
      (``docs/design/shop.md``, *A stable cut's ring*). A **strong** line that is a hump, not a tone — less than
      ``hump_db`` (15 dB) over the bins 3–4 away, its growth not read — has its ring read too: where the tooth-passing
      harmonics are weak (a slot of an even-toothed cutter, a light cut) the mode that the cutting noise drives
@@ -259,6 +270,11 @@ _LINE_DB = 5.0  # a peak without tooth-passing aliases stands this far over the 
 _GAIN_WARN_DB = -3.0  # a cut's floor this far under the air cut's: the recorder's gain changed (warned)
 _STEADY_WARN_DB = 6.0  # dB: a chatter line of a record without an air cut that grew less is warned of
 _HUMP_DB = 15.0  # a strong chatter line this little over the bins 3–4 away is a hump; its ring is read
+_TONE_DB = 20.0  # a line this far over the bins 3–4 away (7.5–10 Hz at 2.5 Hz bins) is a tone: a Lorentzian that
+# high has a half-power half-width ≤ 0.9 Hz, so it decays at ≤ ~5.5 /s — no ring of the cutting noise (≥ 20 /s)
+_TONE_ALIASES = 3  # … and with this many of its aliases f ± f_t, f ± 2 f_t significant new lines it is a chatter
+# family at any strength down to _TONE_DOMINANCE: a tone the tooth passing amplitude-modulates has sidebands ±f_t only
+_TONE_DOMINANCE = 1e-4
 _UNHEARD_LINE_DB = 20.0  # a record whose spindle harmonics do not stand out keeps a chatter line this far out
 _MASKED_WARN = 0.95  # a stable verdict with this much of the band under the spindle harmonics' masks is warned of
 _SHORT_MASKED_WARN = 1 / 3  # … and with this much where the cut is too short to be read beside the harmonics
@@ -1263,7 +1279,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     # 3. harmonic mask: all multiples of the spindle frequency
     keep, harm = _harmonic_mask(freq, inband, f_s, f_s, df)
 
-    def judge(ta, tb, d_alias=None, hump=None):
+    def judge(ta, tb, d_alias=None, hump=None, tone=False):
         sel = frames_in(ta, tb)
         keep_w, harm_w, f_w, f_range = keep, harm, f_s, None
         if track is not None:  # the speeds these frames ran at
@@ -1277,7 +1293,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             skip = np.any(np.abs(off) <= hw, axis=1)
         seg = _judge(P[sel], stats, freq, keep_w, harm_w, ref, rise_db,
                      (dominance, alias_dominance if d_alias is None else d_alias), alpha, df, f_w, teeth * f_w,
-                     growth_db, f_range, skip)
+                     growth_db, f_range, skip, tone)
         opr = _once_per_rev(x[int(ta * rate):int(tb * rate)], rate, f_s)
         return CutSegment("cut", ta, tb, **seg, once_per_rev=opr)
 
@@ -1349,6 +1365,12 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         segments.extend(merged)
         if e_out:
             segments.append(CutSegment("exit", tb - e_out, tb, "transient"))
+    if ref is not None and not any(sg.kind == "cut" and sg.verdict == "chatter" for sg in segments):
+        # no chatter by the tests above: each cut part read again for a tone family under the alias bar (module
+        # docstring, *strong*). A second pass, not a third kind of "strong" in the first: where the first finds
+        # chatter, its line and frequency stand (heavy chatter's far aliases f_c + 4 f_t are tone families too)
+        again = [judge(sg.start_s, sg.end_s, tone=True) if sg.kind == "cut" else sg for sg in segments]
+        segments = [b if b.verdict == "chatter" else a for a, b in zip(segments, again)]
     judged = [sg for sg in segments if sg.kind == "cut"]
     chat = [sg for sg in judged if sg.verdict == "chatter"]
     verdict = "chatter" if chat else "stable"
@@ -1466,12 +1488,14 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         # spindle harmonic (line_db None: the test on the harmonics), whose line the ring's reading removes
         from .growth import RingDecay, ring_decay
 
+        longest_db = longest.line_db
         ring = (ring_decay(x, rate, rpm=60 * f_s, teeth=teeth, line_hz=chatter_hz, start_s=longest.start_s,
                            end_s=longest.end_s) if longest.line_db is not None else
                 RingDecay(None, reason="the chatter lies on a spindle harmonic, which the reading removes"))
         res = replace(res, ring=ring)
-        longest_db = longest.line_db
-        if _rings(ring, longest.end_s - longest.start_s):
+        # a tone's contrast bounds its decay (_TONE_DB): a ring read faster on such a line is a misreading
+        tone = longest_db is not None and longest_db >= _TONE_DB
+        if _rings(ring, longest.end_s - longest.start_s) and not tone:
             # judged again without the aliases' lower bar: what else the record holds (a growing line, chatter on a
             # spindle harmonic — a flip lobe's, which the weak line beside it hid) decides, else stable
             if hump:  # the hump's band and its aliases left out: what else the record holds decides
@@ -1524,11 +1548,16 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                                                          start_s=ta, end_s=tb))
         elif not hump:
             heard = ("" if ring.rate_per_s is None else
+                     f"; a tone {longest_db:.0f} dB over its neighbours, which no ring of ≥ 20 /s makes (its ring read "
+                     f"{-ring.rate_per_s:.3g} /s)" if tone and _rings(ring, longest.end_s - longest.start_s) else
                      f"; the line decays at {-ring.rate_per_s:.3g} /s, too slowly to call it a ring")
             warns.append(f"chatter at {chatter_hz:.1f} Hz rests on a weak line "
                          f"({10 * math.log10(max(longest.dominance, 1e-12)):.0f} dB against the strongest spindle "
-                         f"harmonic; {10 * math.log10(dominance):.0f} dB is strong) with its tooth-passing aliases, "
-                         f"and no growth was read{heard}: a stable cut near its limit rings like this under the "
+                         f"harmonic; {10 * math.log10(dominance):.0f} dB is strong) with its tooth-passing aliases"
+                         + (f" (under the alias rule's {10 * math.log10(alias_dominance):.0f} dB: a steady tone "
+                            "family, as saturated chatter under a resonant tooth-passing harmonic is)"
+                            if longest.dominance < alias_dominance else "")
+                         + f", and no growth was read{heard}: a stable cut near its limit rings like this under the "
                          "cutting noise; the surface, or a cut 5–10 % deeper that chatters strongly, decides it")
     elif not chat:
         st = [sg for sg in judged if sg.peak_hz is not None]
@@ -2180,7 +2209,7 @@ def _leakage(p, freq, harm, f_lo, f_hi, df):
 
 
 def _judge(Pseg, stats, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_s, f_t, growth_db=0.0,
-           f_range=None, exclude=None) -> dict:
+           f_range=None, exclude=None, tone=False) -> dict:
     """The chatter test on the mean of the frames ``Pseg`` (see the module docstring); ``stats`` the pair
     (:func:`_welch_dof`, :func:`_tone_threshold`) of the frames; ``dominance`` the pair (without, with a tooth-passing
     alias); ``f_range`` the spindle frequencies (Hz) the frames ran at when the speed was tracked; ``exclude`` bins
@@ -2239,7 +2268,11 @@ def _judge(Pseg, stats, freq, keep, harm, ref, rise_db, dominance, alpha, df, f_
             a = int(round((f_peak + j * f_t) / df))
             n_alias += bool(1 <= a < p.size - 1 and good[a - 1:a + 2].any())
     d_plain, d_alias = dominance
-    strong = dom >= d_plain or (n_alias > 0 and d_alias > 0 and dom >= d_alias)
+    # a tone family (``tone``: the second pass of a record the other tests found no chatter in): chatter under a
+    # resonant tooth-passing harmonic (module docstring, *strong*)
+    tone = (tone and d_alias > 0 and n_alias >= _TONE_ALIASES and bool(line_db[i] >= _TONE_DB)
+            and dom >= _TONE_DOMINANCE)
+    strong = dom >= d_plain or (n_alias > 0 and d_alias > 0 and dom >= d_alias) or tone
     line = n_alias > 0 or bool(line_db[i] >= _LINE_DB)
     chatter = sig > 1 and bool(new[i]) and strong and sustained and line
     out = dict(verdict="chatter" if chatter else "stable", chatter_hz=f_peak if chatter else None, peak_hz=f_peak,
