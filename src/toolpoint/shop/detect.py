@@ -94,11 +94,10 @@ The detector (:func:`analyse_cut`):
      its line stands (heavy chatter's far aliases are tone families too). Where the tool spends little of the
      revolution in the cut, chatter saturates weak (the tool leaves the cut) and spreads into its aliases; the
      measured effect of both ratios on simulated records over a speed × depth grid is in ``docs/design/shop.md``.
-     Under the cutting
-     force's noise a stable cut near its limit makes the same family (``docs/design/shop.md``, *Cutting noise*), so
-     a chatter verdict that rests on a line weaker than ``dominance``, whose growth was not read, has the line's
-     **ring** read (:func:`toolpoint.shop.growth.ring_decay`): a chatter's limit cycle is a steady tone, a stable
-     cut's ring decays at the closed loop's rate σ. A line that decays at ≥ 20 /s and ≥ 10/T (T the part read),
+     Under the cutting force's noise a stable cut near its limit makes the same family (``docs/design/shop.md``,
+     *Cutting noise*), so a chatter verdict that rests on a line weaker than ``dominance``, whose growth was not read,
+     has the line's **ring** read (:func:`toolpoint.shop.growth.ring_decay`): a chatter's limit cycle is a steady tone,
+     a stable cut's ring decays at the closed loop's rate σ. A line that decays at ≥ 20 /s and ≥ 10/T (T the part read),
      to a ln sd ≤ 0.5, is a ring — unless the line stands ≥ ``_TONE_DB`` over the bins 3–4 either side, which a
      Lorentzian does only when it decays at ≤ ~5 /s (the line's contrast bounds its decay, and the ring's reading
      is then wrong: it read 44–163 /s on saturated chatter families 40–43 dB out). A ring's part is judged again
@@ -1457,6 +1456,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             break
     criterion = {"alpha": alpha, "rise_db": rise_db if ref is not None else None, "dominance": dominance,
                  "alias_dominance": alias_dominance, "growth_db": growth_db, "growth_t": _GROWTH_T, "hump_db": hump_db,
+                 "tone_family": {"line_db": _TONE_DB, "aliases": _TONE_ALIASES, "dominance": _TONE_DOMINANCE},
                  "mask_hz": f"2*{df:.4g} + {_MASK_REL:g}*f", "frame_s": L / rate, "band_hz": [lo, hi],
                  "spindle_multiples_removed": True,
                  "on_harmonic_excess_db": _LOCK_DB if teeth >= 3 and ref is not None else None,
