@@ -1495,7 +1495,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         res = replace(res, ring=ring)
         # a tone's contrast bounds its decay (_TONE_DB): a ring read faster on such a line is a misreading
         tone = longest_db is not None and longest_db >= _TONE_DB
-        if _rings(ring, longest.end_s - longest.start_s) and not tone:
+        rings = _rings(ring, longest.end_s - longest.start_s)
+        if rings and not tone:
             # judged again without the aliases' lower bar: what else the record holds (a growing line, chatter on a
             # spindle harmonic — a flip lobe's, which the weak line beside it hid) decides, else stable
             if hump:  # the hump's band and its aliases left out: what else the record holds decides
@@ -1549,7 +1550,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         elif not hump:
             heard = ("" if ring.rate_per_s is None else
                      f"; a tone {longest_db:.0f} dB over its neighbours, which no ring of ≥ 20 /s makes (its ring read "
-                     f"{-ring.rate_per_s:.3g} /s)" if tone and _rings(ring, longest.end_s - longest.start_s) else
+                     f"{-ring.rate_per_s:.3g} /s)" if tone and rings else
                      f"; the line decays at {-ring.rate_per_s:.3g} /s, too slowly to call it a ring")
             warns.append(f"chatter at {chatter_hz:.1f} Hz rests on a weak line "
                          f"({10 * math.log10(max(longest.dominance, 1e-12)):.0f} dB against the strongest spindle "

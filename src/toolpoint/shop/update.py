@@ -859,8 +859,13 @@ class Posterior:
         """The posterior samples of the parameters (S, P), SI, that :meth:`parameter_quantiles` reads: the lobe
         samples where they were weighted by their own SDM limits (``own_sdm_ess``; the posterior the lobes are made
         of), else ``theta``."""
-        z = self.lobe_z if self.own_sdm_ess is not None else self.z
-        return self.prior.theta(z[:, :self.prior.sigma.size])
+        return self.prior.theta(self._posterior_z[:, :self.prior.sigma.size])
+
+    @property
+    def _posterior_z(self) -> np.ndarray:
+        """The samples' coordinates (S, P + 2) the parameters' and the label model's quantiles read: the lobe samples'
+        where they were weighted by their own SDM limits, else ``z``."""
+        return self.lobe_z if self.own_sdm_ess is not None else self.z
 
     def parameter_quantiles(self) -> dict:
         """name → (prior 5/50/95 %, posterior 5/50/95 %) of each parameter (SI), the posterior's of
@@ -868,7 +873,7 @@ class Posterior:
         zq = np.array([-1.6448536269514729, 0.0, 1.6448536269514729])
         prior_q = np.exp(self.prior.log_median[None, :] + zq[:, None] * self.prior.sigma[None, :])
         P = self.prior.sigma.size
-        z = self.lobe_z if self.own_sdm_ess is not None else self.z
+        z = self._posterior_z
         post_q = np.quantile(self.parameter_samples, [0.05, 0.5, 0.95], axis=0)
         out = {n: (tuple(prior_q[:, k]), tuple(post_q[:, k])) for k, n in enumerate(self.prior.names)}
         mu, sd = self.label_offset
