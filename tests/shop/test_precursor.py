@@ -13,7 +13,7 @@ import pytest
 from scipy.stats import norm
 
 from toolpoint.shop.model import cornelius_2024, limit_at_speeds, sdm_limits
-from toolpoint.shop.update import PRECURSOR, TestCut, log_likelihood, noisy_shop, update
+from toolpoint.shop.update import NOISY_POCKET, PRECURSOR, TestCut, log_likelihood, noisy_shop, update
 
 
 def _ring(rpm, depth, sd=0.2, line=None):
@@ -48,6 +48,41 @@ def test_a_chatter_label_is_softened_by_the_precursor_share_and_a_stable_one_is_
         assert np.all(np.abs(d[u < -0.5]) < 1e-3)  # far under the limit: no ring loud enough
 
 
+def test_a_noisy_shop_hears_chatter_late_by_the_cut_s_height_in_its_pocket():
+    """``noisy_pocket`` ν moves a cut's labels' boundary up by ν h, h = ln(a_lim / a_min): against the same likelihood
+    with the label offset ν h, h read from a second route to the lobes' floor — the least limit over a fine speed grid
+    (:func:`limit_at_speeds`), not :func:`floor_limit`'s max of −2 Re λΦ. At a pocket's top of the two-mode case h
+    ≈ 1, at the lobes' floor ≈ 0 (the likelihood as without the term)."""
+    from toolpoint.shop.model import floor_limit
+
+    pr = cornelius_2024(0.1)
+    th = pr.theta(np.random.default_rng(3).standard_normal((60, pr.sigma.size)))
+    f = pr.freq_grid()
+    speeds = np.linspace(9000.0, 26000.0, 12000)
+    a_grid = limit_at_speeds(pr, th, speeds, f)[0]
+    a_min = a_grid.min(axis=1)
+    np.testing.assert_allclose(floor_limit(pr, th, f), a_min, rtol=2e-3)
+    med = limit_at_speeds(pr, pr.theta(np.zeros((1, pr.sigma.size))), speeds, f)[0][0]
+    top, bottom = speeds[np.argmax(speeds * med)], speeds[np.argmin(med)]
+    nu = 0.04
+    for rpm, lo, hi in ((top, 0.5, 1.6), (bottom, 0.0, 0.05)):
+        a_lim = limit_at_speeds(pr, th, [rpm], f)[0][:, 0]
+        h = np.log(a_lim / a_min)
+        assert lo < np.median(h) < hi, (rpm, np.median(h))
+        for stable in (True, False):
+            cut = [TestCut(rpm, float(np.median(a_lim)), stable)]
+            got = log_likelihood(pr, th, cut, freq_hz=f, label_growth=0.0, noisy_pocket=nu)
+            ref = log_likelihood(pr, th, cut, freq_hz=f, label_growth=0.0, label_offset=nu * h)
+            np.testing.assert_allclose(got, ref, atol=5e-3)
+    # update: applied where a stable cut's ring says the shop is noisy, and only there
+    ring, quiet = [_ring(15000.0, 0.3e-3)], [_ring(15000.0, 0.3e-3, sd=1.5)]
+    kw = dict(rng=np.random.default_rng(0), n_samples=100, lobe_samples=40, forward="zoa", rpm_grid=[15000.0])
+    assert update(pr, ring, **kw).noisy_pocket == NOISY_POCKET
+    assert update(pr, ring, **kw, precursor=None).noisy_pocket == NOISY_POCKET
+    assert update(pr, quiet, **kw).noisy_pocket is None
+    assert update(pr, ring, **kw, noisy_pocket=None).noisy_pocket is None
+
+
 def test_the_shop_is_noisy_only_where_a_stable_cut_s_ring_is_read_tightly():
     """The evidence is the first stable cut whose ring is read to an ln sd ≤ 0.5 (a table's ring without an sd
     counts: the user read it); a loose ring (the entry's kick in a quiet cut: 1.3–2.2), or none, is not."""
@@ -72,8 +107,9 @@ def test_update_keeps_more_limits_above_a_chatter_label_only_in_a_noisy_shop():
     for name, cuts, pc in (("noisy", [_ring(15000.0, 0.3e-3), chat], PRECURSOR),
                            ("off", [_ring(15000.0, 0.3e-3), chat], None),
                            ("quiet", [_ring(15000.0, 0.3e-3, sd=1.5), chat], PRECURSOR)):
+        # the noisy shop's late chatter at a pocket's top left out: this test is the precursor's alone
         p = update(pr, cuts, rng=np.random.default_rng(2), n_samples=3000, lobe_samples=100, forward="zoa",
-                   method="sir", precursor=pc)
+                   method="sir", precursor=pc, noisy_pocket=None)
         assert (p.precursor, p.noisy_evidence) == ((PRECURSOR, 0) if name == "noisy" else (None, None))
         a = limit_at_speeds(pr, p.theta, [15000.0, 20000.0], f)[0]
         share[name] = (np.mean(a[:, 1] > chat.depth_m), np.mean(a[:, 0] > 0.3e-3))
@@ -94,8 +130,9 @@ def test_a_bad_precursor_is_refused():
 
 @pytest.mark.slow
 def test_cli_update_says_the_shop_is_noisy_and_no_precursor_leaves_it_out(tmp_path, capsys):
-    """A stable row with a ring and a chattering row: the summary says the shop is noisy (naming the line), update.json
-    holds the term; ``--no-precursor`` leaves it out (null). Two zero-order updates."""
+    """A stable row with a ring and a chattering row: the summary says the shop is noisy (naming the line) and that
+    chatter may be heard late at a pocket's top, update.json holds both terms; ``--no-precursor`` leaves both out
+    (null). Two zero-order updates."""
     from toolpoint.cli.main import main
 
     prior = Path(__file__).resolve().parents[2] / "examples" / "shop" / "cornelius_prior.toml"
@@ -107,12 +144,17 @@ def test_cli_update_says_the_shop_is_noisy_and_no_precursor_leaves_it_out(tmp_pa
     assert main(args + ["--out", str(tmp_path / "a")]) == 0
     out = capsys.readouterr().out
     assert "noisy shop: the stable cut of line 2 rings (-30 /s at 1270.0 Hz)" in out
-    pc = json.loads((tmp_path / "a" / "update.json").read_text())["precursor"]
+    doc = json.loads((tmp_path / "a" / "update.json").read_text())
+    pc = doc["precursor"]
     assert pc["share"] == PRECURSOR[0] and pc["evidence"]["line"] == 2
-    assert "Noisy shop" in (tmp_path / "a" / "report.html").read_text()
+    assert doc["noisy_pocket"]["per_ln_pocket_height"] == NOISY_POCKET and doc["noisy_pocket"]["evidence"] == pc[
+        "evidence"]
+    assert "chatter may be heard late at a pocket's top" in out
+    assert (tmp_path / "a" / "report.html").read_text().count("Noisy shop") == 2
     assert main(args + ["--out", str(tmp_path / "b"), "--no-precursor"]) == 0
     assert "noisy shop" not in capsys.readouterr().out
-    assert json.loads((tmp_path / "b" / "update.json").read_text())["precursor"] is None
+    doc = json.loads((tmp_path / "b" / "update.json").read_text())
+    assert doc["precursor"] is None and doc["noisy_pocket"] is None
 
 
 @pytest.mark.slow

@@ -695,6 +695,30 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
 
 
 @pytest.mark.slow
+def test_no_step_above_stable_cuts_once_the_shop_is_noisy(tmp_path):
+    """The step above the highest stable cut (proposed whatever its P(chatter)) rests on the stable labels; once a
+    stable cut's record rings tightly (a noisy shop, whose labels at a pocket's top may be chatter unheard:
+    ``noisy_pocket``) the risk bound alone proposes the next cut. The cuts of the step test below, the last stable
+    cut with a ring read to an ln sd of 0.2 (noisy) or 1.5 (loose: a quiet shop's kick); ``noisy_pocket=None`` steps
+    again. Three 300-sample zero-order updates."""
+    from toolpoint.shop.prior import read_modal_prior
+
+    (tmp_path / "prior.toml").write_text(PRIOR_TOML)
+    pr = read_modal_prior(tmp_path / "prior.toml")
+    base = [TestCut(20000.0, 0.5e-3, True), TestCut(12000.0, 0.3e-3, True)]
+    nxt = {}
+    for name, sd, npk in (("noisy", 0.2, 0.025), ("loose", 1.5, 0.025), ("off", 0.2, None)):
+        last = TestCut(20678.0, 0.74e-3, True, ring_per_s=-60.0, ring_hz=1250.0, ring_ln_sd=sd)
+        post = update(pr, [*base, last], rng=np.random.default_rng(4), n_samples=300, lobe_samples=150,
+                      forward="zoa", noisy_pocket=npk)
+        nxt[name] = (post.next_cut, post.noisy_pocket)
+    assert nxt["noisy"][1] == 0.025 and nxt["loose"][1] is None and nxt["off"][1] is None
+    assert not nxt["noisy"][0]["stepped"] and nxt["noisy"][0]["p_chatter"] <= 0.3, nxt["noisy"]
+    for name in ("loose", "off"):
+        assert nxt[name][0]["stepped"] and nxt[name][0]["p_chatter"] > 0.3, (name, nxt[name])
+
+
+@pytest.mark.slow
 def test_cli_update_steps_above_stable_cuts_until_the_first_chatter(tmp_path, capsys):
     """``toolpoint update`` steps ×e^--min-step above the highest stable cut near a speed while no cut has chattered,
     and not after a chatter (``--step-until-near-chatter``: not after a chatter near that speed; with

@@ -45,9 +45,9 @@ def register(sub) -> None:
                    help="leave the stable cuts' rings out of the update (their labels stay): docs/design/shop.md, "
                    "*A stable cut's ring in update*")
     p.add_argument("--no-precursor", action="store_true",
-                   help="take every chatter label at its word even where the stable cuts ring (a noisy shop's "
-                   "false chatter: docs/design/shop.md, *A noisy shop's false chatter*), e.g. labels checked on the "
-                   "surface")
+                   help="take every label at its word even where the stable cuts ring (a noisy shop's false "
+                   "chatter, and its chatter heard late at a pocket's top: docs/design/shop.md, *A noisy shop's "
+                   "false chatter*, *A noisy shop's pocket*), e.g. labels checked on the surface")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--seed", default="0", help="random seed (default 0)")
     p.add_argument("--samples", default="1000", help="posterior samples (default 1000)")
@@ -141,7 +141,7 @@ def run(args) -> int:
     if args.no_ring:
         offset["ring_error"] = None
     if args.no_precursor:
-        offset["precursor"] = None
+        offset["precursor"] = offset["noisy_pocket"] = None
     if args.library and not args.tool:
         raise InputError("--library needs --tool ID", file="command line", field="--tool")
     if args.sigma_freq is not None and not args.library:
@@ -152,7 +152,8 @@ def run(args) -> int:
     import numpy as np
 
     from ..shop.prior import prior_from_library, read_modal_prior
-    from ..shop.report import away_note, pocket_note, precursor_doc, precursor_note, write_update
+    from ..shop.report import (away_note, noisy_pocket_doc, noisy_pocket_note, pocket_note, precursor_doc,
+                               precursor_note, write_update)
     from ..shop.update import read_test_cuts, update
 
     if args.frf is not None and not args.prior:
@@ -203,6 +204,8 @@ def run(args) -> int:
         print("rings: " + rings)
     if (pc := precursor_doc(post)) is not None and any(not c.stable and c.growth_per_s is None for c in cuts):
         print("noisy shop: " + precursor_note(pc))  # said where a chatter label is read differently
+    if (npd := noisy_pocket_doc(post)) is not None:
+        print("noisy shop: " + noisy_pocket_note(npd))
     pocket = pocket_note({"rpm": rc["rpm"], "limit_p05_mm": 1e3 * rc["limit_p05_m"],
                           "own_sdm_p05_mm": None if rc["own_sdm_p05_m"] is None else 1e3 * rc["own_sdm_p05_m"],
                           "lobes_own_sdm": post.own_sdm_ess is not None})

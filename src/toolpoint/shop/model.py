@@ -28,8 +28,8 @@ from ..errors import InputError
 from ..stability.cutting import CuttingConditions
 from ..stability.milling import average_directional_matrix
 
-__all__ = ["ModalPrior", "Samples", "limit_at_speeds", "growth_rate", "sdm_limits", "receptance", "cornelius_2024",
-           "example_tool"]
+__all__ = ["ModalPrior", "Samples", "limit_at_speeds", "floor_limit", "growth_rate", "sdm_limits", "receptance",
+           "cornelius_2024", "example_tool"]
 
 
 @dataclass(frozen=True)
@@ -291,6 +291,37 @@ def _limit_block(prior: ModalPrior, t, n, f) -> tuple[np.ndarray, np.ndarray]:
     with np.errstate(divide="ignore"):
         limit = np.where(best_q > 0, 1.0 / np.where(best_q > 0, best_q, 1.0), np.inf)
     return limit, best_f
+
+
+def floor_limit(prior: ModalPrior, theta, freq_hz=None) -> np.ndarray:
+    """The zero-order lobes' floor of each sample, m (S,): the least limit over all speeds,
+    a_min = 1 / max_{b, f} (−2 Re λ_b Φ(f)) (Altintas & Budak 1995: every lobe's minimum touches it); inf where Re
+    λ_b Φ ≥ 0 everywhere on the grid (no lobe).
+
+    Examples
+    --------
+    One mode: the floor is the least of the limits on a fine speed grid, as :func:`limit_at_speeds` finds them
+    (within the grid's reach of the lobes' minima):
+
+    >>> import numpy as np
+    >>> from toolpoint.stability import CuttingConditions
+    >>> cut = CuttingConditions(teeth=3, tangential_coeff=7e8, radial_ratio=0.3, radial_immersion=0.5)
+    >>> pr = ModalPrior((900.0,), (5e6,), (0.03,), (0.0,), (0.0,), (0.0,), cut, 0.0, 0.0)
+    >>> th = pr.theta(np.zeros((1, 5)))
+    >>> a, _ = limit_at_speeds(pr, th, np.linspace(6000.0, 20000.0, 4000))
+    >>> bool(abs(a.min() / floor_limit(pr, th)[0] - 1) < 2e-3)
+    True
+    """
+    t = np.atleast_2d(np.asarray(theta, float))
+    f = prior.freq_grid() if freq_hz is None else np.asarray(freq_hz, float)
+    out = np.empty(t.shape[0])
+    for i in range(0, t.shape[0], _BLOCK):  # blocks, as limit_at_speeds: the (S, 2, F) temporaries stay small
+        tb = t[i: i + _BLOCK]
+        q = -2.0 * (_eigs(prior, tb)[:, :, None] * receptance(prior, tb, f)[:, None, :]).real
+        qmax = q.max(axis=(1, 2))
+        with np.errstate(divide="ignore"):
+            out[i: i + _BLOCK] = np.where(qmax > 0, 1.0 / np.where(qmax > 0, qmax, 1.0), np.inf)
+    return out
 
 
 def growth_rate(prior: ModalPrior, theta, rpm, chatter_hz) -> np.ndarray:

@@ -10,7 +10,8 @@ In the output folder (written atomically, all or none of each file):
   (K_t in N/mm²);
 * ``update.json`` — recommended point, next test cut (rule, rpm, depth_mm, duration_s, P(chatter)), the test
   cuts (each with its record and part, where the table named one), ``precursor`` (a noisy shop's false chatter
-  the likelihood allowed for, and the stable cut whose ring said the shop is noisy; null in a quiet shop), the
+  the likelihood allowed for, and the stable cut whose ring said the shop is noisy; null in a quiet shop),
+  ``noisy_pocket`` (how late that shop was taken to hear chatter at a pocket's top; null in a quiet shop), the
   forward model and sampler diagnostics (method, ESS per tempering step, acceptance, the lobe samples' ESS by
   their own SDM limits, CPU s);
 * ``lobes.png`` — prior and posterior bands, the P(stable) map, the test cuts, the next cut;
@@ -118,6 +119,7 @@ def _doc(post: Posterior) -> dict:
                  for c, x, xr in zip(post.cuts, post.growth_past_limit or (None,) * len(post.cuts),
                                      post.ring_under_limit or (None,) * len(post.cuts))],
         "precursor": precursor_doc(post),
+        "noisy_pocket": noisy_pocket_doc(post),
         "sampler": {"method": post.method, "forward": post.forward, "samples": int(post.z.shape[0]),
                     "ess": [round(e, 1) for e in post.ess],
                     "acceptance": None if not np.isfinite(post.acceptance) else round(post.acceptance, 3),
@@ -234,16 +236,35 @@ def _growth_cell(c) -> str:
     return format(c["growth_per_s"], ".3g") + ("" if x is None else f" (x {x:.3f})")
 
 
+def _noisy_evidence(post: Posterior) -> dict:
+    c = post.cuts[post.noisy_evidence]
+    return {"line": c.line, "cut": post.noisy_evidence + 1, "ring_per_s": c.ring_per_s, "ring_hz": c.ring_hz}
+
+
 def precursor_doc(post: Posterior) -> dict | None:
     """The noisy shop's false chatter the likelihood used (``update.json``'s ``precursor``), or None (a quiet shop,
     or left out)."""
     if post.precursor is None:
         return None
     pi, reach, sd = post.precursor
-    c = post.cuts[post.noisy_evidence]
-    return {"share": pi, "reach_ln": reach, "sd_ln": sd,
-            "evidence": {"line": c.line, "cut": post.noisy_evidence + 1, "ring_per_s": c.ring_per_s,
-                         "ring_hz": c.ring_hz}}
+    return {"share": pi, "reach_ln": reach, "sd_ln": sd, "evidence": _noisy_evidence(post)}
+
+
+def noisy_pocket_doc(post: Posterior) -> dict | None:
+    """The noisy shop's late chatter at a pocket's top the likelihood used (``update.json``'s ``noisy_pocket``: ν,
+    :data:`~toolpoint.shop.update.NOISY_POCKET`), or None (a quiet shop, or left out)."""
+    if post.noisy_pocket is None:
+        return None
+    return {"per_ln_pocket_height": post.noisy_pocket, "evidence": _noisy_evidence(post)}
+
+
+def noisy_pocket_note(npd: dict) -> str:
+    """One line on the noisy shop's late chatter at a pocket's top (the CLI's summary and the report say the same)."""
+    nu = npd["per_ln_pocket_height"]
+    return (f"chatter may be heard late at a pocket's top, where the tooth passing rings the mode and its line hides "
+            f"chatter the noise has spread: each label is taken as heard {nu:g} × ln(the limit there / the lobes' "
+            f"floor) above the limit (~{100 * (math.exp(nu * math.log(75)) - 1):.0f} % at a pocket 75 × its floor); "
+            "labels checked on the surface leave it out (--no-precursor)")
 
 
 def precursor_note(pc: dict) -> str:
@@ -271,6 +292,8 @@ def _html(post, doc, rows, png) -> str:
     if doc.get("precursor") is not None and any(c["result"] == "chatter" and c["growth_per_s"] is None
                                                 for c in doc["cuts"]):
         caveat += f"<p><b>Noisy shop</b>: {e(precursor_note(doc['precursor']))}.</p>"
+    if doc.get("noisy_pocket") is not None:
+        caveat += f"<p><b>Noisy shop</b>: {e(noisy_pocket_note(doc['noisy_pocket']))}.</p>"
     warns = [w for c in doc["cuts"] for w in c["warnings"]]
     if warns:  # what the records' analysis could not rule out: the labels above rest on it
         caveat += "<p><b>Warnings from the records</b>:</p><ul>" + "".join(f"<li>{e(w)}</li>" for w in warns) + "</ul>"

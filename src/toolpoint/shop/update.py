@@ -50,7 +50,11 @@ In a noisy shop — one whose stable cuts' records ring at the tool's modes (:fu
 its limit may be heard as chatter: its mode, driven by the cutting noise, rings at the chatter frequency. A chatter
 label without a growth reading then has P(label chatter) = p_c + π Φ((u + r)/s) p_s (``precursor``;
 :data:`PRECURSOR`), u = ln(a / a_lim): one-sided, the stable labels keep p_s, so the term acts through the chatter
-labels only — it lets the band rise above them (its lower side rises too, by the mass it lets above).
+labels only — it lets the band rise above them (its lower side rises too, by the mass it lets above). Such a shop also
+hears chatter *late* at a pocket's top, where the tooth-passing harmonic rings the mode and its forced line hides a
+chatter the noise spreads into a hump: there each cut's labels' boundary lies a further ν h above the limit,
+h = ln(a_lim / a_min) the cut's height in its pocket over the lobes' floor (``noisy_pocket``; :data:`NOISY_POCKET`),
+and the next cut takes no step above the stable cuts (below): their labels may be chatter unheard.
 
 The posterior is sampled by sequential Monte Carlo (Chopin 2002; Del Moral, Doucet & Jasra 2006): prior
 samples are tempered, L^β with β from 0 to 1 in steps that keep the effective sample size at half the
@@ -122,10 +126,10 @@ from scipy.special import log_ndtr, logsumexp, ndtr, ndtri
 
 from ..errors import InputError
 from ..stability.zoa_batch import zoa_limits
-from .model import ModalPrior, growth_rate, limit_at_speeds, receptance, sdm_limits
+from .model import ModalPrior, floor_limit, growth_rate, limit_at_speeds, receptance, sdm_limits
 
-__all__ = ["DEFAULT_RISK", "GROWTH_ERROR", "PRECURSOR", "RING_ERROR", "TestCut", "Posterior", "read_test_cuts",
-           "check_consistent", "log_likelihood", "noisy_shop", "update"]
+__all__ = ["DEFAULT_RISK", "GROWTH_ERROR", "NOISY_POCKET", "PRECURSOR", "RING_ERROR", "TestCut", "Posterior",
+           "read_test_cuts", "check_consistent", "log_likelihood", "noisy_shop", "pocket_height", "update"]
 
 
 _RPM_AGREE = 0.005
@@ -460,6 +464,17 @@ def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, s
                                  f"({s.rpm:g} / {c.rpm:g} rpm); check the labels", file=source, field="result")
 
 
+NOISY_POCKET = 0.025
+"""A noisy shop's late chatter at a pocket's top, ν: where the cutting force's noise drives the tool's modes
+(:func:`noisy_shop`), each cut's labels' boundary moves up by a further ν h, h = ln(a_lim / a_min) the cut's height in
+its pocket over the lobes' floor (:func:`pocket_height`), and the ``"info"`` rule proposes no step above the stable
+cuts. At a pocket's top the tooth-passing harmonic sits on the mode; its forced line stands 20–30 dB over chatter that
+has just saturated, and the noise spreads that chatter into a hump that `cut` reads as a ring. With 5 % force noise
+EM28-80 (its pocket 75× its floor, h ≈ 4.3) heard chatter 10–20 % past the limit there (28 of 97 stable labels more than
+5 % past it, the chatter labels at a median 1.157 ×), the two-mode case (2.6×, h ≈ 1) within 2.3 %: ν ≈ 0.1 / 4.3. Set
+from EM28-80's truths 390–409, checked on fresh truths and the other tools (``docs/design/shop.md``, *A noisy shop's
+pocket*)."""
+
 PRECURSOR = (0.5, 0.1, 0.08)
 """A noisy shop's false chatter (π, r, s): where the cutting force's noise drives the tool's modes, a stable cut near
 its limit rings at the chatter frequency and may be heard as chatter — P(chatter heard | stable, u) = π Φ((u + r)/s),
@@ -516,7 +531,7 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
                    miss_rate: float = 0.0, label_offset=0.0, label_growth=0.0,
                    cut_duration_s: float = 1.0, growth_error=None, growth_x=None, ring_x=None,
                    ring_outlier: float = RING_ERROR[1], precursor=None, kappa=None,
-                   kappa_log_ratio=None) -> np.ndarray:
+                   kappa_log_ratio=None, noisy_pocket=None) -> np.ndarray:
     """ln p(cuts | θ) for each row of θ (see the module docstring); shape (S,).
 
     ``log_ratio`` (per cut, optional): ln of a factor on the zero-order limit at the cut's speed (the SDM
@@ -548,7 +563,10 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     chatter with a further probability π Φ((u + r)/s) (:data:`PRECURSOR`) — P(label chatter) = p_c + π h p_s —
     except a chattering cut whose growth was read (a ring does not grow). One-sided: P(label stable) stays p_s (not
     (1 − π h) p_s), so a stable label says no more than in a quiet shop; the band's lower side still rises by the
-    mass the softened chatter labels let above them."""
+    mass the softened chatter labels let above them. ``noisy_pocket`` ν, None to leave it out: each cut's labels'
+    boundary moves up by a further ν h, h = ln(a_lim / a_min) ≥ 0 the cut's height in its pocket over the sample's
+    zero-order floor (:func:`~toolpoint.shop.model.floor_limit`; a_lim with ``log_ratio``'s correction): a noisy
+    shop hears chatter late at a pocket's top (:data:`NOISY_POCKET`)."""
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
@@ -563,6 +581,8 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     if np.any(g > 0):
         dur = np.array([cut_duration_s if c.duration_s is None else c.duration_s for c in cuts], float)
         offset = offset + growth_offset(prior, theta, rpm, f_c, g, dur, kappa, kappa_log_ratio)
+    if noisy_pocket is not None:  # a noisy shop hears chatter late at a pocket's top: ν h further up
+        offset = offset + ex(float(noisy_pocket) * pocket_height(prior, theta, a_lim * np.exp(lr), freq_hz))
     with np.errstate(divide="ignore"):
         x = (ex(np.log(a_lim) + lr) + offset - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
     x = np.where(np.isfinite(x), x, 50.0)  # no lobe reaches the speed: stable at any depth in the grid
@@ -675,6 +695,15 @@ _GROWTH_LR_MAX = 0.1  # |ln(a_SDM / a_ZOA)| at a cut beyond which its growth rat
 _GROWTH_CAP = 0.5  # ln: a chatter that cannot grow audibly within the cut leaves the label uninformative, not wild
 
 
+def pocket_height(prior: ModalPrior, theta, limit_m, freq_hz=None) -> np.ndarray:
+    """h = ln(a_lim / a_min) ≥ 0 of each sample's limits ``limit_m`` (S, ·), m, over its zero-order floor a_min
+    (:func:`~toolpoint.shop.model.floor_limit`): how high in its pocket a cut lies (0 on the lobes' floor; 4.3 at the
+    top of EM28-80's pocket, 75× its floor). 0 where the limit is not finite (no lobe reaches the speed)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h = np.log(np.asarray(limit_m, float)) - np.log(floor_limit(prior, theta, freq_hz))[:, None]
+    return np.where(np.isfinite(h), np.maximum(h, 0.0), 0.0)
+
+
 def growth_offset(prior: ModalPrior, theta, rpm, chatter_hz, growth, duration_s, kappa=None,
                   kappa_log_ratio=None) -> np.ndarray:
     """min(G / (κ t), 0.5): how far (ln) above the limit a chatter that must grow by e^G within t seconds is heard,
@@ -777,6 +806,9 @@ class Posterior:
     lobe_limit_m : ndarray, shape (m, G), optional
         The lobe samples' limits at each speed, m: what ``limit_q_m`` and ``p_stable`` are read from
         (:meth:`p_chatter` reads the map at any depth).
+    noisy_pocket : float or None
+        The noisy shop's late chatter at a pocket's top (ν, :data:`NOISY_POCKET`) the likelihood used; None where it
+        was left out (``update``'s ``noisy_pocket`` None or 0, or a quiet shop).
     """
 
     prior: ModalPrior
@@ -806,6 +838,7 @@ class Posterior:
     own_pocket_rpm: tuple = ()
     band_levels: np.ndarray | None = None
     lobe_limit_m: np.ndarray | None = None
+    noisy_pocket: float | None = None
 
     def p_chatter(self, depth_m) -> np.ndarray:
         """P(chatter) that the map claims at ``depth_m`` (m) at each of the speeds ``rpm``: 1 − ``p_stable`` read at
@@ -910,7 +943,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            audible_margin: float = 0.025, max_cut_duration_s: float = 5.0,
            growth_error: tuple | None = GROWTH_ERROR, ring_error: tuple | None = RING_ERROR,
            precursor: tuple | None = PRECURSOR, own_sdm: bool = True, growth_by: str = "zoa",
-           own_pocket: int = POCKET_SPEEDS, band_noise: bool = True) -> Posterior:
+           own_pocket: int = POCKET_SPEEDS, band_noise: bool = True,
+           noisy_pocket: float | None = NOISY_POCKET) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -1068,6 +1102,15 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         about r under the limit, heard as chatter with probability π Φ((u + r)/s) (:func:`log_likelihood`): a
         chatter label then bounds the limit from above less tightly. In a quiet shop (no stable cut rings) it is
         left out. None: never (a shop whose chatter labels are checked, e.g. on the surface).
+    noisy_pocket : float or None, default :data:`NOISY_POCKET`
+        A noisy shop's late chatter at a pocket's top (ν): once a stable cut's record rings (as ``precursor``), each
+        cut's labels' boundary lies a further ν h above the limit, h = ln(a_lim / a_min) its height in its pocket
+        over the lobes' floor (:func:`pocket_height`): the tooth-passing harmonic that rings the mode there hides
+        chatter that the noise spreads into a hump, which `cut` reads as a ring. The lobes, the recommended point and
+        the next cut's P(chatter) stay those of a_lim, so a stable label high in a pocket lifts the band less; and the
+        ``"info"`` rule proposes no step above the stable cuts (``min_step``), which rests on their labels whatever
+        its P(chatter). In a quiet shop it is left out. None or 0: never (labels checked on the surface). Measured in
+        the whole loop with 5 % cutting-force noise (``docs/design/shop.md``, *A noisy shop's pocket*).
     skip_repeats : bool, default True
         ``"info"`` rule: no candidate at the speed of an earlier cut (±0.5 %) that is no deeper than a stable cut there,
         or no shallower than a chattering one — the shop already knows how it ends. The likelihood takes each cut's
@@ -1257,6 +1300,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     if not (isinstance(own_pocket, (int, float, np.integer, np.floating)) and float(own_pocket).is_integer()
             and 0 <= own_pocket <= 50):
         raise InputError(f"must be a whole number in [0, 50], got {own_pocket!r}", field="own_pocket")
+    if noisy_pocket is not None and not (isinstance(noisy_pocket, (int, float, np.integer, np.floating))
+                                         and 0 <= noisy_pocket <= 0.2):
+        raise InputError(f"must be in [0, 0.2] (ln per ln of pocket height) or None, got {noisy_pocket!r}",
+                         field="noisy_pocket")
     if not isinstance(band_noise, (bool, np.bool_)):
         raise InputError(f"must be true or false, got {band_noise!r}", field="band_noise")
     cuts = tuple(cuts)
@@ -1271,9 +1318,12 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
               miss_rate=miss_rate, label_offset=(off_mu, off_sd), label_growth=(g_med, g_sd),
               cut_duration_s=cut_duration_s, growth_error=growth_error if forward == "zoa" else None)
     # a noisy shop (a stable cut's record rings at a tool's mode): a chatter label may be a stable cut's ring
-    noisy = None if precursor is None else noisy_shop(cuts)
+    noisy = None if precursor is None and not noisy_pocket else noisy_shop(cuts)
     if noisy is not None:
-        kw["precursor"] = tuple(float(v) for v in precursor)
+        if precursor is not None:
+            kw["precursor"] = tuple(float(v) for v in precursor)
+        if noisy_pocket:  # and chatter at a pocket's top is heard late (NOISY_POCKET)
+            kw["noisy_pocket"] = float(noisy_pocket)
     z = _draw_z(rng, n_samples, free)
     ess_hist, acc = [], []
     log_ratio_grid = None
@@ -1403,12 +1453,18 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         off_pick = off_mu + off_sd * z[pick, P]
 
         def offset(ks):  # each lobe sample's label offset at the candidate speeds grid[ks], (m, len(ks))
-            if g_med <= 0:
-                return np.broadcast_to(off_pick[:, None], (m, len(ks)))
-            _, fc = limit_at_speeds(prior, th_pick, grid[ks], f)
-            return off_pick[:, None] + growth_offset(prior, th_pick, grid[ks], fc, g_pick, duration(ks)[0])
+            out = np.broadcast_to(off_pick[:, None], (m, len(ks)))
+            if g_med > 0:
+                _, fc = limit_at_speeds(prior, th_pick, grid[ks], f)
+                out = out + growth_offset(prior, th_pick, grid[ks], fc, g_pick, duration(ks)[0])
+            if "noisy_pocket" in kw:  # the outcome heard in a noisy shop at a pocket's top
+                out = out + kw["noisy_pocket"] * pocket_height(prior, th_pick, lim[:, ks], f)
+            return out
 
-        nxt = _next_info(lim, grid, j, bound, boundary_width, label_noise, chatter_cost, cuts, min_step, miss_rate,
+        # a noisy shop: no step above the stable cuts — the step is proposed whatever its P(chatter), on stable labels
+        # that at a pocket's top may be chatter unheard (noisy_pocket; EM25-55 climbed its pocket to 1.4 × the limit)
+        step = 0.0 if "noisy_pocket" in kw else min_step
+        nxt = _next_info(lim, grid, j, bound, boundary_width, label_noise, chatter_cost, cuts, step, miss_rate,
                          offset, skip_repeats, creep_span, step_until_chatter)
     if forward == "sdm":
         # the recommended depth checked by the own SDM limits of posterior samples that the choice of its speed did
@@ -1431,7 +1487,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
                                                                            np.full(len(cuts), np.nan))),
                      tuple(float(v) if np.isfinite(v) else None for v in (rx[2] if rx is not None else
                                                                            np.full(len(cuts), np.nan))),
-                     kw.get("precursor"), noisy, own_ess, z[pick], own_power, pocket_rpm, levels, lim)
+                     kw.get("precursor"), noisy, own_ess, z[pick], own_power, pocket_rpm, levels, lim,
+                     kw.get("noisy_pocket"))
 
 
 def _quantiles_at(lim, levels):
