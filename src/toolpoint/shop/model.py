@@ -197,7 +197,7 @@ def _eigs(prior: ModalPrior, theta) -> np.ndarray:
     return np.stack([tr / 2 + root, tr / 2 - root], axis=1)
 
 
-def limit_at_speeds(prior: ModalPrior, theta, rpm, freq_hz=None) -> tuple[np.ndarray, np.ndarray]:
+def limit_at_speeds(prior: ModalPrior, theta, rpm, freq_hz=None, *, floor: bool = False) -> tuple:
     """Zero-order limit (m) and chatter frequency (Hz) of each sample at each speed.
 
     Parameters
@@ -207,11 +207,15 @@ def limit_at_speeds(prior: ModalPrior, theta, rpm, freq_hz=None) -> tuple[np.nda
     rpm : array_like, shape (R,)
     freq_hz : array_like, optional
         Frequency grid (default :meth:`ModalPrior.freq_grid`).
+    floor : bool, default False
+        Also return each sample's lobes' floor (:func:`floor_limit`), from the same pass over the grid.
 
     Returns
     -------
     limit_m, chatter_hz : ndarray, shape (S, R)
         inf / nan where no lobe reaches the speed within the grid.
+    floor_m : ndarray, shape (S,)
+        With ``floor``: :func:`floor_limit`'s.
 
     Examples
     --------
@@ -236,20 +240,28 @@ def limit_at_speeds(prior: ModalPrior, theta, rpm, freq_hz=None) -> tuple[np.nda
     # In blocks of samples whose (S, 2, F) temporaries stay in cache (~1–2 MB each), not one pass over all: the
     # same bits, 0.174 → 0.106 s CPU per call (best of 15) on 1000 EM16-50 samples at four speeds (blocks of 100;
     # 2026-12-02).
-    if t.shape[0] > _BLOCK:
-        parts = [_limit_block(prior, t[i: i + _BLOCK], n, f) for i in range(0, t.shape[0], _BLOCK)]
-        return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
-    return _limit_block(prior, t, n, f)
+    parts = [_limit_block(prior, t[i: i + _BLOCK], n, f) for i in range(0, t.shape[0], _BLOCK)]
+    return tuple(np.concatenate([p[k] for p in parts]) for k in range(3 if floor else 2))
 
 
 _BLOCK = 100  # samples per block of limit_at_speeds
 
 
-def _limit_block(prior: ModalPrior, t, n, f) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`limit_at_speeds` of one block of samples t (S, 3M + 2) at speeds n (R,), grid f (F,)."""
-    H = receptance(prior, t, f)  # (S, F)
-    lam = _eigs(prior, t)  # (S, 2)
-    mu = lam[:, :, None] * H[:, None, :]  # (S, 2, F)
+def _mu(prior: ModalPrior, t, f) -> np.ndarray:
+    """μ_b(f) = λ_b Φ(f) of each sample, (S, 2, F)."""
+    return _eigs(prior, t)[:, :, None] * receptance(prior, t, f)[:, None, :]
+
+
+def _floor(q) -> np.ndarray:
+    """The least limit 1 / max q of each sample (S,) from q = −2 Re μ (S, 2, F); inf where q ≤ 0 everywhere."""
+    qmax = q.max(axis=(1, 2))
+    with np.errstate(divide="ignore"):
+        return np.where(qmax > 0, 1.0 / np.where(qmax > 0, qmax, 1.0), np.inf)
+
+
+def _limit_block(prior: ModalPrior, t, n, f) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`limit_at_speeds` of one block of samples t (S, 3M + 2) at speeds n (R,), grid f (F,), and the floor."""
+    mu = _mu(prior, t, f)  # (S, 2, F)
     q = -2.0 * mu.real  # 1/a, valid where > 0
     N = prior.cutting.teeth
     S, R = t.shape[0], n.size
@@ -290,7 +302,7 @@ def _limit_block(prior: ModalPrior, t, n, f) -> tuple[np.ndarray, np.ndarray]:
         best_f[sx[last], r] = np.where(qc[last] > 0, fc[last], np.nan)
     with np.errstate(divide="ignore"):
         limit = np.where(best_q > 0, 1.0 / np.where(best_q > 0, best_q, 1.0), np.inf)
-    return limit, best_f
+    return limit, best_f, _floor(q)
 
 
 def floor_limit(prior: ModalPrior, theta, freq_hz=None) -> np.ndarray:
@@ -314,14 +326,8 @@ def floor_limit(prior: ModalPrior, theta, freq_hz=None) -> np.ndarray:
     """
     t = np.atleast_2d(np.asarray(theta, float))
     f = prior.freq_grid() if freq_hz is None else np.asarray(freq_hz, float)
-    out = np.empty(t.shape[0])
-    for i in range(0, t.shape[0], _BLOCK):  # blocks, as limit_at_speeds: the (S, 2, F) temporaries stay small
-        tb = t[i: i + _BLOCK]
-        q = -2.0 * (_eigs(prior, tb)[:, :, None] * receptance(prior, tb, f)[:, None, :]).real
-        qmax = q.max(axis=(1, 2))
-        with np.errstate(divide="ignore"):
-            out[i: i + _BLOCK] = np.where(qmax > 0, 1.0 / np.where(qmax > 0, qmax, 1.0), np.inf)
-    return out
+    # blocks, as limit_at_speeds: the (S, 2, F) temporaries stay small
+    return np.concatenate([_floor(-2.0 * _mu(prior, t[i: i + _BLOCK], f).real) for i in range(0, t.shape[0], _BLOCK)])
 
 
 def growth_rate(prior: ModalPrior, theta, rpm, chatter_hz) -> np.ndarray:

@@ -570,7 +570,7 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
     rpm = np.array([c.rpm for c in cuts])
     depth = np.array([c.depth_m for c in cuts])
     stable = np.array([c.stable for c in cuts])
-    a_lim, f_c = limit_at_speeds(prior, theta, rpm, freq_hz)
+    a_lim, f_c, *floor = limit_at_speeds(prior, theta, rpm, freq_hz, floor=noisy_pocket is not None)
     # one factor per cut (C,), or per sample and cut (S, C): each sample's own SDM limit (update's own_sdm)
     lr = np.zeros((1, len(cuts))) if log_ratio is None else np.atleast_2d(np.asarray(log_ratio, float))
     # kappa_log_ratio (Q, C): the labels' likelihood a mixture over Q references' growth, one axis more (S, Q, C)
@@ -582,7 +582,7 @@ def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.
         dur = np.array([cut_duration_s if c.duration_s is None else c.duration_s for c in cuts], float)
         offset = offset + growth_offset(prior, theta, rpm, f_c, g, dur, kappa, kappa_log_ratio)
     if noisy_pocket is not None:  # a noisy shop hears chatter late at a pocket's top: ν h further up
-        offset = offset + ex(float(noisy_pocket) * pocket_height(prior, theta, a_lim * np.exp(lr), freq_hz))
+        offset = offset + ex(float(noisy_pocket) * pocket_height(prior, theta, a_lim * np.exp(lr), floor_m=floor[0]))
     with np.errstate(divide="ignore"):
         x = (ex(np.log(a_lim) + lr) + offset - np.log(depth)[None, :]) / np.asarray(boundary_width, float)
     x = np.where(np.isfinite(x), x, 50.0)  # no lobe reaches the speed: stable at any depth in the grid
@@ -695,12 +695,14 @@ _GROWTH_LR_MAX = 0.1  # |ln(a_SDM / a_ZOA)| at a cut beyond which its growth rat
 _GROWTH_CAP = 0.5  # ln: a chatter that cannot grow audibly within the cut leaves the label uninformative, not wild
 
 
-def pocket_height(prior: ModalPrior, theta, limit_m, freq_hz=None) -> np.ndarray:
+def pocket_height(prior: ModalPrior, theta, limit_m, freq_hz=None, *, floor_m=None) -> np.ndarray:
     """h = ln(a_lim / a_min) ≥ 0 of each sample's limits ``limit_m`` (S, ·), m, over its zero-order floor a_min
-    (:func:`~toolpoint.shop.model.floor_limit`): how high in its pocket a cut lies (0 on the lobes' floor; 4.3 at the
-    top of EM28-80's pocket, 75× its floor). 0 where the limit is not finite (no lobe reaches the speed)."""
+    (``floor_m`` (S,), else :func:`~toolpoint.shop.model.floor_limit` on ``freq_hz``): how high in its pocket a cut
+    lies (0 on the lobes' floor; 4.3 at the top of EM28-80's pocket, 75× its floor). 0 where the limit is not finite
+    (no lobe reaches the speed)."""
+    a_min = floor_limit(prior, theta, freq_hz) if floor_m is None else np.asarray(floor_m, float)
     with np.errstate(divide="ignore", invalid="ignore"):
-        h = np.log(np.asarray(limit_m, float)) - np.log(floor_limit(prior, theta, freq_hz))[:, None]
+        h = np.log(np.asarray(limit_m, float)) - np.log(a_min)[:, None]
     return np.where(np.isfinite(h), np.maximum(h, 0.0), 0.0)
 
 
@@ -1452,13 +1454,15 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     else:
         off_pick = off_mu + off_sd * z[pick, P]
 
+        floor_pick = floor_limit(prior, th_pick, f) if "noisy_pocket" in kw else None  # once, not per call
+
         def offset(ks):  # each lobe sample's label offset at the candidate speeds grid[ks], (m, len(ks))
             out = np.broadcast_to(off_pick[:, None], (m, len(ks)))
             if g_med > 0:
                 _, fc = limit_at_speeds(prior, th_pick, grid[ks], f)
                 out = out + growth_offset(prior, th_pick, grid[ks], fc, g_pick, duration(ks)[0])
-            if "noisy_pocket" in kw:  # the outcome heard in a noisy shop at a pocket's top
-                out = out + kw["noisy_pocket"] * pocket_height(prior, th_pick, lim[:, ks], f)
+            if floor_pick is not None:  # the outcome heard in a noisy shop at a pocket's top
+                out = out + kw["noisy_pocket"] * pocket_height(prior, th_pick, lim[:, ks], floor_m=floor_pick)
             return out
 
         # a noisy shop: no step above the stable cuts — the step is proposed whatever its P(chatter), on stable labels
