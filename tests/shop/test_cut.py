@@ -1312,6 +1312,37 @@ def test_the_real_recording_s_stable_cutting_reads_stable_wherever_the_record_st
         assert min(s.start_s for s in cut if s.verdict == "chatter") + shift < 9.7
 
 
+@pytest.mark.parametrize("air_s", [0.6, 0.45, 0.2])
+def test_a_short_air_cut_at_the_record_s_start_or_end_is_air_not_cutting(air_s):
+    """A recorder started 0.2–0.6 s before the tool comes in, or stopped as soon after it left: air shorter than an
+    air cut (0.6 s at 6000 rpm, 1.5 of the 0.4 s frames) is a pause where it lies between two cuts, not at the
+    record's ends. Taken for cutting there, it put the entry or the exit (the mode's ring as the tool comes in, the
+    tooth passing dying away) into a judged window: stable synthetic cuts read "chatter" at 391–409 Hz, beside the
+    400 Hz tooth passing — 2 of 2 seeds with 0.6 s of air at the start, with 0.2–0.6 s at the end (the code before
+    2026-12-06). Kept as air, the cut is stable, chatter is heard as with a long air cut, and the cut's length is
+    the cut's. With both ends that short the record holds no air cut to compare with, and says so."""
+    from toolpoint.shop.update import _cutting_s
+
+    for seed in (0, 1):
+        x, rate, t0, t1 = shop_record(rpm=6000.0, teeth=4, air_s=1.0, cut_s=3.0, mode_hz=700.0, seed=seed)
+        xc, *_ = shop_record(rpm=6000.0, teeth=4, air_s=1.0, cut_s=3.0, mode_hz=700.0, chatter_hz=1234.0,
+                             chatter_amp=0.1, seed=seed)
+        k = int((1.0 - air_s) * rate)
+        for part in (slice(k, None), slice(0, x.size - k)):
+            res = analyse_cut(x[part], rate, rpm=6000.0, teeth=4)
+            assert res.verdict == "stable", (seed, [(s.kind, round(s.start_s, 2), s.verdict) for s in res.segments])
+            kinds = [s.kind for s in res.segments]
+            assert kinds[:2] == ["air", "entry"] and kinds[-2:] == ["exit", "air"]
+            assert _cutting_s(res) == pytest.approx(t1 - t0, abs=0.15)  # the cut's length, not the air's with it
+            res = analyse_cut(xc[part], rate, rpm=6000.0, teeth=4)
+            assert res.verdict == "chatter" and res.chatter_hz == pytest.approx(1234.0, rel=2e-3)
+        # both ends short: the fans' tones (617, 1813 Hz) cannot be told from chatter without the air, and `cut` says
+        # why its "chatter" is in doubt
+        res = analyse_cut(x[k:x.size - k], rate, rpm=6000.0, teeth=4)
+        assert res.verdict == "chatter" and min(abs(res.chatter_hz - f) for f in (617.0, 1813.0)) < 2.0
+        assert any("shorter than an air cut (0.6 s)" in w for w in res.criterion["warnings"]), res.criterion["warnings"]
+
+
 @pytest.mark.parametrize("seed", [0, 2])
 def test_chatter_that_grows_as_the_tool_comes_into_the_part_is_chatter(seed):
     """A growth is read against the forced lines where those rise (the tool coming into the part): chatter that rises
