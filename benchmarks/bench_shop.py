@@ -1,7 +1,8 @@
 """Test cuts: ``cut`` speed and accuracy, ``update`` convergence over virtual campaigns (prints; not a test).
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_shop.py [--seeds 20] [--quick]
-        [--only cut|teeth|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard|bracket|prior-pocket|exact]
+        [--only cut|teeth|recorder|twocut|inside|update|sampler|forward|ceiling|sdm-bands|heard|bracket|prior-pocket|
+                exact]
         [--shops zoa,noisy,sdm,sim]
         [--cases cornelius,example]
         [--max-cuts 10] [--verbose] [--no-stop]
@@ -21,6 +22,8 @@ CPU time (time.process_time), not wall time: the machine is shared.
    drift, 25.6 kS/s).
    ``teeth``: the same simulated records judged with a wrong tooth count (N ± 1, 2 N, N / 2): the verdicts it
    changes and whether ``cut`` warns of the count, and the records warned at the right count.
+   ``recorder``: the same records started 50 ms later, stopped 50 ms earlier, 30 dB quieter, with offset and drift,
+   with 3 s more air: the verdicts each moves.
    ``twocut``: two of those records one after the other, at one speed (two depths: neither refused nor judged
    worse) or at two speeds ×1.31 apart (refused: one ``--rpm`` judges one speed).
    ``inside``: records taken inside a chattering cut, without air cut (windows of the real recording's chattering
@@ -329,6 +332,70 @@ class _TeethScore(_Score):
             print(f"   {kind}: {cnt['n']} records ({cnt['refused']} refused): verdict changed {cnt['changed']} "
                   f"({cnt['to_chatter']} to chatter), of them warned {cnt['changed_warned']}; warned in all "
                   f"{cnt['warned']}")
+
+
+class _RecorderScore(_Score):
+    """What the way a record was taken does to ``cut``: each record judged as heard and after a change that should
+    not matter — started 50 ms later (``later``) or stopped 50 ms earlier (``earlier``): the first or last samples
+    cut off; 30 dB quieter (``quiet``); a DC offset of 0.05 full scale with drifts at 0.3 Hz and 7 Hz (``drift``);
+    3 s more air before the cut, the record's own (``air``: 0.5 s of it from 0.05 s on, every other copy reversed
+    so that nothing jumps). Per change: the records whose verdict moved (to chatter), refused, and the verdicts
+    right against the SDM; see ``docs/design/shop.md``, *A short air cut at the record's start or end*."""
+
+    KINDS = ("as heard", "later", "earlier", "quiet", "drift", "air")
+
+    def __init__(self, record=None):
+        super().__init__(record)
+        self.count = {k: dict.fromkeys(("n", "refused", "changed", "to_chatter", "right"), 0) for k in self.KINDS}
+
+    @staticmethod
+    def changed(kind, x, rate):
+        k = int(0.05 * rate)
+        if kind == "later":
+            return x[k:]
+        if kind == "earlier":
+            return x[:x.size - k]
+        if kind == "quiet":
+            return x * 10 ** (-30 / 20)
+        if kind == "drift":
+            t = np.arange(x.size) / rate
+            y = x + 0.05 + 0.05 * np.sin(2 * np.pi * 0.3 * t) + 0.02 * np.sin(2 * np.pi * 7 * t)
+            return y / max(1.0, float(np.abs(y).max()) / 0.99)
+        if kind == "air":
+            air = x[k:k + int(0.5 * rate)]
+            return np.concatenate([air if j % 2 == 0 else air[::-1] for j in range(6)] + [x])
+        return x
+
+    def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
+        from toolpoint.errors import InputError
+
+        _, recs = self.heard(mm, c, rpm, depth, lim, seed, seed_level, rng)
+        for p, (x, rate) in recs.items():
+            self.n += 1
+            chatter = bool(rho[p] > 1)
+            ref = None
+            for kind in self.KINDS:
+                cnt = self.count[kind]
+                cnt["n"] += 1
+                try:
+                    r = analyse_cut(self.changed(kind, x, rate), rate, rpm=float(rpm[p]), teeth=c.teeth,
+                                    full_scale=self.full_scale)
+                except InputError:
+                    cnt["refused"] += 1
+                    continue
+                ref = r.verdict if kind == "as heard" else ref
+                moved = ref is not None and r.verdict != ref
+                cnt["changed"] += moved
+                cnt["to_chatter"] += moved and r.verdict == "chatter"
+                cnt["right"] += (r.verdict == "chatter") == chatter
+
+    def report(self, what):
+        print(f"{what}; {self.skipped} within ±5 % of the SDM limit left out), each judged as heard and as another "
+              "recorder would have taken it:")
+        for kind, cnt in self.count.items():
+            print(f"   {kind}: {cnt['n']} records, {cnt['refused']} refused, verdict right {cnt['right']}"
+                  + ("" if kind == "as heard" else
+                     f", changed against as heard {cnt['changed']} ({cnt['to_chatter']} to chatter)"))
 
 
 class _TwoCutScore(_Score):
@@ -998,8 +1065,8 @@ def main():
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed-start", type=int, default=0, help="first seed of the update benchmark")
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=("cut", "teeth", "twocut", "inside", "update", "sampler", "forward", "ceiling",
-                                       "sdm-bands", "heard", "bracket", "prior-pocket", "exact"))
+    ap.add_argument("--only", choices=("cut", "teeth", "recorder", "twocut", "inside", "update", "sampler", "forward",
+                                       "ceiling", "sdm-bands", "heard", "bracket", "prior-pocket", "exact"))
     ap.add_argument("--shops", default="zoa,noisy,sim",
                     help="comma-separated shops of the update benchmark (zoa, noisy, sdm, sim)")
     ap.add_argument("--cases", default="cornelius,example",
@@ -1046,6 +1113,18 @@ def main():
             pockets[tool] = prior_from_library(out, tool)
         bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level,
                           sensor=a.sensor, score=_TeethScore(sensor))
+    if a.only in (None, "recorder"):
+        sensor = SENSORS[a.sensor]
+        bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level, sensor=a.sensor,
+                      score=_RecorderScore(sensor), force_noise=a.force_noise)
+        pockets = {"cornelius": cornelius_2024(0.1), "example": example_tool(0.15)}
+        if a.library_prior:
+            from toolpoint.shop.prior import prior_from_library
+
+            out, tool = a.library_prior.rsplit(":", 1)
+            pockets[tool] = prior_from_library(out, tool)
+        bench_cut_pockets(a.quick, pockets, seed_start=a.pocket_truth_seed, seed_level=a.seed_level,
+                          sensor=a.sensor, score=_RecorderScore(sensor), force_noise=a.force_noise)
     if a.only in (None, "twocut"):
         bench_cut_sim(a.quick, seed_start=a.cut_truth_seed, seed_level=a.seed_level, sensor=a.sensor,
                       score=_TwoCutScore(SENSORS[a.sensor]))
