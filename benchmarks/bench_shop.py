@@ -23,7 +23,7 @@ CPU time (time.process_time), not wall time: the machine is shared.
    ``teeth``: the same simulated records judged with a wrong tooth count (N ± 1, 2 N, N / 2): the verdicts it
    changes and whether ``cut`` warns of the count, and the records warned at the right count.
    ``recorder``: the same records started 50 ms later, stopped 50 ms earlier, 30 dB quieter, with offset and drift,
-   with 3 s more air: the verdicts each moves.
+   with 3 s more air (a microphone's also in 16 bits 30 dB down, at 48 kHz, through MP3): the verdicts each moves.
    ``twocut``: two of those records one after the other, at one speed (two depths: neither refused nor judged
    worse) or at two speeds ×1.31 apart (refused: one ``--rpm`` judges one speed).
    ``inside``: records taken inside a chattering cut, without air cut (windows of the real recording's chattering
@@ -339,32 +339,56 @@ class _RecorderScore(_Score):
     not matter — started 50 ms later (``later``) or stopped 50 ms earlier (``earlier``): the first or last samples
     cut off; 30 dB quieter (``quiet``); a DC offset of 0.05 full scale with drifts at 0.3 Hz and 7 Hz (``drift``);
     3 s more air before the cut, the record's own (``air``: 0.5 s of it from 0.05 s on, every other copy reversed
-    so that nothing jumps). Per change: the records whose verdict moved (to chatter), refused, and the verdicts
-    right against the SDM; see ``docs/design/shop.md``, *A short air cut at the record's start or end*."""
+    so that nothing jumps); a sound file's also 30 dB quieter in 16 bits (``quiet 16-bit``), resampled to 48 kHz
+    (``48 kHz``) and through libsndfile's MP3 encoder at its default bit rate (``MP3``). Per change: the records
+    whose verdict moved (to chatter), refused, and the verdicts right against the SDM; see ``docs/design/shop.md``,
+    *A short air cut at the record's start or end*."""
 
     KINDS = ("as heard", "later", "earlier", "quiet", "drift", "air")
+    AUDIO = ("quiet 16-bit", "48 kHz", "MP3")  # a sound file's (full scale 1), not a DAQ's record in m/s²
 
     def __init__(self, record=None):
         super().__init__(record)
-        self.count = {k: dict.fromkeys(("n", "refused", "changed", "to_chatter", "right"), 0) for k in self.KINDS}
+        self.kinds = self.KINDS + (self.AUDIO if self.full_scale == 1.0 else ())
+        self.count = {k: dict.fromkeys(("n", "refused", "changed", "to_chatter", "right"), 0) for k in self.kinds}
 
     @staticmethod
     def changed(kind, x, rate):
+        """(the record as ``kind`` takes it, its rate Hz)."""
         k = int(0.05 * rate)
         if kind == "later":
-            return x[k:]
+            return x[k:], rate
         if kind == "earlier":
-            return x[:x.size - k]
+            return x[:x.size - k], rate
         if kind == "quiet":
-            return x * 10 ** (-30 / 20)
+            return x * 10 ** (-30 / 20), rate
         if kind == "drift":
             t = np.arange(x.size) / rate
             y = x + 0.05 + 0.05 * np.sin(2 * np.pi * 0.3 * t) + 0.02 * np.sin(2 * np.pi * 7 * t)
-            return y / max(1.0, float(np.abs(y).max()) / 0.99)
+            return y / max(1.0, float(np.abs(y).max()) / 0.99), rate
         if kind == "air":
             air = x[k:k + int(0.5 * rate)]
-            return np.concatenate([air if j % 2 == 0 else air[::-1] for j in range(6)] + [x])
-        return x
+            return np.concatenate([air if j % 2 == 0 else air[::-1] for j in range(6)] + [x]), rate
+        if kind == "quiet 16-bit":
+            return np.round(x * 10 ** (-30 / 20) * 32767) / 32767, rate
+        if kind == "48 kHz":
+            from fractions import Fraction
+
+            from scipy.signal import resample_poly
+
+            q = Fraction(48000, int(round(rate)))
+            return resample_poly(x, q.numerator, q.denominator), 48000.0
+        if kind == "MP3":
+            import io
+
+            import soundfile as sf
+
+            buf = io.BytesIO()
+            sf.write(buf, np.clip(x, -1.0, 1.0), int(round(rate)), format="MP3")
+            buf.seek(0)
+            y, r = sf.read(buf)
+            return y, float(r)
+        return x, rate
 
     def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
         from toolpoint.errors import InputError
@@ -374,12 +398,12 @@ class _RecorderScore(_Score):
             self.n += 1
             chatter = bool(rho[p] > 1)
             ref = None
-            for kind in self.KINDS:
+            for kind in self.kinds:
                 cnt = self.count[kind]
                 cnt["n"] += 1
+                y, r_y = self.changed(kind, x, rate)
                 try:
-                    r = analyse_cut(self.changed(kind, x, rate), rate, rpm=float(rpm[p]), teeth=c.teeth,
-                                    full_scale=self.full_scale)
+                    r = analyse_cut(y, r_y, rpm=float(rpm[p]), teeth=c.teeth, full_scale=self.full_scale)
                 except InputError:
                     cnt["refused"] += 1
                     continue
