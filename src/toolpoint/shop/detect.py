@@ -1696,7 +1696,7 @@ def _air_cut_runs(active, short_t, min_air, dur):
     the entry's ring into the first judged window, out of the entry's transient part: of 2 752 simulated records
     started 50 ms later (the pockets' 0.69 s of air before the cut then under the 0.6 s ``min_air`` of a slow
     spindle), 153 changed verdict, 145 of them stable cuts called chatter; kept as air, 6 (``docs/design/shop.md``,
-    *A short air cut at the record's start*)."""
+    *A short air cut at the record's start or end*)."""
     active = active.copy()
     edge = np.zeros(active.size, bool)
     for s, e, v in _runs(active):
