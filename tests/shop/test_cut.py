@@ -1312,6 +1312,21 @@ def test_the_real_recording_s_stable_cutting_reads_stable_wherever_the_record_st
         assert min(s.start_s for s in cut if s.verdict == "chatter") + shift < 9.7
 
 
+@pytest.mark.parametrize("start_s", [6.4, 6.6])
+def test_the_real_recording_started_just_before_the_tool_comes_in_keeps_its_air(start_s):
+    """The real recording started 0.3–0.5 s before its entry (6.9 s), under an air cut's 0.6 s: read as cutting, that
+    air put the entry into the first judged window, "chatter at 1068–1069 Hz" from the record's start (the code before
+    2026-12-06), where the whole record reads its first two seconds of cutting stable. Kept as air, it reads them as the
+    whole record does."""
+    rec = real_record()
+    rate = rec.rate_hz
+    res = analyse_cut(rec.samples[int(start_s * rate):], rate, rpm=6500, teeth=2, full_scale=1.0)
+    assert [s.kind for s in res.segments][:2] == ["air", "entry"]
+    cut = _cut_segments(res)
+    assert cut[0].verdict == "stable" and cut[0].end_s + start_s > 8.0, [(s.start_s, s.verdict) for s in cut]
+    assert res.verdict == "chatter" and res.chatter_hz == pytest.approx(1067.3, rel=2e-3)
+
+
 @pytest.mark.parametrize("air_s", [0.6, 0.45, 0.2])
 def test_a_short_air_cut_at_the_record_s_start_or_end_is_air_not_cutting(air_s):
     """A recorder started 0.2–0.6 s before the tool comes in, or stopped as soon after it left: air shorter than an
