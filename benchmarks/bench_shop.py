@@ -227,6 +227,7 @@ class _Score:
         self.right_sim = dict.fromkeys(THRESHOLDS, 0)
         self.false_alarm = dict.fromkeys(THRESHOLDS, 0)
         self.n = self.skipped = self.sim_agree = 0
+        self.refused = dict.fromkeys(THRESHOLDS, 0)  # refused in one line (InputError): counted as not right
         self.ferr, self.cpu_cut, self.audio_s = [], 0.0, 0.0
 
     def heard(self, mm, c, rpm, depth, lim, seed, seed_level, rng):
@@ -246,6 +247,8 @@ class _Score:
 
     def add(self, mm, c, rpm, depth, lim, rho, seed, seed_level, rng):
         """Simulate the points (rpm, depth) (their SDM limit ``lim`` and ρ), hear and judge them."""
+        from toolpoint.errors import InputError
+
         res, recs = self.heard(mm, c, rpm, depth, lim, seed, seed_level, rng)
         for p, (x, rate) in recs.items():
             chatter = bool(rho[p] > 1)
@@ -253,8 +256,15 @@ class _Score:
             self.sim_agree += chatter == (not res.stable[p])
             for thr in THRESHOLDS:
                 t0 = time.process_time()
-                r = analyse_cut(x, rate, rpm=float(rpm[p]), teeth=c.teeth, full_scale=self.full_scale, dominance=thr[0],
-                                alias_dominance=thr[1], growth_db=thr[2])
+                try:
+                    r = analyse_cut(x, rate, rpm=float(rpm[p]), teeth=c.teeth, full_scale=self.full_scale,
+                                    dominance=thr[0], alias_dominance=thr[1], growth_db=thr[2])
+                except InputError as e:  # e.g. a housing accelerometer that does not hear the spindle
+                    self.refused[thr] += 1
+                    if thr == THRESHOLDS[0]:
+                        print(f"   refused: {float(rpm[p]):.0f} rpm, {float(depth[p] / lim[p]):.2f} × the limit, "
+                              f"truth seed {seed}: {e}", flush=True)
+                    continue
                 if thr == THRESHOLDS[0]:
                     self.cpu_cut += time.process_time() - t0
                     self.audio_s += x.size / rate
@@ -273,7 +283,8 @@ class _Score:
             print(f"   dominance {thr[0]:g}, with an alias {thr[1]:g}, growth {thr[2]:g} dB"
                   f"{' (default)' if thr == THRESHOLDS[0] else ''}: "
                   f"{self.right[thr]}/{n} verdicts right "
-                  f"({self.right[thr] / n:.1%}), {self.false_alarm[thr]} false chatter; against the simulation's own "
+                  f"({self.right[thr] / n:.1%}), {self.false_alarm[thr]} false chatter"
+                  f"{f', {self.refused[thr]} refused' if self.refused[thr] else ''}; against the simulation's own "
                   f"verdict {self.right_sim[thr]}/{n} ({self.right_sim[thr] / n:.1%})")
         ferr = np.array(self.ferr)
         print(f"   chatter frequency (modulo tooth-passing aliases) vs the simulation's: median {np.median(ferr):.2%}, "
