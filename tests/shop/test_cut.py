@@ -1327,6 +1327,30 @@ def test_the_real_recording_started_just_before_the_tool_comes_in_keeps_its_air(
     assert res.verdict == "chatter" and res.chatter_hz == pytest.approx(1067.3, rel=2e-3)
 
 
+@pytest.mark.slow
+def test_takes_of_the_real_recording_joined_in_one_record_keep_their_air_cuts():
+    """Twelve takes of the real recording's first 30 s (air, entry at 6.9 s, cut to 16.2 s, air) put end to end, each
+    beginning as the file does, with the decoder's priming and 45 ms fade-in: as at each join of MP3 takes.
+    Counted together, the twelve brief dips passed for a level of their own, and split from the rest they "separated"
+    better than air cut and cut: the whole 6 min read as one cut, its air "chatter at 1770.7 Hz" (the code before
+    2026-12-06; 20 copies of the whole 63 s recording the same, at 2330 Hz). Now every take has its air, its entry and
+    exit where the recording has them, and its chatter at 1067 Hz."""
+    rec = real_record()
+    rate = rec.rate_hz
+    take = rec.samples[:int(30 * rate)]  # it begins as the file does: the decoder's priming, a 45 ms fade-in
+    take_s = take.size / rate
+    res = analyse_cut(np.tile(take, 12), rate, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=1.0)
+    assert res.verdict == "chatter" and res.chatter_hz == pytest.approx(1067.3, rel=2e-3)
+    assert sum(s.kind == "air" for s in res.segments) == 13
+    for kind, at in (("entry", 6.9), ("exit", 16.2)):
+        t = np.array([s.start_s for s in res.segments if s.kind == kind])
+        assert t.size == 12 and np.all(np.abs(t - take_s * np.arange(12) - at) < 0.4), (kind, t)
+    for k in range(12):
+        lines = [s.chatter_hz for s in _cut_segments(res) if k * take_s <= s.start_s < (k + 1) * take_s
+                 and s.verdict == "chatter"]
+        assert any(abs(f - 1067.3) < 2.0 for f in lines), (k, lines)
+
+
 @pytest.mark.parametrize("air_s", [0.6, 0.45, 0.2])
 def test_a_short_air_cut_at_the_record_s_start_or_end_is_air_not_cutting(air_s):
     """A recorder started 0.2–0.6 s before the tool comes in, or stopped as soon after it left: air shorter than an
