@@ -951,6 +951,32 @@ def test_stereo_channels_in_opposite_polarity_are_not_averaged_away(tmp_path):
     assert res.verdict == "chatter" and abs(res.chatter_hz / 1067.4 - 1) < 0.002
 
 
+def test_stereo_microphones_apart_are_not_averaged_into_a_notch(tmp_path, capsys):
+    """Two microphones a few cm apart hear a source off their axis at different times, and their mean has notches at
+    odd multiples of 1/(2τ). The real recording's channel with a copy of itself 0.47 ms later: the mean notched its
+    1067 Hz chatter out (read as chatter at 2135 Hz, its air as cutting). The reader sees the mean lose the band
+    (under a quarter of the channels' power in a third octave) and reads the loudest channel, and says so; the real
+    recording's own two channels (side by side: the mean keeps 0.94–1.0 in every band) are averaged as before."""
+    import soundfile as sf
+
+    x, rate = sf.read(REAL)
+    a = x[:, 0]
+    f = np.fft.rfftfreq(a.size, 1 / rate)
+    late = np.fft.irfft(np.fft.rfft(a) * np.exp(-2j * np.pi * f * 0.47e-3), a.size)
+    path = tmp_path / "apart.wav"
+    sf.write(path, np.c_[a, 0.9 * late], rate, subtype="FLOAT")
+    rec = read_cut_record(path)
+    assert rec.channel.startswith("0 (the loudest") and len(rec.warnings) == 1
+    assert "905–1140 Hz" in rec.warnings[0] and "--channel" in rec.warnings[0]
+    res = analyse_cut(rec.samples, rate, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=1.0)
+    assert res.verdict == "chatter" and res.chatter_hz == pytest.approx(1067.3, rel=2e-3)
+    assert main(["cut", str(path), "--rpm", "6500", "--teeth", "2", "--out", str(tmp_path / "c.json")]) == 0
+    assert "warning: the mean of the 2 channels keeps" in capsys.readouterr().err
+    assert json.loads((tmp_path / "c.json").read_text())["channel"].startswith("0 (the loudest")
+    real = read_cut_record(REAL)
+    assert real.channel == "mean of 2" and real.warnings == ()
+
+
 @pytest.mark.parametrize("start_s,end_s", [(10.0, 16.0), (10.0, 14.0), (9.6, 14.6), (10.0, 13.0)])
 def test_a_record_taken_inside_the_chattering_cut_is_not_split_into_air_and_cut(start_s, end_s):
     """The real recording's chattering stretch cut out as a record of its own. Its chatter waxes and wanes (the

@@ -41,7 +41,8 @@ def register(sub) -> None:
     p.add_argument("--rpm", required=True, help="nominal spindle speed, rpm (refined from the record)")
     p.add_argument("--teeth", required=True, help="number of teeth")
     p.add_argument("--rate", help="sampling rate, Hz (needed for a one-column table)")
-    p.add_argument("--channel", help="0-based channel / column (default: mean of audio channels)")
+    p.add_argument("--channel", help="0-based channel / column (default: the mean of audio channels; the loudest "
+                   "channel where the mean cancels in a band: microphones apart)")
     p.add_argument("--rpm-tolerance", default="0.03",
                    help="relative search range around --rpm for the spindle harmonics (default 0.03; 0 = exact)")
     p.add_argument("--window", default="1.0", help="length of the windows the cut is judged in, s (default 1)")
@@ -152,6 +153,6 @@ def run(args) -> int:
             + " (each with its air, to judge alone with --start/--end: "
             + ", ".join(f"{p0:.1f}–{p1:.1f} s" for p0, p1 in res.parts) + ")",
             file=sys.stderr if out is None else sys.stdout)
-    for w in res.criterion.get("warnings", ()):
+    for w in (*rec.warnings, *res.criterion.get("warnings", ())):
         print(f"{rec_path.name}: warning: {w}", file=sys.stderr)
     return 0

@@ -344,8 +344,9 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
             from .detect import analyse_cut
 
             rp = (p.parent / rec) if not Path(rec).is_absolute() else Path(rec)
-            if rp not in records:  # a session's record, one row per cut in it, is read once
+            if rp not in records:  # a session's record, one row per cut in it, is read once (and warned of once)
                 records[rp] = read_cut_record(rp)
+                warns += tuple(f"{rec}: {w}" for w in records[rp].warnings)
             r = records[rp]
             if span is not None and span[0] >= r.duration_s:
                 raise InputError(f"line {line}: {span[0]:g} s is after the end of its record {rec} "
@@ -362,7 +363,7 @@ def read_test_cuts(path: str | os.PathLike, *, teeth: int | None = None, cut_opt
                     raise InputError(f"line {line}: its record {what} was not judged: {why}", file=p,
                                      field="record") from None
                 a = None  # the table's own label stands, and the user hears why the record did not count
-                warns = (f"its record {what} was not judged ({why}); the table's '{res}' stands",)
+                warns += (f"its record {what} was not judged ({why}); the table's '{res}' stands",)
         if rec and a is not None:
             ran = a.criterion.get("speed_elsewhere_rpm")
             on_ran = a.chatter_hz is not None and ran is not None and _on_tooth_passing(a.chatter_hz, ran, a.teeth)
