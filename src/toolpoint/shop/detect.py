@@ -2643,11 +2643,11 @@ def _two_levels(e_db, n_min, activity_db):
     deviations), or None when either level lasts fewer than ``n_min`` frames or they differ by < ``activity_db``.
 
     A level lasts only in runs of ≥ ``n_min`` frames (after the smoothing), or at the record's ends (short air
-    before and after a cut: :func:`_air_cut_runs`): brief dips scattered through a long record — an MP3's 45 ms
-    fade-in at each join of takes put end to end, a wireless microphone's dropouts — are no air cut, however many
-    there are. Counted together they passed as one level before, and the few extreme frames
-    split off from the rest "separated" better than air cut and cut did: 20 copies of the real recording in one
-    21 min record read as one cut, their air chattering at 2330 Hz (18 copies: right)."""
+    before and after a cut: :func:`_air_cut_runs`): brief dips scattered through a long record (an MP3's 45 ms
+    fade-in at each join of takes put end to end) are no air cut, however many there are. Counted together they
+    passed as one level before, and the few extreme frames split off from the rest "separated" better than air cut
+    and cut did: 20 copies of the real recording in one 21 min record read as one cut, their air chattering at 2330
+    Hz (18 copies: right)."""
     thr = _otsu(e_db)
     hi_m, lo_m = e_db[e_db > thr], e_db[e_db <= thr]
     if min(hi_m.size, lo_m.size) < n_min or hi_m.mean() - lo_m.mean() < activity_db:
