@@ -247,9 +247,8 @@ def _read_audio(p: Path, channel: int | None) -> CutRecord:
     warns = ()
     if channel is None and data.shape[1] > 1:
         band = _mean_cancels(data, x, float(rate))
-        if band is not None:  # read the loudest channel instead, and say so
-            keep, lo, hi = band
-            k = int(np.argmax(np.var(data, axis=0, dtype=float)))
+        if band is not None:  # read the loudest channel (in the band the check read) instead, and say so
+            keep, lo, hi, k = band
             x, ch = data[:, k], f"{k} (the loudest; the mean of {data.shape[1]} cancels at {lo:.0f}–{hi:.0f} Hz)"
             warns = (f"the mean of the {data.shape[1]} channels keeps {100 * keep:.0f} % of their power at "
                      f"{lo:.0f}–{hi:.0f} Hz (microphones apart: the sound reaches them at different times and "
@@ -266,8 +265,9 @@ microphones side by side) 0.94–1.0 in every band; two microphones 15 cm apart 
 
 
 def _mean_cancels(data, mean, rate) -> tuple | None:
-    """(share kept, band's low Hz, high Hz) of the third-octave band (160 Hz – min(8 kHz, 0.45 rate)) where the
-    channels' mean keeps the least of their mean power, when that share is under :data:`_CANCEL_KEEP`; else None.
+    """(share kept, band's low Hz, high Hz, the loudest channel over the bands) of the third-octave band (160 Hz –
+    min(8 kHz, 0.45 rate)) where the channels' mean keeps the least of their mean power, when that share is under
+    :data:`_CANCEL_KEEP`; else None. The channels' powers come from the same spectra: no float64 copy of them all.
 
     Why: averaging two microphones a few cm apart comb-filters the sound (notches at odd multiples of 1/(2τ), τ their
     delay): the real recording's channels, one of them delayed by 0.47 ms, averaged to a record whose 1067 Hz chatter
@@ -278,8 +278,8 @@ def _mean_cancels(data, mean, rate) -> tuple | None:
     if data.shape[0] < 2 * nper:
         return None
     f, p_mean = welch(mean, rate, nperseg=nper, detrend=False)  # bands from 160 Hz: no offset reaches them
-    _, p_each = welch(data, rate, nperseg=nper, axis=0, detrend=False)  # float32 as read: no float64 copy
-    p_each = p_each.mean(axis=1)
+    _, p_ch = welch(data, rate, nperseg=nper, axis=0, detrend=False)  # (F, C), float32 as read
+    p_each = p_ch.mean(axis=1)
     worst = None
     centre = 160.0
     while centre * 2 ** (1 / 6) <= min(8000.0, 0.45 * rate):
@@ -290,7 +290,10 @@ def _mean_cancels(data, mean, rate) -> tuple | None:
             if worst is None or keep < worst[0]:
                 worst = (keep, lo, hi)
         centre *= 2 ** (1 / 3)
-    return worst if worst is not None and worst[0] < _CANCEL_KEEP else None
+    if worst is None or worst[0] >= _CANCEL_KEEP:
+        return None
+    inband = (f >= 160.0 * 2 ** (-1 / 6)) & (f <= min(8000.0, 0.45 * rate))
+    return (*worst, int(np.argmax(p_ch[inband].sum(axis=0))))
 
 
 def _read_uff(p: Path, channel: int | None) -> CutRecord:
