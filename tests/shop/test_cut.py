@@ -573,6 +573,67 @@ def test_the_spectra_computed_in_chunks_are_those_of_all_frames_at_once():
         np.testing.assert_array_equal(centres, np.arange(n) * hop + L / 2)
 
 
+def test_the_mean_of_chosen_frames_is_numpys_own_bit_for_bit():
+    """The mean spectrum of a run of frames is summed a chunk at a time instead of from a copy of the rows (a long
+    record's air cut held a fifth of its peak memory in one): NumPy's ``P[sel].mean(axis=0)`` exactly, for masks and
+    for index lists with repeats (frames that two runs share are counted twice, as before)."""
+    from toolpoint.shop.detect import _rows_mean
+
+    rng = np.random.default_rng(5)
+    P = rng.random((3000, 257)) ** 6 * 1e4
+    mask = rng.random(3000) < 0.7
+    idx = np.sort(rng.choice(3000, 2500, replace=True))
+    for sel in (mask, idx, idx[:40], np.flatnonzero(mask)):
+        np.testing.assert_array_equal(_rows_mean(P, sel, chunk=512), P[sel].mean(axis=0))
+
+
+def test_the_air_beside_the_harmonics_is_read_at_its_own_level():
+    """The long frame beside the harmonics compares a cut's line with the air cut's level there. The air's frame was
+    windowed whole and then cropped by the FFT to four times the cut's samples, part of a Hann window scaled as the
+    whole one: after 8 s of air (the most it takes) the air's level 3.0 dB low under a 1 s cut, 14 dB under a 0.5 s
+    one (the shortest it reads), so a line of the cut rose over the air by that much more (the code before
+    2026-12-06). White noise of one level in both: the same density to 0.5 dB (the medians of ≥ 2 000 periodogram
+    bins); a tone of one amplitude 4 × the cut's peak (the air's frame 4 × as long)."""
+    from toolpoint.shop.detect import _long_psd
+
+    rate = 44100.0
+    rng = np.random.default_rng(7)
+    for cut_s, air_s in ((0.5, 8.0), (1.0, 8.0), (3.0, 8.0), (2.0, 1.5)):
+        n = int(cut_s * rate)
+        f, p = _long_psd(rng.standard_normal(n), rate, n)
+        fa, pa = _long_psd(rng.standard_normal(int(air_s * rate)), rate, min(n, int(air_s * rate)))
+        band, band_a = (f > 500) & (f < 5000), (fa > 500) & (fa < 5000)
+        gap_db = 10 * np.log10(np.median(pa[band_a]) / np.median(p[band]))
+        assert abs(gap_db) < 0.5, (cut_s, air_s, gap_db)
+    # a noise-free tone: its density's peak grows with the frame, so the air's frame is the cut's length at most 4×
+    t = np.arange(int(8.0 * rate)) / rate
+    tone = np.sin(2 * np.pi * 1234.5 * t)
+    n = int(1.0 * rate)
+    _, p = _long_psd(tone[:n], rate, n)
+    _, pa = _long_psd(tone, rate, n)
+    assert 10 * np.log10(pa.max() / p.max()) == pytest.approx(10 * np.log10(4.0), abs=0.5)
+
+
+@pytest.mark.slow
+def test_a_long_record_s_analysis_holds_a_few_copies_of_it():
+    """Memory of a long record (the real recording four times over, 4.2 min): the analysis's own allocations at
+    their peak, as tracemalloc counts NumPy's, are at most 3.5 times the record's float64 samples — 3.1× measured,
+    6.2× before the spectra were kept only up to the band and the means taken without copies (2026-12-06:
+    ``docs/design/shop.md``, *A long record's memory*)."""
+    import tracemalloc
+
+    rec = real_record()
+    x = np.tile(rec.samples, 4)
+    tracemalloc.start()
+    try:
+        res = analyse_cut(x, rec.rate_hz, rpm=6500, teeth=2, rpm_tolerance=0.05, full_scale=1.0)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert res.verdict == "chatter" and res.chatter_hz == pytest.approx(1067.3, rel=2e-3)
+    assert peak <= 3.5 * x.nbytes, (peak / 1e6, x.nbytes / 1e6)
+
+
 def test_running_out_of_memory_is_one_line_and_writes_nothing(tmp_path, capsys, monkeypatch):
     """A record too long for the machine's memory (a whole session's recording): one line saying so and what to make
     smaller, exit 2, no traceback, no output file."""

@@ -698,7 +698,7 @@ def _stft(x, L, hop, chunk=1 << 21, bins=None):
     The frames are a strided view of ``x``, windowed and transformed ``chunk`` samples' worth at a time: all of them
     at once held ~14 copies of the record (3.8 GB for 10 min of 44.1 kHz audio), this the spectra and one chunk.
     ``bins``: only the lowest this many bins are kept."""
-    from scipy import fft as sfft  # as _long_psd's (there NumPy 1.26, CI's floor, is ~3× slower at odd lengths)
+    from scipy import fft as sfft  # NumPy 1.26 (CI's floor) is ~3× slower at odd lengths
 
     n_frames = 1 + (x.size - L) // hop
     w = np.hanning(L)
@@ -711,6 +711,19 @@ def _stft(x, L, hop, chunk=1 << 21, bins=None):
         spec = sfft.rfft(frames[s:s + step] * w, axis=1)[:, :nb]
         p[s:s + step] = (spec.real ** 2 + spec.imag ** 2) / norm
     return p, (np.arange(n_frames) * hop + L / 2)
+
+
+def _rows_mean(P, sel, chunk=512):
+    """``P[sel].mean(axis=0)`` without the copy of the rows: a cut's frames are most of a long record's spectra (an
+    air cut's mean held 188 MB of a 5 min record's 886 MB peak). Bit for bit the same: each chunk is summed onto
+    the running sum in order, as NumPy's reduction over axis 0 adds row after row."""
+    idx = np.flatnonzero(sel) if np.asarray(sel).dtype == bool else np.asarray(sel)
+    if idx.size <= chunk:
+        return P[idx].mean(axis=0)
+    acc = P[idx[:chunk]].sum(axis=0)
+    for s in range(chunk, idx.size, chunk):
+        acc = np.concatenate((acc[None], P[idx[s:s + chunk]])).sum(axis=0)
+    return acc / idx.size
 
 
 def _comb_score(freq, logp, floor, f0s, fmax):
@@ -1006,11 +1019,17 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     L = min(next_fast_len(int(math.ceil(max(0.1 * rate, min(40 * rate / f_nom, 0.4 * rate))))), max(256, x.size // 4))
     L += L % 2
     hop = L // 4
-    P, centres = _stft(x, L, hop)
-    frame_t = centres / rate
-    freq = np.fft.rfftfreq(L, 1 / rate)
     df = rate / L
     lo, hi = band_hz if band_hz is not None else (max(50.0, 0.5 * f_nom), min(0.45 * rate, 10_000.0))
+    # the spectra's bins up to the band's top, with a margin for the windows reaching past it (the speed's tolerance,
+    # two tooth-passing harmonics) and two of the floor's blocks (its blocks start at bin 0, so those in the band
+    # stay the same): at 44.1 kHz under half of them, and they are most of a long record's memory
+    nb = None
+    if math.isfinite(hi) and hi > 0:
+        nb = int(math.ceil((hi * (1 + max(rpm_tolerance, 0.005)) + 2 * teeth * f_nom) / df / _BLOCK) + 2) * _BLOCK
+    P, centres = _stft(x, L, hop, bins=nb)
+    frame_t = centres / rate
+    freq = np.fft.rfftfreq(L, 1 / rate)[:P.shape[1]]
     inband = (freq >= lo) & (freq <= hi)
     if inband.sum() < 3 * _BLOCK:
         raise InputError(f"the band {lo:.4g}–{hi:.4g} Hz holds only {int(inband.sum())} frequency lines at this "
@@ -1051,7 +1070,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         a = [frames_in(ta + 0.1, tb - 0.1) for ta, tb, v in rn if v is False and tb - ta > 0.3]
         a = np.concatenate(a) if a else np.array([], int)
         c = np.concatenate([frames_in(ta, tb) for ta, tb, v in rn if v]) if any(v for *_, v in rn) else None
-        return rn, a, (P[a].mean(axis=0) if a.size else None), c
+        return rn, a, (_rows_mean(P, a) if a.size else None), c
 
     runs, air, ref, cutting = parts(active)
     if cutting is None:
@@ -1089,7 +1108,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
 
     def spectrum(frames):
         """(mean power, its log, the log of its block-median floor) of these frames."""
-        mean_p = P[frames].mean(axis=0)
+        mean_p = _rows_mean(P, frames)
         return mean_p, np.log(mean_p + 1e-300), np.log(_block_floor(mean_p[None, :], inband)[0] + 1e-300)
 
     def spindle(frames):
@@ -1209,7 +1228,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         if alt[2] is not None and alt[3] is not None:
             g = spindle(alt[3])
             keep_g, harm_g = _harmonic_mask(freq, inband, g[0], g[0], df)
-            if _lines_held(P[alt[3]].mean(axis=0), alt[2], freq, keep_g, harm_g, g[0], df, louder_db=-np.inf) < 0.5:
+            if _lines_held(_rows_mean(P, alt[3]), alt[2], freq, keep_g, harm_g, g[0], df, louder_db=-np.inf) < 0.5:
                 runs, air, ref, cutting = alt
                 f_s, spindle_found, rev_s, elsewhere, comb = g
                 f_comb, cand = f_s, None
@@ -1222,11 +1241,11 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         # cut hears it. A run without a whole long frame is shorter than an air cut: a pause in the cut either way
         keep0, harm0 = _harmonic_mask(freq, inband, f_s, f_s, df)  # at the median speed: chatter a wrong reading
         # of the speed in a frame or two would mask is the line looked for
-        S_cut = P[cutting].mean(axis=0)
+        S_cut = _rows_mean(P, cutting)
         accepted = np.zeros_like(cand)
         for s, e, v in _runs(cand):
             whole = (frame_t - 0.5 * L / rate >= short_t[s]) & (frame_t + 0.5 * L / rate <= short_t[e - 1])
-            if v and (not whole.any() or _lines_held(S_cut, P[whole].mean(axis=0), freq, keep0, harm0, f_s, df)
+            if v and (not whole.any() or _lines_held(S_cut, _rows_mean(P, whole), freq, keep0, harm0, f_s, df)
                       >= 0.5):
                 accepted[s:e] = True
         if accepted.any():  # the split again, the air's prominence read from the quiet frames left
@@ -1584,14 +1603,21 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
     steady tones (fans, the spindle) do not move and cutting noise raises; then by the tooth-passing harmonics'
     prominence (module docstring, step 2 and *Automatic gain control*)."""
     Ls = max(64, (L // 8) & ~1)
-    Ps, cs = _stft(x, Ls, Ls // 2)
+    # the short frames' bins up to the band's top only: all that is read of them (the level, and the tooth passing's
+    # prominence, whose windows end within hi (1 + tol) + Δf), and the band a view, not a copy (both were 160 of a 5
+    # min record's 886 MB)
     fs_ = np.fft.rfftfreq(Ls, 1 / rate)
-    band_s = Ps[:, (fs_ >= lo) & (fs_ <= hi)]
+    nb = int(np.searchsorted(fs_, hi * (1 + max(rpm_tolerance, 0.005)) + 2 * rate / Ls, side="right"))
+    Ps, cs = _stft(x, Ls, Ls // 2, bins=nb)
+    fs_ = fs_[:Ps.shape[1]]
+    band_s = Ps[:, int(np.searchsorted(fs_, lo, side="left")):int(np.searchsorted(fs_, hi, side="right"))]
     active = np.ones(Ps.shape[0], bool)
     n_min = max(2, int(0.3 * rate / (Ls // 2)))  # each level must last 0.3 s: a few silent frames are no air cut
     if Ps.shape[0] >= 16:
         best_sep = 0.0
-        for e_db in (10 * np.log10(band_s.sum(axis=1) + 1e-300), 10 * np.log10(np.median(band_s, axis=1) + 1e-300)):
+        # the median a chunk of frames at a time: np.median sorts a copy of all it is given
+        med = np.concatenate([np.median(band_s[s:s + 4096], axis=1) for s in range(0, band_s.shape[0], 4096)])
+        for e_db in (10 * np.log10(band_s.sum(axis=1) + 1e-300), 10 * np.log10(med + 1e-300)):
             split = _two_levels(e_db, n_min, activity_db)
             if split is not None and split[1] > best_sep:
                 best_sep, active = split[1], split[0]
@@ -1667,12 +1693,12 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
                     ia, ib = np.searchsorted(short_t, frame_t - half), np.searchsorted(short_t, frame_t + half)
                     air = (ib > ia) & (n_cut[ib] == n_cut[ia])
                     keep = (freq >= lo) & (freq <= hi)
-                    S_air = P[air].mean(axis=0) if air.any() else None
+                    S_air = _rows_mean(P, air) if air.any() else None
                     for s, e, v in _runs(like_air):
                         if v and short_t[e - 1] - short_t[s] >= min_air:
                             run = (frame_t >= short_t[s]) & (frame_t <= short_t[e - 1])
                             if S_air is not None and run.any() and _lines_of_its_own(
-                                    P[run].mean(axis=0), S_air, freq, keep, np.zeros_like(keep), f_nom,
+                                    _rows_mean(P, run), S_air, freq, keep, np.zeros_like(keep), f_nom,
                                     freq[1] - freq[0]):
                                 continue
                             act[s:e] = False
@@ -2524,11 +2550,20 @@ _NEAR_HARMONICS = 8  # the lowest spindle harmonics searched
 
 
 def _long_psd(seg, rate, n):
-    """One Hann frame of ``n`` samples (zero-padded ×4): (frequencies Hz, power spectral density)."""
-    from scipy import fft as sfft  # 4 n is any length: NumPy 1.26's FFT (CI's floor) ~3× slower at odd ones
+    """One Hann frame over ``seg``, at most its first 4 ``n`` samples, zero-padded to 4 ``n``: (frequencies Hz, power
+    spectral density).
 
+    At most 4 ``n``: the air cut's frame (``n`` the cut's samples) was once windowed whole and then cropped by the FFT
+    to 4 ``n``, part of a Hann window scaled as the whole one: after 8 s of air the air's level 3.0 dB low under a 1 s
+    cut, 14 dB under a 0.5 s one. NumPy's FFT, not SciPy's: SciPy keeps the plans of its last 16 lengths, and a
+    Bluestein plan of an odd length of a few seconds' samples holds 20–50 MB (40 cuts of 7–8 s held 0.81 GB after
+    they were done; NumPy 2.4 0.05 GB, in the same CPU time). Not a fast length instead: the zero-padding's grid
+    moves which of two maxima 0.2 Hz apart heavy chatter 2.4 Hz beside a resonant harmonic is read at, and its
+    mirror's asymmetry from 20.8 to 7.0 dB (the one-mode pocket of ``test_cut_simulated``, 1.35 × its limit: stable
+    padded to 5 n or to the fast length next to 4 n, chatter padded to 3 n, 4 n, 8 n or another fast length)."""
+    seg = seg[:4 * n]
     w = np.hanning(seg.size)
-    z = sfft.rfft((seg - seg.mean()) * w, 4 * n)
+    z = np.fft.rfft((seg - seg.mean()) * w, 4 * n)
     return np.fft.rfftfreq(4 * n, 1.0 / rate), np.abs(z) ** 2 / (rate * float(np.sum(w * w)))
 
 
