@@ -404,7 +404,8 @@ class CutAnalysis:
         (chatter on a mains harmonic, 50 or 60 Hz × k within 2 Δf + 0.2 %, in a record without an air cut: hum
         from a ground loop is a steady tone there, and without the air cut only its strength is judged).
     time_s, freq_hz, power : ndarray
-        The spectrogram (frame centres s, frequencies Hz, power per bin) for the figure.
+        The spectrogram (frame centres s, frequencies Hz, power per bin) for the figure, up to a little past the
+        band judged (what the analysis reads; the bins above it were half a long record's memory).
     growth : ChatterGrowth or None
         How fast the chatter of the longest chattering cut grew (:func:`toolpoint.shop.growth.chatter_growth`: its
         rate σ, 1/s, or why it was not read); None when stable.
