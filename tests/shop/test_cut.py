@@ -3,6 +3,7 @@
 import dataclasses
 import functools
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -990,9 +991,12 @@ def test_a_record_that_does_not_hear_the_spindle_is_refused_not_judged(tmp_path,
     rec = real_record()
     a, b = 0, int(20 * rec.rate_hz)  # air, cut, chatter
     res = analyse_cut(rec.samples[a:b], rec.rate_hz, rpm=8000, teeth=2, full_scale=rec.full_scale)
-    said = [w for w in res.criterion["warnings"] if "range's edge" in w]
+    # where the harmonics do stand out: the best comb outside the range, or (since the record's loud blip at 6.6 s is
+    # no longer a cut of its own and the cut's stable first second is judged apart) its tooth passing there
+    said = [w for w in res.criterion["warnings"] if w.startswith("no spindle harmonics stand out")]
     assert len(said) == 1 and res.verdict == "chatter" and abs(res.chatter_hz / 1067.3 - 1) < 0.01
-    assert abs(float(said[0].split("; at ")[1].split(" rpm")[0]) / 6460 - 1) < 0.005
+    at = re.search(r"(?:; at|over the floor at) (\d+) rpm \(-19\.\d %\)", said[0])
+    assert at is not None and abs(float(at.group(1)) / 6460 - 1) < 0.005, said[0]
     ok = analyse_cut(rec.samples[a:b], rec.rate_hz, rpm=6460, teeth=2, rpm_tolerance=0.0, full_scale=rec.full_scale)
     assert ok.verdict == "chatter" and abs(ok.chatter_hz / 1067.3 - 1) < 0.01
 
@@ -1496,3 +1500,37 @@ def test_chatter_that_grows_as_the_tool_comes_into_the_part_is_chatter(seed):
                                   chatter_amp=0.1, ramp_s=ramp_s, seed=seed)
         res = analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0)
         assert res.verdict == "chatter" and res.chatter_hz == pytest.approx(1234.0 + 37 * seed, rel=0.01), ramp_s
+
+
+TALK = Path(__file__).resolve().parents[1] / "data" / "voice"
+
+
+def test_talk_in_the_air_before_a_cut_is_neither_a_cut_nor_the_air_s_reference():
+    """Someone talking near the phone in the air cut, at 0.3 × the cut's RMS (−10 dB: a raised voice near a phone
+    during a cut of ~85 dB): sentences spoken by espeak-ng (``tests/data/voice``, a speech model nobody here wrote)
+    over the shop records of ``shop_synth``. Before 2026-12-06 27 of 60 such records (10 cases × 6 utterances) were
+    judged wrong, stable cuts "chattering" at a fan's 617 or 1813 Hz: a loud syllable's frame was a "cut" of its own,
+    and the voice in the air's reference raised its floor, so the air was lowered "for a gain control" until the fan
+    rose 10 dB over it in the cut. Chatter stays heard at its frequency."""
+    import soundfile as sf
+    from scipy.signal import resample_poly
+
+    talks = []
+    for k in "abc":
+        v, r = sf.read(TALK / f"talk_{k}.flac")
+        assert r == 22050
+        talks.append(resample_poly(v, 2, 1))  # 44.1 kHz
+    cases = [(6000, 4, None, 0), (3000, 2, None, 4), (15000, 2, None, 6), (6000, 4, 1234.0, 1), (9000, 3, 2345.0, 3)]
+    for rpm, teeth, chatter, seed in cases:
+        x, rate, t0, t1 = shop_record(rpm=rpm, teeth=teeth, chatter_hz=chatter, chatter_amp=0.5, air_s=6.5, cut_s=3.0,
+                                      seed=seed)
+        rms = np.sqrt(np.mean(x[int(t0 * rate):int(t1 * rate)] ** 2))
+        for v in talks:
+            y = x.copy()
+            i = int(0.3 * rate)
+            y[i:i + v.size] += 0.3 * rms * v / np.sqrt(np.mean(v ** 2))
+            res = analyse_cut(y / 1.5, rate, rpm=rpm, teeth=teeth, full_scale=1.0)
+            if chatter is None:
+                assert res.verdict == "stable", (rpm, res.chatter_hz)
+            else:
+                assert res.verdict == "chatter" and abs(res.chatter_hz / chatter - 1) < 0.01, (rpm, res.chatter_hz)

@@ -552,6 +552,7 @@ def check_record(samples, rate_hz: float, rpm: float, teeth: int, *, full_scale:
                          f"{peak:.4g}; record with less gain", file=source, field="samples")
 
 
+_AIR_LOUD_DB = 3.0  # dB: air frames this much louder than the air's quieter quarter are left out of its reference
 _SILENCE_S = 0.02  # s: a run of equal samples this long is digital silence (a real record's noise never holds still)
 
 
@@ -1069,10 +1070,11 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         """(runs, the air cut's frames, its mean spectrum or None, the cutting frames or None)."""
         rn = _air_cut_runs(act, short_t, min_air, dur)
         a = [frames_in(ta + 0.1, tb - 0.1) for ta, tb, v in rn if v is False and tb - ta > 0.3]
-        a = np.concatenate(a) if a else np.array([], int)
+        a = _quiet_air(np.concatenate(a) if a else np.array([], int), lvl_db)
         c = np.concatenate([frames_in(ta, tb) for ta, tb, v in rn if v]) if any(v for *_, v in rn) else None
         return rn, a, (_rows_mean(P, a) if a.size else None), c
 
+    lvl_db = 10 * np.log10(P[:, inband].sum(axis=1) + 1e-300)
     runs, air, ref, cutting = parts(active)
     if cutting is None:
         raise InputError("no cutting found in the record (only air cut)", file=source, field="samples")
@@ -1621,7 +1623,7 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
         for e_db in (10 * np.log10(band_s.sum(axis=1) + 1e-300), 10 * np.log10(med + 1e-300)):
             split = _two_levels(e_db, n_min, activity_db)
             if split is not None and split[1] > best_sep:
-                best_sep, active = split[1], split[0]
+                best_sep, active = split[1], _no_blips(split[0], n_min)
     short_t = cs / rate
     min_air = max(0.5, 20 / f_nom, 1.5 * L / rate)  # an air cut is long enough to give a reference spectrum
     # how far the tooth-passing harmonics stand out: in the short frames where they resolve them (≥ 8 bins between
@@ -1644,7 +1646,7 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
         # cut and cut alike hides the cut's few dB. The tooth-passing harmonics stand out in the cut only
         split = _two_levels(prom, n_min, activity_db)
         if split is not None:
-            active = split[0]
+            active = _no_blips(split[0], n_min)
     elif prom is not None and (~active).sum() >= n_min:
         # quiet, but the tooth-passing harmonics stand out there as in the loud part: perhaps cutting all the same. A
         # record taken inside a cut (no air cut at all) is louder where chatter waxes and quieter where it wanes, and
@@ -2696,6 +2698,37 @@ def _two_levels(e_db, n_min, activity_db):
         return None
     sep = (hi_m.mean() - lo_m.mean()) / np.sqrt(0.5 * (hi_m.var() + lo_m.var()) + 1e-12)
     return up, float(sep)
+
+
+def _quiet_air(frames, lvl_db):
+    """The air cut's ``frames`` whose band level (``lvl_db``, dB per frame) lies within ``_AIR_LOUD_DB`` of their
+    quieter quarter's: the air's reference without what was loud in it only for a while (talk near the microphone).
+
+    Averaged in, a voice's formants raised the air's floor over much of the band, and the air was then "lowered for a
+    gain control" (:func:`_judge`) until a fan's steady line rose 10 dB over it in the cut: "chatter at 1813 Hz". The
+    air of a steady shop holds its level to a fraction of a dB over frames of thousands of bins, and keeps all of
+    them."""
+    if frames.size < 4:
+        return frames
+    lv = lvl_db[frames]
+    keep = lv <= np.percentile(lv, 25) + _AIR_LOUD_DB
+    return frames[keep]
+
+
+def _no_blips(up, n_min):
+    """``up`` without its runs shorter than ``n_min`` frames away from the record's ends, where a run of at least
+    ``n_min`` frames is also up: a loud blip in the air (a syllable of talk near the microphone, a knock) is no cut
+    when the record holds one. Judged as a cut of its own, its single long frame — mostly air — made a stable record
+    "chatter" at a fan's line; a record whose only loud run is short keeps it (a short cut is refused or judged on
+    what it holds, not dropped)."""
+    runs = _runs(up)
+    if not any(v and e - s >= n_min for s, e, v in runs):
+        return up
+    up = up.copy()
+    for s, e, v in runs:
+        if v and e - s < n_min and s > 0 and e < up.size:
+            up[s:e] = False
+    return up
 
 
 def _otsu(v):
