@@ -36,9 +36,10 @@ The detector (:func:`analyse_cut`):
    the loud stretches without tooth passing that are air all the same; when no level splits, as under a loud coolant
    that runs through air cut and cut, the prominence of the tooth-passing harmonics in the long frames splits it
    instead; a quiet stretch that is cutting all the same, as where chatter wanes in a record without air cut, see *A
-   record inside the cut* below); each cutting run gets an entry and an exit part (the first and last
-   ``max(0.2 s, 10 rev)``, at most 20 % of it) and its middle is cut in windows of ``window_s`` judged one by one
-   (neighbours with the same verdict merged);
+   record inside the cut* below); a loud run shorter than 0.3 s amid air (a syllable of talk near the microphone,
+   a knock) is air when the record holds a longer one; each cutting run gets an entry and an exit part (the first
+   and last ``max(0.2 s, 10 rev)``, at most 20 % of it) and its middle is cut in windows of ``window_s`` judged one
+   by one (neighbours with the same verdict merged);
 3. **harmonics removed** — every bin within ``2 Δf + 0.05 % f`` (the Hann window's main lobe, and the
    speed's wander) of a multiple of f_s is masked
    (runout included: all multiples, not only those of f_t). *A wandering spindle*: the speed of each cutting
@@ -76,7 +77,8 @@ The detector (:func:`analyse_cut`):
      0.004–0.04 (it ignored F's error and the heavier tail); α = 0.01 with the calibrated level is as sensitive
      as that was (t_α +0.9 … −0.1 dB from it over 2–80 frames), and now says what it holds;
    * *new*: when the record holds an air cut, only lines standing ``rise_db`` (10 dB) above the air
-     cut's spectrum are candidates (fans and pumps are there before the cut, chatter is not); of the
+     cut's spectrum are candidates (fans and pumps are there before the cut, chatter is not; the air's spectrum
+     leaves out its frames 3 dB louder than its quieter quarter, such as talk near the microphone); of the
      significant new lines the strongest in power is the one judged (a chatter cluster raises its own
      local floor, so the most significant line can be a weak isolated one);
    * *strong*: its power ≥ ``dominance`` (default 0.05, −13 dB) of the strongest spindle harmonic in the
