@@ -254,7 +254,38 @@ def _read_audio(p: Path, channel: int | None) -> CutRecord:
                      f"{lo:.0f}–{hi:.0f} Hz (microphones apart: the sound reaches them at different times and "
                      f"cancels there when averaged); channel {k}, the loudest, was read (`cut --channel` picks "
                      "another)",)
+    low = _low_bit_rate(p, sf)
+    if low is not None:
+        warns = (*warns, low)
     return CutRecord(np.asarray(x, float), float(rate), os.fspath(p), ch, full_scale=1.0, warnings=warns)
+
+
+_LOSSY = {"MPEG_LAYER_I": "MP1", "MPEG_LAYER_II": "MP2", "MPEG_LAYER_III": "MP3", "VORBIS": "Vorbis", "OPUS": "Opus"}
+_LOW_KBPS = 80.0
+"""A lossy file's mean bit rate under which the reader warns, kbit/s. At a low rate the perceptual coder's artefacts
+stand 22–27 dB under the strongest harmonic, where weak chatter's tooth-passing aliases are judged. Measured on
+simulated microphone records (``docs/design/shop.md``, *A phone's voice note*): of 576 grid records, Opus at 34
+kbit/s (a messenger's voice note) called 30 stable cuts chatter, against 0 uncompressed, at 72 kbit/s 0 (one verdict
+changed), at 136 kbit/s none changed; of 896, MP3 at 48 kbit/s 6 and Vorbis at 65 kbit/s 4 (and 7 chattering cuts
+missed), MP3 at 91 kbit/s 1. The real recording is an MP3 of 128 kbit/s."""
+
+
+def _low_bit_rate(p: Path, sf) -> str | None:
+    """A warning for an audio file coded lossily at under :data:`_LOW_KBPS` (its mean bit rate, from its size and
+    duration, the container's few bytes included), else None."""
+    try:
+        info = sf.info(p)
+    except (sf.LibsndfileError, RuntimeError, TypeError, ValueError, OSError):
+        return None
+    codec = _LOSSY.get(info.subtype)
+    if codec is None or not info.duration > 0:
+        return None
+    kbps = p.stat().st_size * 8 / info.duration / 1000
+    if kbps >= _LOW_KBPS:
+        return None
+    return (f"coded as {codec} at {kbps:.0f} kbit/s: a perceptual coder's artefacts can pass for weak chatter "
+            "(simulated records coded at 34–65 kbit/s: 0.8–5.4 % more verdicts wrong, most of them stable cuts "
+            "called chatter); record WAV or FLAC, or at 128 kbit/s or more")
 
 
 _CANCEL_KEEP = 0.25
