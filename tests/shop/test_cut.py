@@ -1562,6 +1562,7 @@ def test_a_record_coded_at_a_low_bit_rate_is_warned_of(tmp_path, capsys):
     assert main(["cut", str(low), "--rpm", "6500", "--teeth", "2", "--rpm-tolerance", "0.05",
                  "--out", str(tmp_path / "c.json")]) == 0
     assert "note.opus: warning: coded as Opus at" in capsys.readouterr().err
+    assert json.loads((tmp_path / "c.json").read_text())["record_warnings"] == list(said)
 
 
 def test_talk_during_a_stable_cut_that_reads_as_chatter_is_warned_of():

@@ -108,7 +108,8 @@ def run(args) -> int:
                       dominance=dominance, alias_dominance=alias_dominance, growth_db=growth_db,
                       hump_db=hump_db, full_scale=rec.full_scale, source=str(rec_path),
                       span_s=None if start is None and end is None else (start or 0.0, end or math.inf))
-    doc = {"record": str(rec_path), "channel": rec.channel, "rate_hz": rec.rate_hz, **res.to_dict()}
+    doc = {"record": str(rec_path), "channel": rec.channel, "rate_hz": rec.rate_hz,
+           "record_warnings": list(rec.warnings), **res.to_dict()}
     fig = None
     if plot is not None:
         use_agg()
