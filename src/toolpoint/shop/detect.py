@@ -1085,7 +1085,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         c = np.concatenate([frames_in(ta, tb) for ta, tb, v in rn if v]) if any(v for *_, v in rn) else None
         return rn, a, (_rows_mean(P, a) if a.size else None), c
 
-    lvl_db = 10 * np.log10(P[:, inband].sum(axis=1) + 1e-300)
+    ib0, ib1 = np.flatnonzero(inband)[[0, -1]]  # the band's bins are contiguous: a view, not a copy of them
+    lvl_db = 10 * np.log10(P[:, ib0:ib1 + 1].sum(axis=1) + 1e-300)
     runs, air, ref, cutting = parts(active)
     if cutting is None:
         raise InputError("no cutting found in the record (only air cut)", file=source, field="samples")
@@ -2451,7 +2452,7 @@ def _growing_line(Pseg, p, good, freq, df, z, t_a, rise_bins, h_pow, growth_db, 
     ``keep`` (the bins off the spindle harmonics) is given."""
     if Pseg.shape[0] < 6:
         return None
-    pk = np.flatnonzero(good[1:-1] & (p[1:-1] >= p[:-2]) & (p[1:-1] >= p[2:])) + 1
+    pk = _local_peaks(p, good)
     for i in pk[np.argsort(p[pk])[::-1][:8]]:
         g, t = _growth(Pseg, slice(i - 1, i + 2), forced)
         grew = g is not None and g >= growth_db and t >= _GROWTH_T
@@ -2490,6 +2491,11 @@ def _step_ratio(Pseg, bins) -> float:
     return float(rss.min() / max(rss_line, 1e-12))
 
 
+def _local_peaks(p, mask) -> np.ndarray:
+    """Bins of ``mask`` where ``p`` is a local maximum (≥ both neighbours; the ends excluded)."""
+    return np.flatnonzero(mask[1:-1] & (p[1:-1] >= p[:-2]) & (p[1:-1] >= p[2:])) + 1
+
+
 def _held(Pseg, i, keep, freq, df) -> bool:
     """Whether the line at bin ``i`` holds its frequency over the frames ``Pseg``: in ≥ ``_HELD_SHARE`` of the frames
     where the strongest of the ``keep`` bins within ±``_HELD_REL`` (and ±8 bins) of it stands ≥ ``_HELD_DB`` over their
@@ -2518,7 +2524,7 @@ def _glides(Pseg, p, good, i, keep, freq, df, f_t, top=8) -> bool:
     that steps in frequency as it saturates: it is a warning."""
     if _held(Pseg, i, keep, freq, df):
         return False
-    pk = np.flatnonzero(good[1:-1] & (p[1:-1] >= p[:-2]) & (p[1:-1] >= p[2:])) + 1
+    pk = _local_peaks(p, good)
     if pk.size == 0:
         return False
     f = freq[pk[np.argsort(p[pk])[::-1][:top]]]
