@@ -1512,6 +1512,26 @@ def test_talk_in_the_air_before_a_cut_is_neither_a_cut_nor_the_air_s_reference()
     judged wrong, stable cuts "chattering" at a fan's 617 or 1813 Hz: a loud syllable's frame was a "cut" of its own,
     and the voice in the air's reference raised its floor, so the air was lowered "for a gain control" until the fan
     rose 10 dB over it in the cut. Chatter stays heard at its frequency."""
+    cases = [(6000, 4, None, 0), (3000, 2, None, 4), (15000, 2, None, 6), (6000, 4, 1234.0, 1), (9000, 3, 2345.0, 3)]
+    assert len(list(_judged_with_talk_in_the_air(cases, 0.3, 1.5))) == 15
+
+
+def test_talk_as_loud_as_the_cut_in_the_air_is_no_cut():
+    """Talk in the air cut as loud as the cut (1 × its RMS): the level split takes the voice for cutting. Before
+    2026-12-06 (night) 5 of these 15 records were judged wrong (stable cuts "chattering" at a voice's harmonic). A
+    loud run of a sound file whose level comes and goes by ≥ 6 dB as speech does, and whose tooth passing stands out
+    as lines no further than in the air (or than noise), beside a cut whose stands ≥ 6 dB further out, is no cut:
+    left out, and said so. Chatter stays heard at its frequency."""
+    cases = [(3000, 2, None, 0), (6000, 4, None, 1), (12000, 4, None, 3), (4500, 6, 1234.0, 5), (6000, 4, 1234.0, 6)]
+    said = sum(any(" s is no cut: its level comes and goes" in w for w in res.criterion["warnings"])
+               for res in _judged_with_talk_in_the_air(cases, 1.0, 2.2))
+    assert said >= 10  # (syllables too short to read the level's spread stay cuts, judged: stable here)
+
+
+def _judged_with_talk_in_the_air(cases, level, scale):
+    """Each case (rpm, teeth, chatter Hz or None, seed) of ``shop_synth`` with 6.5 s of air around its 3 s cut, and
+    each of ``tests/data/voice``'s sentences added from 0.3 s at ``level`` × the cut's RMS, the sum / ``scale``,
+    judged: asserted stable, or chatter at its frequency; each result yielded."""
     import soundfile as sf
     from scipy.signal import resample_poly
 
@@ -1520,7 +1540,6 @@ def test_talk_in_the_air_before_a_cut_is_neither_a_cut_nor_the_air_s_reference()
         v, r = sf.read(TALK / f"talk_{k}.flac")
         assert r == 22050
         talks.append(resample_poly(v, 2, 1))  # 44.1 kHz
-    cases = [(6000, 4, None, 0), (3000, 2, None, 4), (15000, 2, None, 6), (6000, 4, 1234.0, 1), (9000, 3, 2345.0, 3)]
     for rpm, teeth, chatter, seed in cases:
         x, rate, t0, t1 = shop_record(rpm=rpm, teeth=teeth, chatter_hz=chatter, chatter_amp=0.5, air_s=6.5, cut_s=3.0,
                                       seed=seed)
@@ -1528,12 +1547,31 @@ def test_talk_in_the_air_before_a_cut_is_neither_a_cut_nor_the_air_s_reference()
         for v in talks:
             y = x.copy()
             i = int(0.3 * rate)
-            y[i:i + v.size] += 0.3 * rms * v / np.sqrt(np.mean(v ** 2))
-            res = analyse_cut(y / 1.5, rate, rpm=rpm, teeth=teeth, full_scale=1.0)
+            y[i:i + v.size] += level * rms * v / np.sqrt(np.mean(v ** 2))
+            res = analyse_cut(y / scale, rate, rpm=rpm, teeth=teeth, full_scale=1.0)
             if chatter is None:
                 assert res.verdict == "stable", (rpm, res.chatter_hz)
             else:
                 assert res.verdict == "chatter" and abs(res.chatter_hz / chatter - 1) < 0.01, (rpm, res.chatter_hz)
+            yield res
+
+
+def test_a_cut_whose_chatter_waxes_and_wanes_beside_a_stable_cut_is_kept():
+    """The talk rule's guard (above): two cuts in one sound file, a stable one and one whose chatter waxes and wanes
+    by 16 dB at 2 Hz — its level comes and goes as speech does (the rule's spread ≥ 6 dB) — or at 0.4 Hz as the real
+    recording's chatter swings: its tooth passing stands out as a cut's, so both are cuts and the record chatters."""
+    from toolpoint.shop.detect import _SPEECH_SPREAD_DB, _level_spread_db
+
+    for swing_hz in (2.0, 0.4):
+        a, rate, *_ = shop_record(rpm=6000.0, teeth=4, air_s=1.5, cut_s=3.0, seed=3)
+        b, _, t0, t1 = shop_record(rpm=6000.0, teeth=4, air_s=1.5, cut_s=3.0, chatter_hz=1234.0, chatter_amp=2.0,
+                                   chatter_swing_db=16.0, swing_hz=swing_hz, seed=4)
+        if swing_hz == 2.0:
+            assert _level_spread_db(b, rate, t0, t1, 100.0) >= _SPEECH_SPREAD_DB  # the level alone would drop it
+        res = analyse_cut(np.concatenate([a, b]) / 4, rate, rpm=6000, teeth=4, full_scale=1.0)
+        assert res.verdict == "chatter" and abs(res.chatter_hz / 1234.0 - 1) < 0.01, (swing_hz, res.chatter_hz)
+        assert not any("is no cut" in w for w in res.criterion["warnings"])
+        assert sum(sg.kind == "cut" for sg in res.segments) >= 2
 
 
 def test_a_record_coded_at_a_low_bit_rate_is_warned_of(tmp_path, capsys):
