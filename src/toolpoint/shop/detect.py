@@ -39,9 +39,12 @@ The detector (:func:`analyse_cut`):
    record inside the cut* below); a loud run shorter than 0.3 s amid air (a syllable of talk near the microphone,
    a knock) is air when the record holds a longer one; in a sound file, a loud run whose level comes and goes as
    speech does and in which the tooth passing drowns, beside a cut in which it stands out, is no cut (talk as loud
-   as the cut: :func:`_drowned_runs`; left out of the verdict, and warned of); each cutting run gets an entry and an
-   exit part (the first and last ``max(0.2 s, 10 rev)``, at most 20 % of it) and its middle is cut in windows of
-   ``window_s`` judged one by one (neighbours with the same verdict merged);
+   as the cut: :func:`_drowned_runs`; left out of the verdict, and warned of); a sound file whose whole level steps at
+   once, every line and the noise floor alike (takes recorded at different gains joined in one file), is judged with
+   each part scaled to one gain (:func:`_gain_steps`, warned of; a step read inside a cut is its chatter growing,
+   not a gain); each cutting run gets an entry and an exit part (the first and last ``max(0.2 s, 10 rev)``, at
+   most 20 % of it) and its middle is cut in windows of ``window_s`` judged one by one (neighbours with the same
+   verdict merged);
 3. **harmonics removed** — every bin within ``2 Δf + 0.05 % f`` (the Hann window's main lobe, and the
    speed's wander) of a multiple of f_s is masked
    (runout included: all multiples, not only those of f_t). *A wandering spindle*: the speed of each cutting
@@ -191,7 +194,9 @@ The detector (:func:`analyse_cut`):
    harmonics of the strongest line near k f_t over the median power within ±f_t/2 of it) does not move with the gain:
    a loud stretch whose prominence stays within ±2 dB of the air cut's own (smoothed over 9 short frames, or in the
    long frames where the short ones do not resolve the tooth-passing harmonics) for as long as an air cut lasts is
-   air. The veto acts only then, and only inside what the level called cutting: developed chatter lowers the
+   air. The veto acts only then, only where the loud frames unlike the air stand ≥ 4 dB over noise's own prominence
+   (in a loud shop whose cutting noise drowns the tooth passing everywhere, a chattering cut's 6 dB made the stable
+   cuts beside it "air"), and only inside what the level called cutting: developed chatter lowers the
    prominence too (heavy chatter at a pocket: 25–30 dB → 9–14 dB, the air 5–7 dB), a spindle whose own lines ring in
    air can raise the air's above the cut's, and shorter disagreements where the tool enters and leaves are left to
    the level. (b) The air cut as the reference of "new": the cut, recorded with less gain, stands less far above it
@@ -408,8 +413,9 @@ class CutAnalysis:
         stand out far more (None: none); ``analysed_rate_hz`` the rate the spectra were
         taken at (a record sampled above 50 kHz is decimated to 22–48 kHz first); ``digital_silence_s`` and
         ``spindle_off_s`` the spans left out, s (the recorder's input not live; the spindle not at speed at the
-        record's start or end, or stopped between two cuts: module docstring, step 2); ``warnings`` what the verdict
-        cannot rule out
+        record's start or end, or stopped between two cuts: module docstring, step 2); ``gain_steps`` [time s, dB]
+        where a sound file's whole level stepped (each part judged at the quietest part's gain, and the spectrogram
+        too: :func:`_gain_steps`); ``warnings`` what the verdict cannot rule out
         (chatter on a mains harmonic, 50 or 60 Hz × k within 2 Δf + 0.2 %, in a record without an air cut: hum
         from a ground loop is a steady tone there, and without the air cut only its strength is judged).
     time_s, freq_hz, power : ndarray
@@ -572,6 +578,103 @@ _DROWNED_DB = 6.0  # … whose tooth passing stands out as lines this much less 
 _NO_LINE_DB = 3.0  # … or no more than this (noise's own) …
 _CLEAR_CUT_DB = 6.0  # … beside a cut whose stands out this much further than both is no cut (_drowned_runs)
 _SILENCE_S = 0.02  # s: a run of equal samples this long is digital silence (a real record's noise never holds still)
+_GAIN_STEP_DB = 6.0  # dB: a sound file's level that steps this much at once, every line and the floor alike, …
+_GAIN_FLAT_DB = 2.0  # … its floor's shift the same over the band to this (half the 16–84 % range) …
+_GAIN_LINE_DB = 3.0  # … and nine in ten of its lines shifted alike to this …
+_GAIN_LINE_FLOOR_DB = 6.0  # … and as the floor was to this: a gain step (_gain_steps)
+_GAIN_SIDE_S = 1.0  # s: the level read this long on each side of a step …
+_GAIN_ABRUPT = 0.75  # … of which this share, and at most its inverse, is stepped within 0.2 s either side of it
+
+
+def _gain_steps(x, rate, P, frame_t, freq, inband, L, hop):
+    """[(time s, step dB)] where a record's gain steps: takes recorded at different gains joined in one file, a
+    recorder's input gain turned between cuts.
+
+    A step is read where the band level's median over ``_GAIN_SIDE_S`` after a point differs by ≥ ``_GAIN_STEP_DB``
+    from the median before it (frames that reach over the point left out), and kept where the record is the same
+    but for its gain: the block floor's shift the same over the band (half its 16–84 % range ≤ ``_GAIN_FLAT_DB``),
+    and the lines standing ≥ 10 dB out on its quieter side (fans, the spindle's, the tooth passing) shifted alike
+    (nine in ten within ``_GAIN_LINE_DB`` of their median), as the floor did (within ``_GAIN_LINE_FLOOR_DB``: a
+    room's noise varies more than its machines' tones); the step is the lines' shift where there are two or more. A
+    cut that begins raises the floor by its noise while the fans' lines stay where they were and the tooth passing
+    rises further; talk raises its formants' bands; chatter its own line: none of them moves everything alike. The
+    step is placed to 5 ms by the level of 5 ms blocks around it, and must be made there: ``_GAIN_ABRUPT`` … 1 /
+    ``_GAIN_ABRUPT`` of it within 0.2 s either side (a spindle running up is not a step, nor a cut that begins
+    within reach of a step read inside it)."""
+    n = P.shape[0]
+    dt = hop / rate
+    side = max(3, int(round(_GAIN_SIDE_S / dt)))
+    gap = int(math.ceil(0.5 * L / hop))  # frames centred within half a frame of the point reach over it
+    if n < 2 * (side + gap) + 1:
+        return []
+    ib0, ib1 = np.flatnonzero(inband)[[0, -1]]
+    lvl = 10 * np.log10(P[:, ib0:ib1 + 1].sum(axis=1) + 1e-300)
+    win = np.lib.stride_tricks.sliding_window_view(lvl, side)
+    med = np.median(win, axis=1)  # med[i]: the median over frames i … i + side − 1
+    # the point between frames c − 1 and c: before it frames c − gap − side … c − gap − 1, after it c + gap … c + gap +
+    # side − 1
+    c = np.arange(gap + side, n - gap - side + 1)
+    jump = med[c + gap] - med[c - gap - side]
+    big = np.abs(jump) >= _GAIN_STEP_DB
+    steps = []
+    last = -np.inf
+    for i in np.flatnonzero(big):
+        lo_, hi_ = max(0, i - side), min(jump.size, i + side + 1)
+        if abs(jump[i]) < np.abs(jump[lo_:hi_]).max() or c[i] - last < 2 * side:
+            continue  # not the largest jump within a side's reach of it, or too near the last one kept
+        # each bin's median over the frames of a side: a frame or two of the other side's sound (the point is known to
+        # a few frames only) would make a mean's lines shift alike by their share, -10 dB for one frame in ten
+        a = np.median(P[c[i] - gap - side:c[i] - gap], axis=0)
+        b = np.median(P[c[i] + gap:c[i] + gap + side], axis=0)
+        fl = _block_floor(np.vstack([a, b]), inband)
+        ok = inband & np.isfinite(fl).all(axis=0) & (fl > 0).all(axis=0)
+        if ok.sum() < 3 * _BLOCK:
+            continue
+        d = 10 * np.log10(fl[1, ok] / fl[0, ok])
+        shift = float(np.median(d))
+        p16, p84 = np.percentile(d, [16, 84])
+        if abs(shift) < _GAIN_STEP_DB or 0.5 * (p84 - p16) > _GAIN_FLAT_DB:
+            continue
+        # the lines of the quieter side (their power over the 3 bins of a main lobe), ≥ 10 dB over its floor
+        q, other, sgn = (a, b, 1.0) if shift > 0 else (b, a, -1.0)
+        fq = fl[0] if shift > 0 else fl[1]
+        pk = ok & (q > 10 * fq) & (q >= np.roll(q, 1)) & (q >= np.roll(q, -1))
+        pk[[0, -1]] = False
+        idx = np.flatnonzero(pk)
+        if idx.size >= 2:
+            s3 = lambda v: v[idx - 1] + v[idx] + v[idx + 1]  # noqa: E731
+            line = sgn * 10 * np.log10(s3(other) / s3(q))
+            moved = float(np.median(line))
+            if (float(np.percentile(np.abs(line - moved), 90)) > _GAIN_LINE_DB
+                    or abs(moved - shift) > _GAIN_LINE_FLOOR_DB):
+                continue
+            shift = moved  # the steady sources' lines gauge a gain better than a floor whose noise may vary
+        # where, to 5 ms: the split of the 5 ms blocks' levels near the point that fits two levels best; and at once:
+        # the level's medians over the 0.2 s either side of it step by _GAIN_ABRUPT … 1/_GAIN_ABRUPT of the shift (a
+        # spindle running up, a phone carried nearer, change the level over a second or more)
+        t_c = frame_t[c[i]] - 0.5 * dt
+        blk = max(1, int(0.005 * rate))
+        nb = int(round(0.2 * rate / blk))
+        reach = (gap + side // 2 + 1) * dt  # a median's jump is at its largest while half a side straddles the step
+        k0 = max(0, int((t_c - reach) * rate) // blk * blk - nb * blk)
+        e = x[k0:min(x.size, int((t_c + reach) * rate) + nb * blk)]
+        # in the band judged: below it a room's rumble differs from take to take
+        fe = np.fft.rfftfreq(e.size, 1 / rate)
+        e = np.fft.irfft(np.where((fe >= freq[inband][0]) & (fe <= freq[inband][-1]), np.fft.rfft(e), 0), e.size)
+        e = 10 * np.log10(np.add.reduceat(e ** 2, np.arange(0, e.size, blk)) / blk + 1e-300)
+        if e.size < 2 * nb + 4:
+            continue
+        mid = e[nb:e.size - nb]
+        cs, cs2 = np.cumsum(mid), np.cumsum(mid ** 2)
+        m = np.arange(1, mid.size)
+        sse = (cs2[:-1] - cs[:-1] ** 2 / m) + ((cs2[-1] - cs2[:-1]) - (cs[-1] - cs[:-1]) ** 2 / (mid.size - m))
+        j = nb + int(np.argmin(sse)) + 1  # the first block after the step
+        if not _GAIN_ABRUPT <= (np.median(e[j:j + nb]) - np.median(e[j - nb:j])) / shift <= 1 / _GAIN_ABRUPT:
+            continue
+        t_s = (k0 + j * blk) / rate
+        steps.append((t_s, shift))
+        last = c[i]
+    return steps
 
 
 def _live_part(x, rate, source):
@@ -906,7 +1009,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 rise_db: float = 10.0, dominance: float = 0.05, alias_dominance: float = 0.002,
                 growth_db: float = 6.0, alpha: float = _ALPHA, full_scale: float | None = None,
                 source: str | None = None, span_s: tuple | None = None, hump_db: float = _HUMP_DB,
-                _at_speed: bool = False) -> CutAnalysis:
+                _at_speed: bool = False, _gains: bool = False) -> CutAnalysis:
     """Judge a record of a milling cut: stable or chatter, per segment, with the chatter frequency.
 
     Parameters
@@ -1055,6 +1158,32 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         raise InputError(f"the band {lo:.4g}–{hi:.4g} Hz holds only {int(inband.sum())} frequency lines at this "
                          "record length", file=source, field="band_hz")
 
+    if full_scale is not None and not _gains:
+        # a sound file whose gain steps (takes recorded at different gains joined in one file, the recorder's gain
+        # turned between cuts): one air cut's reference and one level split over the whole record took a louder
+        # take's fans for chatter and its air for cutting. Judged with each part scaled to the quietest part's gain
+        steps = _gain_steps(x, rate, P, frame_t, freq, inband, L, hop)
+        while steps:
+            r0 = float(rate_hz)
+            at = np.array([int(round(t * r0)) for t, _ in steps])
+            g_db = np.concatenate([[0.0], np.cumsum([d for _, d in steps])])  # each part's gain against the first's
+            part = np.searchsorted(at, np.arange(x_in.size), side="right")
+            y = x_in * 10 ** (-(g_db - g_db.min()) / 20)[part]
+            res = analyse_cut(y, rate_hz, **kw, _gains=True)
+            # a take's join, a gain turned between cuts, lies in the air: a "step" within a cut is its chatter growing
+            # (a simulated cut 1.55 × its limit, all its family and its noise 7.6 dB up within 0.1 s), not a gain
+            in_air = [any(g.kind == "air" and g.start_s <= t <= g.end_s for g in res.segments) for t, _ in steps]
+            if not all(in_air):
+                steps = [st for st, ok in zip(steps, in_air) if ok]
+                continue
+            said = ", ".join(f"{t:.2f} s ({d:+.1f} dB)" for t, d in steps)
+            warns = [*res.criterion.get("warnings", ()), (
+                f"the record's level steps at {said}, its lines and its noise floor alike: takes recorded at "
+                "different gains joined in one file, or the recorder's gain turned between cuts? Each part was "
+                "scaled to one gain and judged so (judge the takes one by one to be sure: --start/--end)")]
+            return replace(res, criterion=dict(res.criterion, warnings=warns, gain_steps=[
+                [round(t, 4), round(d, 2)] for t, d in steps]))
+
     if not _at_speed and rpm_tolerance > 0:
         # the spindle starting, coasting down or standing still at the record's start or end (a phone started before
         # the spindle, stopped after it), or between two cuts (stopped and started again): quieter than the air cut
@@ -1067,7 +1196,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             r0 = float(rate_hz)
             idx = [(int(round(a * r0)), min(x_in.size, int(round(b * r0)))) for a, b in spans]
             y, starts, xf = _splice(x_in, r0, idx)
-            sub = analyse_cut(y, rate_hz, **kw, _at_speed=True)
+            sub = analyse_cut(y, rate_hz, **kw, _at_speed=True, _gains=True)
             if any(g.kind == "air" for g in sub.segments):
                 kept = [(i0 / r0, i1 / r0) for i0, i1 in idx]
                 ends = [0.0, *(t for sp in kept for t in sp), x_in.size / r0]
@@ -1705,8 +1834,8 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
         # cut's excess; the quiet part of the real chattering stretch 5.5 dB over and 0.73 of the loud part's
         # excess, of synthetic cuts ≥ 12 dB and ≥ 0.9. Short runs too: the veto below reads the air's prominence from
         # the other quiet frames
+        base = _noise_prominence_db(rate, frames, teeth * f_nom, tol, lo, hi)
         if active.sum() >= n_min:
-            base = _noise_prominence_db(rate, frames, teeth * f_nom, tol, lo, hi)
             ex_cut = float(np.median(prom[active])) - base
             for s, e, v in _runs(active):
                 if not v and float(np.median(prom[s:e])) - base >= max(_CUT_PROMINENCE_DB, 0.5 * ex_cut):
@@ -1734,7 +1863,12 @@ def _split(x, rate, L, P, freq, frame_t, lo, hi, f_nom, teeth, rpm_tolerance, ac
             act = act.copy()
             if (~act).sum() >= n_min:
                 like_air = act & (np.abs(prom - np.median(prom[~act])) <= _AIR_PROMINENCE_DB)
-                if (act & ~like_air).sum() >= n_min:
+                # and only where the tooth passing says "cut" somewhere: the loud frames unlike the air stand
+                # ≥ _CUT_PROMINENCE_DB over noise. In a loud shop whose cutting noise drowns the tooth passing (room
+                # noise 2.0 of tests/shop_synth.py: air and stable cuts alike 4.4–5.5 dB, noise's own 4.8), a
+                # chattering cut's 6.3 dB made every stable cut beside it "air"
+                unlike = act & ~like_air
+                if unlike.sum() >= n_min and float(np.median(prom[unlike])) - base >= _CUT_PROMINENCE_DB:
                     # the air's spectrum from the long frames wholly inside it: a frame reaching into a chattering
                     # stretch holds its chatter through the window
                     half = 0.5 * L / rate
