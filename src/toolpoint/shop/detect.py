@@ -1167,8 +1167,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             r0 = float(rate_hz)
             at = np.array([int(round(t * r0)) for t, _ in steps])
             g_db = np.concatenate([[0.0], np.cumsum([d for _, d in steps])])  # each part's gain against the first's
-            part = np.searchsorted(at, np.arange(x_in.size), side="right")
-            y = x_in * 10 ** (-(g_db - g_db.min()) / 20)[part]
+            y = np.empty_like(x_in)  # part by part: an index per sample was 8 bytes a sample of a long record
+            for k, (a, b) in enumerate(zip([0, *at], [*at, x_in.size])):
+                y[a:b] = x_in[a:b] * 10 ** (-(g_db[k] - g_db.min()) / 20)
             res = analyse_cut(y, rate_hz, **kw, _gains=True)
             # a take's join, a gain turned between cuts, lies in the air: a "step" within a cut is its chatter growing
             # (a simulated cut 1.55 × its limit, all its family and its noise 7.6 dB up within 0.1 s), not a gain
