@@ -1468,6 +1468,7 @@ def _each_take_right(res, truth):
                for s in res.segments if s.kind == "cut"), "a cut where none was made"
 
 
+@pytest.mark.slow
 def test_takes_recorded_at_different_gains_and_joined_are_each_judged_at_one_gain():
     """Five takes joined in one sound file, recorded at gains up to 15 dB apart (a phone moved, a recorder's gain
     turned): one air reference for all took the louder takes' fans for chatter ("chatter at 617 Hz" on a stable cut)
@@ -1481,6 +1482,10 @@ def test_takes_recorded_at_different_gains_and_joined_are_each_judged_at_one_gai
     # the 3 dB step is under the 6 dB looked for, and harmless; the 12 dB one read by the lines' shift to a dB or two
     assert len(steps) == 1 and abs(steps[0][0] - joins[1]) < 0.05 and abs(steps[0][1] - 12) < 2.5, steps
     assert any(w.startswith("the record's level steps at ") for w in res.criterion["warnings"])
+    # a part of the record (--start/--end) says its step in the record's times
+    part = analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0, span_s=(13.0, 40.0))
+    assert np.allclose(part.criterion["gain_steps"], steps, atol=1e-3)
+    assert any(w.startswith(f"the record's level steps at {steps[0][0]:.2f} s") for w in part.criterion["warnings"])
     # the same takes at one gain: no step read, nothing said
     x, rate, truth, _ = _takes(cases, [0.0] * 5, 0.05)
     res = analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0)

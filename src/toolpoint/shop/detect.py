@@ -1177,13 +1177,9 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             if not all(in_air):
                 steps = [st for st, ok in zip(steps, in_air) if ok]
                 continue
-            said = ", ".join(f"{t:.2f} s ({d:+.1f} dB)" for t, d in steps)
-            warns = [*res.criterion.get("warnings", ()), (
-                f"the record's level steps at {said}, its lines and its noise floor alike: takes recorded at "
-                "different gains joined in one file, or the recorder's gain turned between cuts? Each part was "
-                "scaled to one gain and judged so (judge the takes one by one to be sure: --start/--end)")]
-            return replace(res, criterion=dict(res.criterion, warnings=warns, gain_steps=[
-                [round(t, 4), round(d, 2)] for t, d in steps]))
+            steps = [[round(t, 4), round(d, 2)] for t, d in steps]
+            warns = [*res.criterion.get("warnings", ()), _gain_warning(steps)]
+            return replace(res, criterion=dict(res.criterion, warnings=warns, gain_steps=steps))
 
     if not _at_speed and rpm_tolerance > 0:
         # the spindle starting, coasting down or standing still at the record's start or end (a phone started before
@@ -2009,12 +2005,24 @@ def _harmonic_mask(freq, inband, f_lo, f_hi, df):
 
 def _spans_shifted(criterion: dict, t0: float) -> dict:
     """``criterion`` of a part of a record that starts at ``t0`` s, its spans of what was left out (digital silence,
-    the spindle not at speed) in the record's times."""
+    the spindle not at speed) and its gain steps in the record's times."""
     out = dict(criterion)
     for key in ("digital_silence_s", "spindle_off_s"):
         if key in out:
             out[key] = [[round(u + t0, 4), round(v + t0, 4)] for u, v in out[key]]
+    if "gain_steps" in out:  # and the warning that quotes them
+        was = _gain_warning(out["gain_steps"])
+        out["gain_steps"] = [[round(t + t0, 4), d] for t, d in out["gain_steps"]]
+        out["warnings"] = [_gain_warning(out["gain_steps"]) if w == was else w for w in out.get("warnings", ())]
     return out
+
+
+def _gain_warning(steps) -> str:
+    """The warning of :func:`_gain_steps`' ``steps`` [[time s, dB], …]."""
+    said = ", ".join(f"{t:.2f} s ({d:+.1f} dB)" for t, d in steps)
+    return (f"the record's level steps at {said}, its lines and its noise floor alike: takes recorded at different "
+            "gains joined in one file, or the recorder's gain turned between cuts? Each part was scaled to one gain "
+            "and judged so (judge the takes one by one to be sure: --start/--end)")
 
 
 def _shifted(res: CutAnalysis, t0: float, criterion: dict) -> CutAnalysis:
