@@ -1479,7 +1479,7 @@ def test_takes_recorded_at_different_gains_and_joined_are_each_judged_at_one_gai
     res = analyse_cut(x, rate, rpm=6000, teeth=4, full_scale=1.0)
     _each_take_right(res, truth)
     steps = res.criterion["gain_steps"]
-    # the 3 dB step is under the 6 dB looked for, and harmless; the 12 dB one read by the lines' shift to a dB or two
+    # the 3 dB step is under the 4 dB looked for, and harmless; the 12 dB one read by the lines' shift to a dB or two
     assert len(steps) == 1 and abs(steps[0][0] - joins[1]) < 0.05 and abs(steps[0][1] - 12) < 2.5, steps
     assert any(w.startswith("the record's level steps at ") for w in res.criterion["warnings"])
     # a part of the record (--start/--end) says its step in the record's times
@@ -1527,6 +1527,36 @@ def test_takes_of_the_real_recording_joined_in_one_record_keep_their_air_cuts():
         lines = [s.chatter_hz for s in _cut_segments(res) if k * take_s <= s.start_s < (k + 1) * take_s
                  and s.verdict == "chatter"]
         assert any(abs(f - 1067.3) < 2.0 for f in lines), (k, lines)
+
+
+@pytest.mark.slow
+def test_takes_of_the_real_recording_at_different_gains_are_each_judged_at_one_gain():
+    """The real recording's first 30 s, then the whole recording 12 dB quieter: two takes of a real shop joined, the
+    phone moved away between them. Real air is not the same from take to take: line by line the recording's air
+    before its cut and after it differ by 4–6 dB (nine in ten of its lines), and the code before 2026-12-07 asked
+    nine in ten within 3 dB of their shift, so it read no step here: the second take's cut went unfound, and 20 ms
+    at the record's start read "chatter at 1770 Hz". Now one step is read at the join (−9.8 dB, the lines' median
+    shift), and each take's cut chatters at 1067 Hz where it was made, with no cut in the air."""
+    rec = real_record()
+    rate = rec.rate_hz
+    first = rec.samples[:int(30 * rate)]
+    join = first.size / rate
+    res = analyse_cut(np.r_[first, rec.samples * 10 ** (-12 / 20)], rate, rpm=6500, teeth=2, rpm_tolerance=0.05,
+                      full_scale=1.0)
+    steps = res.criterion["gain_steps"]
+    assert len(steps) == 1 and abs(steps[0][0] - join) < 0.1 and -13 < steps[0][1] < -8, steps
+    for t0 in (0.0, join):  # the recording's cut: entry at 6.9 s, chatter from 9.1 s, exit at 16.2 s
+        lines = [s.chatter_hz for s in _cut_segments(res) if t0 + 9.5 < s.end_s and s.start_s < t0 + 16.0
+                 and s.verdict == "chatter"]
+        assert lines and all(abs(f / 1067.3 - 1) < 0.01 for f in lines), (t0, lines)
+    assert all(any(t0 + 6.6 < s.end_s and s.start_s < t0 + 16.6 for t0 in (0.0, join)) for s in _cut_segments(res))
+    # the plot shows the record at one gain, as judged, and says where it was scaled
+    from toolpoint.shop import plot_cut
+
+    fig = plot_cut(res)
+    assert [t.get_text() for t in fig.axes[0].texts if "gain step" in t.get_text()] == [
+        f" gain step {steps[0][1]:+.1f} dB"]
+    assert fig.axes[1].get_ylabel() == "mean power, dB (parts at one gain)"
 
 
 @pytest.mark.parametrize("air_s", [0.6, 0.45, 0.2])

@@ -578,12 +578,12 @@ _DROWNED_DB = 6.0  # … whose tooth passing stands out as lines this much less 
 _NO_LINE_DB = 3.0  # … or no more than this (noise's own) …
 _CLEAR_CUT_DB = 6.0  # … beside a cut whose stands out this much further than both is no cut (_drowned_runs)
 _SILENCE_S = 0.02  # s: a run of equal samples this long is digital silence (a real record's noise never holds still)
-_GAIN_STEP_DB = 6.0  # dB: a sound file's level that steps this much at once, every line and the floor alike, …
+_GAIN_STEP_DB = 4.0  # dB: a sound file's level that steps this much at once, every line and the floor alike, …
 _GAIN_FLAT_DB = 2.0  # … its floor's shift the same over the band to this (half the 16–84 % range) …
-_GAIN_LINE_DB = 3.0  # … and nine in ten of its lines shifted alike to this …
+_GAIN_LINE_DB = 7.0  # … and nine in ten of its lines shifted alike to this (real air: 4–6 dB from take to take) …
 _GAIN_LINE_FLOOR_DB = 6.0  # … and as the floor was to this: a gain step (_gain_steps)
 _GAIN_SIDE_S = 1.0  # s: the level read this long on each side of a step …
-_GAIN_ABRUPT = 0.75  # … of which this share, and at most its inverse, is stepped within 0.2 s either side of it
+_GAIN_ABRUPT = 2 / 3  # … of which this share, and at most its inverse, is stepped within 0.2 s either side of it
 
 
 def _gain_steps(x, rate, P, frame_t, freq, inband, L, hop):
@@ -591,16 +591,18 @@ def _gain_steps(x, rate, P, frame_t, freq, inband, L, hop):
     recorder's input gain turned between cuts.
 
     A step is read where the band level's median over ``_GAIN_SIDE_S`` after a point differs by ≥ ``_GAIN_STEP_DB``
-    from the median before it (frames that reach over the point left out), and kept where the record is the same
-    but for its gain: the block floor's shift the same over the band (half its 16–84 % range ≤ ``_GAIN_FLAT_DB``),
-    and the lines standing ≥ 10 dB out on its quieter side (fans, the spindle's, the tooth passing) shifted alike
-    (nine in ten within ``_GAIN_LINE_DB`` of their median), as the floor did (within ``_GAIN_LINE_FLOOR_DB``: a
-    room's noise varies more than its machines' tones); the step is the lines' shift where there are two or more. A
-    cut that begins raises the floor by its noise while the fans' lines stay where they were and the tooth passing
-    rises further; talk raises its formants' bands; chatter its own line: none of them moves everything alike. The
-    step is placed to 5 ms by the level of 5 ms blocks around it, and must be made there: ``_GAIN_ABRUPT`` … 1 /
-    ``_GAIN_ABRUPT`` of it within 0.2 s either side (a spindle running up is not a step, nor a cut that begins
-    within reach of a step read inside it)."""
+    from the median before it (frames that reach over the point left out), and kept where the record is the same but
+    for its gain: the block floor's shift the same over the band (half its 16–84 % range ≤ ``_GAIN_FLAT_DB``), and
+    the lines standing ≥ 10 dB out on its quieter side (fans, the spindle's, the tooth passing) shifted alike (nine
+    in ten within ``_GAIN_LINE_DB`` of their median: a real shop's air is not the same from take to take, the real
+    recording's before its cut and after it differ line by line by up to 4–6 dB), as the floor did (within
+    ``_GAIN_LINE_FLOOR_DB``: a room's noise varies more than its machines' tones); the step is the lines' shift
+    where there are two or more. A cut that begins raises the floor by its noise while the fans' lines stay where
+    they were and the tooth passing rises further; talk raises its formants' bands; chatter its own line: none of
+    them moves everything alike. The step is placed to 5 ms by the level of 5 ms blocks around it, and must be made
+    there: ``_GAIN_ABRUPT`` … 1 / ``_GAIN_ABRUPT`` of it within 0.2 s either side (a spindle running up is not a
+    step, nor a cut that begins within reach of a step read inside it), blocks 20 dB under the quieter side (an MP3
+    take's priming at its join) left out."""
     n = P.shape[0]
     dt = hop / rate
     side = max(3, int(round(_GAIN_SIDE_S / dt)))
@@ -664,12 +666,19 @@ def _gain_steps(x, rate, P, frame_t, freq, inband, L, hop):
         e = 10 * np.log10(np.add.reduceat(e ** 2, np.arange(0, e.size, blk)) / blk + 1e-300)
         if e.size < 2 * nb + 4:
             continue
+        # a block 20 dB under the quieter side belongs to neither: an MP3 take's priming and fade-in at its join (75 ms
+        # from -300 to -51 dB on the real recording), a dropout; kept, it pulls the split and the medians its way
+        floor_ = np.percentile(e, 25) - 20.0
+        dip = e < floor_
+        e = np.maximum(e, floor_)
         mid = e[nb:e.size - nb]
         cs, cs2 = np.cumsum(mid), np.cumsum(mid ** 2)
         m = np.arange(1, mid.size)
         sse = (cs2[:-1] - cs[:-1] ** 2 / m) + ((cs2[-1] - cs2[:-1]) - (cs[-1] - cs[:-1]) ** 2 / (mid.size - m))
         j = nb + int(np.argmin(sse)) + 1  # the first block after the step
-        if not _GAIN_ABRUPT <= (np.median(e[j:j + nb]) - np.median(e[j - nb:j])) / shift <= 1 / _GAIN_ABRUPT:
+        pre, post = e[j - nb:j][~dip[j - nb:j]], e[j:j + nb][~dip[j:j + nb]]
+        if min(pre.size, post.size) < nb // 2 or not (
+                _GAIN_ABRUPT <= (np.median(post) - np.median(pre)) / shift <= 1 / _GAIN_ABRUPT):
             continue
         t_s = (k0 + j * blk) / rate
         steps.append((t_s, shift))
@@ -3075,7 +3084,9 @@ def plot_cut(res: CutAnalysis, *, fmax_hz: float | None = None, title: str = "",
     bounds and, in a strip above it, their verdicts (narrow neighbours' labels on rows of their own, so they stay
     legible), the chatter frequency of each chattering segment in red. Bottom: the mean spectrum (dB) of the
     chattering part (else of the cut) against the air cut's, with the same harmonics and the chatter frequency
-    marked — what the test compares: a line between the harmonics that the air does not hold.
+    marked — what the test compares: a line between the harmonics that the air does not hold. Where the record's
+    gain steps (``criterion["gain_steps"]``), both panels show it with each part scaled to one gain, as judged, and
+    each step is marked (dash-dot, with its dB).
 
     Parameters
     ----------
@@ -3113,6 +3124,11 @@ def plot_cut(res: CutAnalysis, *, fmax_hz: float | None = None, title: str = "",
         db = np.insert(db, np.repeat(gap + 1, 2), np.nan, axis=1)
     mesh = ax.pcolormesh(tc, f, np.ma.masked_invalid(db), shading="nearest", vmin=top - 70, vmax=top, cmap="magma",
                          rasterized=True)
+    steps = res.criterion.get("gain_steps", ())
+    for t_s, d_db in steps:  # the spectrogram is of the record scaled to one gain: say where and by how much
+        ax.axvline(t_s, color="cyan", lw=1.0, ls="-.")
+        ax.text(t_s, 0.02, f" gain step {d_db:+.1f} dB", transform=blended_transform_factory(ax.transData,
+                ax.transAxes), ha="left", va="bottom", fontsize=7, color="cyan", rotation=90)
     for a, b in res.criterion.get("spindle_off_s", ()):
         ax.axvspan(a, b, color="0.85", zorder=0)
         ax.text(0.5 * (a + b), 0.5, "spindle\nnot at\nspeed", transform=blended_transform_factory(ax.transData,
@@ -3173,7 +3189,7 @@ def plot_cut(res: CutAnalysis, *, fmax_hz: float | None = None, title: str = "",
     ax2.plot([], [], color="tab:blue", ls="--", lw=0.6, label=f"tooth passing ({f_t:.1f} Hz × k)")
     ax2.set_xlim(0, fmax)
     ax2.set_xlabel("frequency, Hz")
-    ax2.set_ylabel("mean power, dB")
+    ax2.set_ylabel("mean power, dB" + (" (parts at one gain)" if steps else ""))
     ax2.legend(loc="upper right", fontsize=7)
     head = (f"{res.verdict}" + (f" at {res.chatter_hz:.1f} Hz" if res.chatter_hz else "")
             + (f"; Harmonizer speed {res.recommended_rpm:.0f} rpm" if res.recommended_rpm else "")
