@@ -5,7 +5,7 @@ Chatter detection from a record of a cut: microphone audio (WAV, FLAC, OGG, MP3)
 displacement time histories (CSV/text columns, time first; one column with ``--rate``; UFF58). Spindle
 and tooth-passing harmonics (all multiples of the spindle frequency: runout included) are removed, the
 strongest remaining peak is tested (:func:`toolpoint.shop.analyse_cut` documents the criterion), per
-segment (air cut, entry, cut windows, exit).
+segment (air cut, entry, cut windows, exit; talk near the microphone left out as ``talk``).
 
 ``cut.json``: ``verdict`` (stable|chatter), ``chatter_hz`` (null when stable), ``cuts`` (start_s, end_s, verdict,
 chatter_hz of each cut between air cuts, and part_s: the part that holds it with its air), ``segments`` (kind,

@@ -316,8 +316,9 @@ class CutSegment:
 
     Attributes
     ----------
-    kind : {"air", "entry", "cut", "exit", "whole"}
-        What the part is.
+    kind : {"air", "talk", "entry", "cut", "exit", "whole"}
+        What the part is: ``talk`` a loud stretch of a sound file left out as someone talking near the microphone
+        (its level comes and goes as speech does and the tooth passing drowns in it; warned of), air for the rest.
     start_s, end_s : float
         Its time span, s.
     verdict : {"air", "stable", "chatter", "transient"}
@@ -454,7 +455,7 @@ class CutAnalysis:
         frequency. A record of one test cut holds one; a session's record, one per cut."""
         out, run = [], []
         for g in (*self.segments, None):
-            if g is not None and g.kind != "air":
+            if g is not None and g.kind not in _AIR_KINDS:
                 run.append(g)
                 continue
             chat = [w for w in run if w.kind == "cut" and w.verdict == "chatter"]
@@ -474,8 +475,8 @@ class CutAnalysis:
         for a, b, *_ in self.cuts:
             i = next(k for k, g in enumerate(segs) if g.start_s == a)
             j = next(k for k, g in enumerate(segs) if g.end_s == b)
-            p0 = 0.5 * (segs[i - 1].start_s + a) if i > 0 and segs[i - 1].kind == "air" else a
-            p1 = 0.5 * (b + segs[j + 1].end_s) if j + 1 < len(segs) and segs[j + 1].kind == "air" else b
+            p0 = 0.5 * (segs[i - 1].start_s + a) if i > 0 and segs[i - 1].kind in _AIR_KINDS else a
+            p1 = 0.5 * (b + segs[j + 1].end_s) if j + 1 < len(segs) and segs[j + 1].kind in _AIR_KINDS else b
             out.append((p0, p1))
         return tuple(out)
 
@@ -577,6 +578,7 @@ _SPREAD_BLOCK_S = 0.01  # … in blocks this long at least, and a revolution (_l
 _DROWNED_DB = 6.0  # … whose tooth passing stands out as lines this much less than in the air (drowned) …
 _NO_LINE_DB = 3.0  # … or no more than this (noise's own) …
 _CLEAR_CUT_DB = 6.0  # … beside a cut whose stands out this much further than both is no cut (_drowned_runs)
+_AIR_KINDS = ("air", "talk")  # segments not cutting: the air, and talk left out of the verdict (_drowned_runs)
 _SILENCE_S = 0.02  # s: a run of equal samples this long is digital silence (a real record's noise never holds still)
 _GAIN_STEP_DB = 4.0  # dB: a sound file's level that steps this much at once, every line and the floor alike, …
 _GAIN_FLAT_DB = 2.0  # … its floor's shift the same over the band to this (half the 16–84 % range) …
@@ -1109,7 +1111,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         k0 = int(round(a * rate_hz))
         res = analyse_cut(x[k0:int(round(min(b, dur) * rate_hz))], rate_hz, **kw)
         crit = dict(res.criterion, span_s=[a, min(b, dur)])
-        if not any(g.kind == "air" for g in res.segments):  # the air cut may lie just outside the part given
+        if not any(g.kind in _AIR_KINDS for g in res.segments):  # the air cut may lie just outside the part given
             crit["warnings"] = [*crit.get("warnings", ()), (
                 f"the part {a:g}–{min(b, dur):.4g} s holds no air cut: its verdict rests on the cut alone (a chatter "
                 "line must stand out by its own strength, aliases or growth, not by rising over the air); where the "
@@ -1182,7 +1184,8 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             res = analyse_cut(y, rate_hz, **kw, _gains=True)
             # a take's join, a gain turned between cuts, lies in the air: a "step" within a cut is its chatter growing
             # (a simulated cut 1.55 × its limit, all its family and its noise 7.6 dB up within 0.1 s), not a gain
-            in_air = [any(g.kind == "air" and g.start_s <= t <= g.end_s for g in res.segments) for t, _ in steps]
+            in_air = [any(g.kind in _AIR_KINDS and g.start_s <= t <= g.end_s for g in res.segments)
+                      for t, _ in steps]
             if not all(in_air):
                 steps = [st for st, ok in zip(steps, in_air) if ok]
                 continue
@@ -1203,7 +1206,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
             idx = [(int(round(a * r0)), min(x_in.size, int(round(b * r0)))) for a, b in spans]
             y, starts, xf = _splice(x_in, r0, idx)
             sub = analyse_cut(y, rate_hz, **kw, _at_speed=True, _gains=True)
-            if any(g.kind == "air" for g in sub.segments):
+            if any(g.kind in _AIR_KINDS for g in sub.segments):
                 kept = [(i0 / r0, i1 / r0) for i0, i1 in idx]
                 ends = [0.0, *(t for sp in kept for t in sp), x_in.size / r0]
                 off = [[round(a, 4), round(b, 4)] for a, b in zip(ends[0::2], ends[1::2]) if b > a]
@@ -1520,10 +1523,11 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     # entry and exit exist when the record shows the tool going in and out: an air cut, or air at its ends too short
     # to be one
     has_air = ref is not None or any(v is None for *_, v in runs)
+    talk = {(ta, tb) for ta, tb, _ in not_cut}  # left out as talk (_drowned_runs): said so in cut.json too
     longest_run = 0.0  # s: the longest cutting run judged (entry and exit left out)
     for ta, tb, v in runs:
         if not v:
-            segments.append(CutSegment("air", ta, tb, "air"))
+            segments.append(CutSegment("talk" if (ta, tb) in talk else "air", ta, tb, "air"))
             continue
         edge = min(edge_s, 0.2 * (tb - ta))
         e_in = edge if (has_air and ta > 0) or not has_air else 0.0  # a record of the cut alone starts at rest
@@ -3145,8 +3149,8 @@ def plot_cut(res: CutAnalysis, *, fmax_hz: float | None = None, title: str = "",
                  lw=0.6 if tooth else 0.3, ls="--" if tooth else ":", alpha=0.7)
 
     harmonics(ax, True)
-    colours = {"air": "grey", "entry": "yellow", "exit": "yellow", "transient": "yellow", "stable": "green",
-               "chatter": "red"}
+    colours = {"air": "grey", "talk": "violet", "entry": "yellow", "exit": "yellow", "transient": "yellow",
+               "stable": "green", "chatter": "red"}
     strip = blended_transform_factory(ax.transData, ax.transAxes)
     span = max(t[-1] - t[0], 1e-9) if t.size > 1 else 1.0
     row, last_end = 0, -np.inf
