@@ -54,7 +54,11 @@ The detector (:func:`analyse_cut`):
    windows hold another family's lines wanders with them: the real recording given 12500 rpm and 4 teeth, its
    source project's plotting values, read its weak 861 Hz line beside the chatter's 852 Hz alias 0.9 % slow,
    masked the 1067 Hz chatter and called 599 Hz chatter), in frames of ≥ 0.4 s where the judging frames are
-   shorter and the cut holds five of them (lines 9 Hz apart merge in a 0.19 s frame's main lobe). Where it departs
+   shorter and the cut holds five of them (lines 9 Hz apart merge in a 0.19 s frame's main lobe). Where that track
+   wanders, the same harmonics are tracked again in frames twice as long, and a wander those do not read over the
+   same stretch is another family's, not the spindle's: their track is used (lines 7 Hz apart merge in a 0.4 s
+   frame's main lobe; the real recording played at 0.75 × its speed, its chatter 7 Hz under a tooth-passing
+   harmonic, was tracked 0.7 % slow in 0.4 s frames and read "chatter" at an alias family's weak line). Where it departs
    from its median by more than the mask's 0.05 %, each judged part masks every multiple of the speeds its
    frames ran at, k f_min − pad … k f_max + pad, and the harmonics' leakage into the floor is the Hann
    window's sidelobe envelope from their nearest position (a moving line is mostly off the bins). A spindle
@@ -1321,26 +1325,26 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
     # the mask allows, each judged part masks the harmonics over the range of speeds its frames ran at
     f_comb = f_s
 
-    long_track = []
+    long_track = {}
 
-    def track_spectra(frames):
-        """The tracker's (power, frame times s, freq Hz, in band, Δf Hz) over these frames: frames of ≥
-        _TRACK_FRAME_S (up to the highest harmonic tracked) where the judging frames are shorter and ≥ 5 of them lie
-        wholly inside these frames' stretches; else these frames."""
-        L2 = min(next_fast_len(int(math.ceil(_TRACK_FRAME_S * rate))), max(256, x.size // 4))
+    def track_spectra(frames, frame_s=_TRACK_FRAME_S):
+        """The tracker's (power, frame times s, freq Hz, in band, Δf Hz) over these frames: frames of ≥ ``frame_s``
+        (up to the highest harmonic tracked) where the judging frames are shorter and ≥ 5 of them lie wholly inside
+        these frames' stretches, else these frames; and whether the longer frames were used."""
+        L2 = min(next_fast_len(int(math.ceil(frame_s * rate))), max(256, x.size // 4))
         L2 += L2 % 2
         if L2 < 1.5 * L:
-            return P[frames], frame_t[frames], freq, inband, df
-        if not long_track:
+            return P[frames], frame_t[frames], freq, inband, df, False
+        if L2 not in long_track:
             df2 = rate / L2
             # the bins up to the highest harmonic's window, in the band: at most 2 hi / rate of the judging spectra's
-            # memory (0.45 at 44.1 kHz)
+            # memory (0.45 at 44.1 kHz); two of the floor's blocks at least (a spindle given in rev/s reads 2 Hz)
             f_top = min(hi, max(4 * teeth, 8) * f_nom * (1 + rpm_tolerance) ** 2)
-            nb = int(math.ceil(f_top / df2)) + 9
+            nb = max(int(math.ceil(f_top / df2)) + 9, 2 * _BLOCK)
             P2, c2 = _stft(x, L2, L2 // 4, bins=nb)
             f2 = np.arange(P2.shape[1]) * df2
-            long_track.append((P2, c2 / rate, f2, (f2 >= lo) & (f2 <= hi), df2, L2 / rate))
-        P2, t2, f2, in2, df2, w2 = long_track[0]
+            long_track[L2] = (P2, c2 / rate, f2, (f2 >= lo) & (f2 <= hi), df2, L2 / rate)
+        P2, t2, f2, in2, df2, w2 = long_track[L2]
         u = np.unique(frames)
         brk = np.flatnonzero(np.diff(u) > 4) + 1  # frames 4 hops apart still touch
         starts = frame_t[np.r_[u[0], u[brk]]] - 0.5 * L / rate
@@ -1349,24 +1353,44 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
         inside = np.any((t2[:, None] - 0.5 * w2 >= starts[None, :] - slack)
                         & (t2[:, None] + 0.5 * w2 <= ends[None, :] + slack), axis=1)
         if inside.sum() < 5:  # a cut shorter than ~2 long frames: its own frames (a long one would hear the air)
-            return P[frames], frame_t[frames], freq, inband, df
-        return P2[inside], t2[inside], f2, in2, df2
+            return P[frames], frame_t[frames], freq, inband, df, False
+        return P2[inside], t2[inside], f2, in2, df2, True
+
+    def steadiest(frames, frame_s=_TRACK_FRAME_S):
+        """(times s, spindle Hz, wander, long frames used) of the set of harmonics tracked that wanders least."""
+        Pt, tt, ft, it, dft, own = track_spectra(frames, frame_s)
+        tracks = [_track_speed(Pt, tt, ft, it, f_comb, o, rpm_tolerance, dft)
+                  for o in ((teeth * np.arange(1, 5), np.arange(1, 5)) if teeth > 1 else (np.arange(1, 5),))]
+        # the tooth-passing harmonics, or the four lowest spindle harmonics where they wander less over as many
+        # frames (half, at least): both follow one spindle, and a set whose windows hold another family's lines
+        # (a chatter's aliases f_c + i f_t a few Hz from them) wanders with it — the real recording given 6567
+        # rpm and 4 or 3 teeth: its weak 4th, 8th … (3rd, 6th …) spindle harmonics wandered 1.0 (1.4) % during
+        # its chatter, its strong 1st–4th 0.17 %
+        tracks = [(t_f, f_f, float(np.max(np.abs(f_f / np.median(f_f) - 1))) if t_f.size >= 3 else np.inf)
+                  for t_f, f_f in tracks]
+        most = max(t[0].size for t in tracks)
+        t_f, f_f, wan = min((t for t in tracks if t[0].size >= 0.5 * most), key=lambda t: t[2])
+        return t_f, f_f, wan, own
 
     def tracked(frames):
         """(the speed track (times s, Hz) or None, its wander, the spindle frequency Hz) over these frames."""
         if rpm_tolerance > 0 and frames.size >= 3 and comb[3] is None:  # a chatter's family: not the speed's lines
-            Pt, tt, ft, it, dft = track_spectra(frames)
-            tracks = [_track_speed(Pt, tt, ft, it, f_comb, o, rpm_tolerance, dft)
-                      for o in ((teeth * np.arange(1, 5), np.arange(1, 5)) if teeth > 1 else (np.arange(1, 5),))]
-            # the tooth-passing harmonics, or the four lowest spindle harmonics where they wander less over as many
-            # frames (half, at least): both follow one spindle, and a set whose windows hold another family's lines
-            # (a chatter's aliases f_c + i f_t a few Hz from them) wanders with it — the real recording given 6567
-            # rpm and 4 or 3 teeth: its weak 4th, 8th … (3rd, 6th …) spindle harmonics wandered 1.0 (1.4) % during
-            # its chatter, its strong 1st–4th 0.17 %
-            tracks = [(t_f, f_f, float(np.max(np.abs(f_f / np.median(f_f) - 1))) if t_f.size >= 3 else np.inf)
-                      for t_f, f_f in tracks]
-            most = max(t[0].size for t in tracks)
-            t_f, f_f, wan = min((t for t in tracks if t[0].size >= 0.5 * most), key=lambda t: t[2])
+            t_f, f_f, wan, _ = steadiest(frames)
+            if t_f.size >= 3 and wan > _TRACK_REL:
+                # a wander that frames twice as long do not read over the same stretch is no spindle's: lines of
+                # another family inside the short frames' main lobes pull their peaks. The real recording played at
+                # 0.75 × its speed: the chatter 7 Hz under the 5th tooth-passing harmonic, its aliases as near the
+                # lower ones, whose 0.4 s frames (bins of 2.5 Hz) read the spindle 0.66–0.73 % slow for 2 s in
+                # mid-cut, its 0.8 s frames 0.04–0.08 %: the masks widened with the track and hid the chatter, read
+                # at an alias family's weak line (1598.8 Hz for 800.5). At its own speed the short frames read 0.18 %,
+                # at the entry and the exit, where the spindle runs faster out of the cut, and 0.054 % between them,
+                # the long ones 0.037 %: kept
+                t_l, f_l, wan_l, own = steadiest(frames, 2 * _TRACK_FRAME_S)
+                if own and t_l.size >= 3:
+                    inner = (t_f >= t_l.min()) & (t_f <= t_l.max())
+                    wan_in = float(np.max(np.abs(f_f[inner] / np.median(f_f) - 1))) if inner.sum() >= 3 else 0.0
+                    if wan_in > max(2 * _TRACK_REL, 2 * wan_l):
+                        t_f, f_f, wan = t_l, f_l, wan_l
             if t_f.size >= 3:
                 if wan > _TRACK_REL:
                     return (t_f, f_f), wan, float(np.median(f_f))
