@@ -56,9 +56,10 @@ The detector (:func:`analyse_cut`):
    masked the 1067 Hz chatter and called 599 Hz chatter), in frames of ≥ 0.4 s where the judging frames are
    shorter and the cut holds five of them (lines 9 Hz apart merge in a 0.19 s frame's main lobe). Where that track
    wanders, the same harmonics are tracked again in frames twice as long, and a wander those do not read over the
-   same stretch is another family's, not the spindle's: their track is used (lines 7 Hz apart merge in a 0.4 s
-   frame's main lobe; the real recording played at 0.75 × its speed, its chatter 7 Hz under a tooth-passing
-   harmonic, was tracked 0.7 % slow in 0.4 s frames and read "chatter" at an alias family's weak line). Where it departs
+   same stretch, averaged as they would read it, is another family's, not the spindle's: their track is used (lines
+   7 Hz apart merge in a 0.4 s frame's main lobe; the real recording played at 0.75 × its speed, its chatter 7 Hz
+   under a tooth-passing harmonic, was tracked 0.7 % slow in 0.4 s frames and read "chatter" at an alias family's
+   weak line). Where it departs
    from its median by more than the mask's 0.05 %, each judged part masks every multiple of the speeds its
    frames ran at, k f_min − pad … k f_max + pad, and the harmonics' leakage into the floor is the Hann
    window's sidelobe envelope from their nearest position (a moving line is mostly off the bins). A spindle
@@ -1382,15 +1383,24 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                 # 0.75 × its speed: the chatter 7 Hz under the 5th tooth-passing harmonic, its aliases as near the
                 # lower ones, whose 0.4 s frames (bins of 2.5 Hz) read the spindle 0.66–0.73 % slow for 2 s in
                 # mid-cut, its 0.8 s frames 0.04–0.08 %: the masks widened with the track and hid the chatter, read
-                # at an alias family's weak line (1598.8 Hz for 800.5). At its own speed the short frames read 0.18 %,
-                # at the entry and the exit, where the spindle runs faster out of the cut, and 0.054 % between them,
-                # the long ones 0.037 %: kept
+                # at an alias family's weak line (1598.8 Hz for 800.5). The short track is compared as the long
+                # frames would read it, and the long one used where they differ by more than ¾ of the short track's
+                # wander (and 0.1 %): 0.66–0.71 % there; 0.068 % on the recording at its own speed (its spindle runs
+                # 0.1–0.2 % faster out of the cut, at the entry and the exit), 0.01–0.13 % for a spindle wandering
+                # ±0.3 % at 0.25–2 Hz (kept: its 0.8 s frames, which average a 1 Hz wander out, read it 0.006 %)
                 t_l, f_l, wan_l, own = steadiest(frames, 2 * _TRACK_FRAME_S)
                 if own and t_l.size >= 3:
-                    inner = (t_f >= t_l.min()) & (t_f <= t_l.max())
-                    wan_in = float(np.max(np.abs(f_f[inner] / np.median(f_f) - 1))) if inner.sum() >= 3 else 0.0
-                    if wan_in > max(2 * _TRACK_REL, 2 * wan_l):
-                        t_f, f_f, wan = t_l, f_l, wan_l
+                    # the short track as the long frames would read it (Hann-weighted over each long frame): a
+                    # spindle's own wander, however fast, reads alike both ways (±0.3 % at 1 Hz: 0.8 s frames
+                    # average it out, and so does this)
+                    w_l = 2 * _TRACK_FRAME_S
+                    wt = np.clip(0.5 + 0.5 * np.cos(2 * np.pi * (t_f[None, :] - t_l[:, None]) / w_l), 0, None) * \
+                        (np.abs(t_f[None, :] - t_l[:, None]) < 0.5 * w_l)
+                    seen = wt.sum(axis=1) > 0
+                    if seen.sum() >= 3:
+                        as_long = (wt[seen] @ f_f) / wt[seen].sum(axis=1)
+                        if float(np.max(np.abs(as_long / f_l[seen] - 1))) > max(2 * _TRACK_REL, 0.75 * wan):
+                            t_f, f_f, wan = t_l, f_l, wan_l
             if t_f.size >= 3:
                 if wan > _TRACK_REL:
                     return (t_f, f_f), wan, float(np.median(f_f))
