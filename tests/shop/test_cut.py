@@ -1192,7 +1192,11 @@ def test_a_tooth_count_the_record_contradicts_is_warned():
     assert not _teeth_warning(right)
     res = analyse_cut(rec.samples, rec.rate_hz, rpm=6500, teeth=3, full_scale=rec.full_scale)
     w = _teeth_warning(res)
-    assert len(w) == 1 and "multiples of 2 (215.3 Hz" in w[0] and "not of the 3 teeth given" in w[0], w
+    # the tooth passing in the cut, 215.3 Hz by hand; the spindle wanders 0.1–0.2 % (215.6–215.8 Hz at the entry and
+    # exit); given 3 teeth, 215.4 Hz since the tracker's second look in longer frames (2026-12-07)
+    assert len(w) == 1 and "not of the 3 teeth given" in w[0], w
+    f_t = float(re.search(r"multiples of 2 \(([\d.]+) Hz", w[0]).group(1))
+    assert abs(f_t - 215.3) <= 0.2, w
 
 
 def test_the_speed_is_tracked_on_the_harmonics_that_hold_still():
