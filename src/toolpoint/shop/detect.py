@@ -1393,14 +1393,21 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                     # the short track as the long frames would read it (Hann-weighted over each long frame): a
                     # spindle's own wander, however fast, reads alike both ways (±0.3 % at 1 Hz: 0.8 s frames
                     # average it out, and so does this)
+                    # (256 long frames at a time, each against the short frames within its reach: all against all
+                    # held n_long × n_short weights, 144 MB for 10 min of record)
                     w_l = 2 * _TRACK_FRAME_S
-                    wt = np.clip(0.5 + 0.5 * np.cos(2 * np.pi * (t_f[None, :] - t_l[:, None]) / w_l), 0, None) * \
-                        (np.abs(t_f[None, :] - t_l[:, None]) < 0.5 * w_l)
-                    seen = wt.sum(axis=1) > 0
-                    if seen.sum() >= 3:
-                        as_long = (wt[seen] @ f_f) / wt[seen].sum(axis=1)
-                        if float(np.max(np.abs(as_long / f_l[seen] - 1))) > max(2 * _TRACK_REL, 0.75 * wan):
-                            t_f, f_f, wan = t_l, f_l, wan_l
+                    as_long = np.full(t_l.size, np.nan)
+                    for b0 in range(0, t_l.size, 256):
+                        tb = t_l[b0:b0 + 256]
+                        ia, ib = np.searchsorted(t_f, [tb[0] - 0.5 * w_l, tb[-1] + 0.5 * w_l])
+                        d = t_f[None, ia:ib] - tb[:, None]
+                        wt = np.where(np.abs(d) < 0.5 * w_l, 0.5 + 0.5 * np.cos(2 * np.pi * d / w_l), 0.0)
+                        sw = wt.sum(axis=1)
+                        as_long[b0:b0 + 256] = np.where(sw > 0, (wt @ f_f[ia:ib]) / np.where(sw > 0, sw, 1.0), np.nan)
+                    seen = ~np.isnan(as_long)
+                    if seen.sum() >= 3 and float(np.max(np.abs(as_long[seen] / f_l[seen] - 1))) > \
+                            max(2 * _TRACK_REL, 0.75 * wan):
+                        t_f, f_f, wan = t_l, f_l, wan_l
             if t_f.size >= 3:
                 if wan > _TRACK_REL:
                     return (t_f, f_f), wan, float(np.median(f_f))
