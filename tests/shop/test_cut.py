@@ -1156,6 +1156,33 @@ def test_the_tone_test_holds_its_false_alarm_rate_on_noise(monkeypatch):
     assert np.allclose(symbol, exact, rtol=5e-3), (symbol, exact)
 
 
+def test_the_tone_level_s_saddlepoint_solves_its_equation():
+    """The saddlepoint ŝ of :func:`_t_alpha`'s tail, K'(ŝ) = Σ w μ / (1 − μ ŝ) = x, by Newton's steps on 1/K' (3–18
+    where bisection took 100), against SciPy's ``brentq`` on each x alone: the left tail (ŝ far below 0), by the mean
+    (ŝ ~ 1e-3) and near the pole 1 / max μ, for few overlapping frames (exact eigenvalues) and many (the Toeplitz
+    symbol's, grouped)."""
+    from scipy.optimize import brentq
+
+    from toolpoint.shop import detect as d
+
+    L, hop = 8820, 2205
+    w = np.hanning(L)
+    rho = [float(np.dot(w[:L - k * hop], w[k * hop:]) / np.dot(w, w)) for k in range(1, 4)]
+    x = np.array([0.05, 0.3, 0.9, 0.999, 1.001, 1.2, 3.0, 20.0, 200.0])
+    for n in (3, 40, 1000):
+        mu, wt = d._overlap_eigenvalues(rho, n)
+        assert abs(float(wt @ mu) - 1.0) < 1e-12  # the mean of Σ μ E is 1: K'(0) = 1
+        got = d._saddlepoint(mu, wt, x, -1e3 * n / x.min())
+        top = 1.0 / mu.max()
+        for xi, si in zip(x, got):
+            k1 = lambda s: float(np.sum(wt * mu / (1 - mu * s))) - xi  # noqa: E731
+            lo = -1.0
+            while k1(lo) > 0:
+                lo *= 2
+            ref = brentq(k1, lo, top * (1 - 1e-12), xtol=1e-15, rtol=1e-14, maxiter=500)
+            assert abs(si - ref) <= 1e-9 * max(abs(ref), 1e-3), (n, xi, si, ref)
+
+
 def test_a_real_microphone_record_that_is_no_cut_is_refused(tmp_path, capsys):
     """The pyuff project's sample microphone time history (UFF58b, 79 292 samples; tests/data/pyuff, MIT), a file
     nobody here made and no record of a cut: at 3000 and 6000 rpm and 4 teeth it read "chatter at 1814.7 Hz" (exit 0,

@@ -946,14 +946,9 @@ def _t_alpha(L, hop, n, m, alpha) -> float:
     med = chi2.ppf(0.5, nu) / nu
     s = math.sqrt(_BIN_CORR * (2 / 3) / (4 * _BLOCK * (chi2.pdf(med * nu, nu) * nu) ** 2)) / med
 
-    def sf(x):  # P(Σ μ_j E_j > x): saddlepoint ŝ of K'(ŝ) = x by bisection (either side of the mean 1), vectorised
+    def sf(x):  # P(Σ μ_j E_j > x): saddlepoint ŝ of K'(ŝ) = x (either side of the mean 1), vectorised
         x = np.where(np.abs(x - 1) < 1e-3, 1 + np.copysign(1e-3, x - 1), x)  # Lugannani–Rice is singular at the mean
-        lo, hi = np.full_like(x, -1e3 * n / max(float(x.min()), 1e-3)), np.full_like(x, (1 - 1e-12) / mu.max())
-        for _ in range(100):
-            mid = 0.5 * (lo + hi)
-            big = (wt * mu / (1 - mu * mid[:, None])).sum(axis=1) > x
-            hi, lo = np.where(big, mid, hi), np.where(big, lo, mid)
-        sh = 0.5 * (lo + hi)
+        sh = _saddlepoint(mu, wt, x, -1e3 * n / max(float(x.min()), 1e-3))
         q = mu / (1 - mu * sh[:, None])
         K = -(wt * np.log1p(-mu * sh[:, None])).sum(axis=1)
         r = np.sign(sh) * np.sqrt(np.maximum(2 * (sh * x - K), 0.0))
@@ -975,6 +970,30 @@ def _t_alpha(L, hop, n, m, alpha) -> float:
     if f(hi) >= 0:
         return math.exp(hi)
     return math.exp(brentq(f, lo, hi, xtol=1e-4))
+
+
+def _saddlepoint(mu, wt, x, lo):
+    """ŝ of K'(ŝ) = Σ wt μ / (1 − μ ŝ) = x for each x, ŝ in (``lo``, 1 / max μ): Newton's steps on 1/K' = 1/x, which
+    is nearly linear in ŝ where K' is steep (by the pole) or flat (far to the left), bisection where a step leaves
+    the bracket. 3–18 steps to K' − x at its rounding, where plain bisection took 100 steps (three quarters of
+    :func:`_t_alpha`'s time); the levels t_α the same to 6e-14 (``tests/shop/test_cut.py`` checks ŝ against SciPy's
+    ``brentq``)."""
+    lo, hi = np.full_like(x, lo), np.full_like(x, (1 - 1e-12) / mu.max())
+    s = np.clip(np.zeros_like(x), lo, hi)
+    for _ in range(100):
+        q = mu / (1 - mu * s[:, None])
+        g = (wt * q).sum(axis=1) - x
+        # converged: K' − x at its rounding (a sum of up to 256 terms: 1e-13 of x), or the bracket closed on ŝ
+        done = (np.abs(g) <= 1e-12 * x) | (hi - lo <= 1e-13 * np.maximum(np.abs(s), 1e-3))
+        if done.all():
+            break
+        big = g > 0
+        hi, lo = np.where(big, s, hi), np.where(big, lo, s)
+        kp = g + x  # Newton on 1/K' = 1/x: 1/K' is linear in ŝ by the pole and far to the left, K' is not
+        new = s - g * kp / (x * (wt * q ** 2).sum(axis=1))
+        new = np.where((new >= lo) & (new <= hi), new, 0.5 * (lo + hi))  # outside only by overshooting
+        s = np.where(done, s, new)
+    return s
 
 
 _EIG_EXACT_MAX = 256
