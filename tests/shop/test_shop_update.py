@@ -1524,6 +1524,7 @@ def test_per_speed_quantiles_are_numpys():
         np.testing.assert_allclose(got, want, equal_nan=True)
 
 
+@pytest.mark.slow  # 4.5–6.5 s each, a calibration over 1500 draws: the fast tier read 181 s on a clean clone (3 min)
 @pytest.mark.parametrize("tau, plain_lo, plain_hi", [(0.0, 0.045, 0.058), (0.1, 0.055, 0.068)])
 def test_the_band_allows_for_its_few_references(tau, plain_lo, plain_hi):
     """Lobes built as ``update`` builds them away from the cut speeds — each sample's zero-order limit (ln sd 0.2)
