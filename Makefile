@@ -18,7 +18,7 @@ demo: $(STAMP)
 # ruff (pyflakes + pycodestyle), the one-way import layers (import-linter), then the fast tier of the tests and
 # doctests on both cores; `make test-slow` runs the slow tier (statistical and end-to-end checks; CI runs both).
 # pytest keeps its rewritten test modules in __pycache__ even where PYTHONDONTWRITEBYTECODE is set: rewriting the
-# asserts costs each worker ~6.5 s of its ~13 s collection, on every run after the first. The fast tier's workers
+# asserts is ~6.5 s of each worker's ~13 s collection, saved on every run after the first. The fast tier's workers
 # each start on one half of the tests and steal from the other's: a module's tests stay on one worker, and with them
 # its cached records and fixtures (2026-12-07, 2-core VM: 199 s → 175–182 s, 374 → 329–342 s of CPU)
 PYTEST := PYTHONDONTWRITEBYTECODE= $(PY) -m pytest
