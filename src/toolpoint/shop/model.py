@@ -166,17 +166,25 @@ def receptance(prior: ModalPrior, theta, freq_hz) -> np.ndarray:
     m = prior.modes
     t = np.atleast_2d(theta)
     f = np.asarray(freq_hz, float)
-    fn, k, zeta = t[:, :m, None], t[:, m:2 * m, None], t[:, 2 * m:3 * m, None]
-    r = f[None, None, :] / fn
     # 1 / (k (d + i e)) = (d − i e) / (k (d² + e²)), d = 1 − r², e = 2ζr: in real arithmetic, the same to
     # rounding and 1.8× faster than NumPy's complex division (0.128 → 0.070 s CPU, 500 samples × 3 modes × 1919
-    # frequencies, 2026-11-26)
-    d = 1.0 - r * r
-    e = 2.0 * zeta * r
-    g = 1.0 / (k * (d * d + e * e))
+    # frequencies, 2026-11-26). Mode by mode, added in the order NumPy's sum over the modes' axis adds them: the
+    # same bits, without (S, M, F) temporaries (CPU, 100 example-tool samples × 3 modes × 1919 frequencies: 6.1–7.3 →
+    # 3.3–3.8 ms; limit_at_speeds of 500 of them at 4 speeds 167–178 → 154–155 ms; 2026-12-07)
+    re = im = np.zeros((t.shape[0], f.size))  # no modes: no response (as the sum over an empty axis)
+    for j in range(m):
+        r = f[None, :] / t[:, j, None]
+        d = 1.0 - r * r
+        e = 2.0 * t[:, 2 * m + j, None] * r
+        g = 1.0 / (t[:, m + j, None] * (d * d + e * e))
+        if j == 0:
+            re, im = d * g, e * g
+        else:
+            re += d * g
+            im += e * g
     out = np.empty((t.shape[0], f.size), complex)
-    out.real = (d * g).sum(axis=1)
-    out.imag = -(e * g).sum(axis=1)
+    out.real = re
+    out.imag = -im
     return out
 
 
