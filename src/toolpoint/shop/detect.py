@@ -1413,7 +1413,7 @@ def analyse_cut(samples, rate_hz: float, *, rpm: float, teeth: int, rpm_toleranc
                     # spindle's own wander, however fast, reads alike both ways (±0.3 % at 1 Hz: 0.8 s frames
                     # average it out, and so does this)
                     # (256 long frames at a time, each against the short frames within its reach: all against all
-                    # held n_long × n_short weights, 144 MB for 10 min of record)
+                    # held n_long × n_short weights, 144 MB for 10 min of record by the frame counts, not measured)
                     w_l = 2 * _TRACK_FRAME_S
                     as_long = np.full(t_l.size, np.nan)
                     for b0 in range(0, t_l.size, 256):

@@ -171,7 +171,7 @@ def receptance(prior: ModalPrior, theta, freq_hz) -> np.ndarray:
     # frequencies, 2026-11-26). Mode by mode, added in the order NumPy's sum over the modes' axis adds them: the
     # same bits, without (S, M, F) temporaries (CPU, 100 example-tool samples × 3 modes × 1919 frequencies: 6.1–7.3 →
     # 3.3–3.8 ms; limit_at_speeds of 500 of them at 4 speeds 167–178 → 154–155 ms; 2026-12-07)
-    re = im = np.zeros((t.shape[0], f.size))  # no modes: no response (as the sum over an empty axis)
+    re = im = 0.0  # no modes: no response (as the sum over an empty axis; broadcast below)
     for j in range(m):
         r = f[None, :] / t[:, j, None]
         d = 1.0 - r * r
