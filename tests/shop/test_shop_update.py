@@ -15,8 +15,8 @@ from toolpoint.errors import InputError
 from toolpoint.shop.campaign import virtual_campaign
 from toolpoint.shop.model import ModalPrior, cornelius_2024, limit_at_speeds, receptance
 from toolpoint.shop.prior import prior_from_library, read_modal_prior
-from toolpoint.shop.update import (OWN_MIN_ESS, TestCut, _band_levels, _own_temper, _p_chatter_map, _quantiles_at,
-                                   log_likelihood, read_test_cuts, update)
+from toolpoint.shop.update import (LABEL_OFFSET, OWN_MIN_ESS, TestCut, _band_levels, _own_temper, _p_chatter_map,
+                                   _quantiles_at, log_likelihood, read_test_cuts, update)
 from toolpoint.stability.zoa_batch import zoa_limits
 
 # the command line's tests of parsing, files and messages run the cheaper zero-order model (the default is "sdm":
@@ -663,11 +663,12 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
                  "--step-only-after-creep", "--rule", "risk"]) == 2
     assert "--step-only-after-creep: only with --rule info" in capsys.readouterr().err
     assert not (tmp_path / "o6").exists()
-    # --label-offset MEAN,SD: the labels' boundary e^δ above the limit. The default (0.035, 0.035) puts the band at
+    # --label-offset MEAN,SD: the labels' boundary e^δ above the limit. The default (0.01, 0.02) puts the band at
     # the cut speed below that of 0,0 (labels = the limit), and parameters.csv reports δ's prior and posterior
     rows = {r.split(",")[0]: r.split(",") for r in (out / "parameters.csv").read_text().splitlines()}
+    mu, sd = LABEL_OFFSET
     assert rows["label_offset_ln"][1] == "ln" and [float(v) for v in rows["label_offset_ln"][2:5]] == \
-        pytest.approx([0.035 - 1.645 * 0.035, 0.035, 0.035 + 1.645 * 0.035], abs=1e-4)
+        pytest.approx([mu - 1.645 * sd, mu, mu + 1.645 * sd], abs=1e-4)
     o0 = tmp_path / "o0"
     assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(o0), "--samples", "300",
                  "--label-offset", "0,0"]) == 0
@@ -1442,7 +1443,11 @@ def test_the_corrected_samples_own_sdm_limits_move_the_band_to_the_sdm():
     parameters to explain cuts that follow the SDM. Six truths drawn from the prior, cuts bracketing each one's
     SDM limit (±7 %) at 7000 and 7500 rpm (flip lobes, ZOA ~35 % low): with ``sdm_train=60`` (the corrected
     samples' own SDM limits at the cut speeds) the band holds the SDM limit at both speeds for every truth, and the
-    median is closer to it than with the references alone (measured: mean |ln(median / SDM)| 0.028 against 0.040)."""
+    median is closer to it than with the references alone. The labels are the SDM limit's own, so the label model is
+    off (offset and growth 0). Measured (2026-12-07): mean |ln(median / SDM)| 0.029 against 0.032. Until then the
+    test ran ``update``'s default label model, whose offset prior N(0.035, 0.035²) put the references' median low:
+    0.032 against 0.050 on that day's code; with the offset refitted to ``cut`` (N(0.01, 0.02²)) 0.029 against 0.024,
+    a comparison these exact labels do not ask for."""
     from toolpoint.stability import sdm_lobes
 
     pr = cornelius_2024(0.05)
@@ -1455,7 +1460,8 @@ def test_the_corrected_samples_own_sdm_limits_move_the_band_to_the_sdm():
         cuts = [TestCut(float(r), float(a * q), bool(q < 1)) for r, a in zip(rpm, a_sdm) for q in (0.93, 1.07)]
         for tr in err:
             q = update(pr, cuts, rng=np.random.default_rng(0), n_samples=300, lobe_samples=150, forward="sdm",
-                       sdm_refs=2, rpm_grid=rpm, sdm_train=tr, sdm_train_model="mean", own_sdm=False).limit_q_m / a_sdm
+                       sdm_refs=2, rpm_grid=rpm, sdm_train=tr, sdm_train_model="mean", own_sdm=False,
+                       label_offset=(0, 0), label_growth=(0, 0)).limit_q_m / a_sdm
             err[tr].extend(np.abs(np.log(q[1])))
             if tr:
                 assert np.all(q[0] <= 1) and np.all(1 <= q[2]), (seed, q)

@@ -6,14 +6,15 @@ same kind of model; here with label noise and a chatter-frequency term):
     P(stable | θ, δ) = ε + (1 − 2ε) Φ( ln(a_lim(θ, n) e^δ / a) / w ),
 
 δ the *label offset*: how far (ln) above the stability limit the shop first hears chatter — one for all the
-cuts, a parameter of the posterior with prior N(μ, s²) (default μ = s = 0.035). A detector hears chatter only
-once it stands out of the forced vibration; at a pocket speed, where chatter sits next to a tooth-passing
-harmonic, the whole loop's detector heard it only 7 % above the SDM limit on one campaign tool (EM28-80) and
-0.4 % above it on the Cornelius case (probit fits to 281 and 231 labelled cuts, ``docs/design/shop.md``). The
-cuts cannot tell δ from the limit, so its prior carries to the band. With δ = 0 assumed, EM28-80's recommended
-depth was above the true limit in 30–55 % of 20 truths after 3–6 cuts, where it claims 5 %; with this prior in
-5–15 % (Cornelius: 10–15 % → 0–5 %; campaigns without a stop, ``docs/design/shop.md``; on truths 20–39 with
-it 0–5 % and 5–20 %).
+cuts, a parameter of the posterior with prior N(μ, s²) (default μ = 0.01, s = 0.02). A detector hears chatter
+only once it stands out of the forced vibration. Refitted on 2026-12-07 to the labels of ``cut`` as it is now: on
+the whole loop's cuts of six tools (1 440 cuts of truths 450–489, probit fits with this module's w = 0.05,
+``benchmarks/label_fit.py``) the labels' whole offset, δ and the growth term below together, was 0.010–0.032 (each
+±0.007–0.011); the growth term takes 0.002–0.02 of it at those tools' growth rates and cut lengths. The default
+until then, μ = s = 0.035, came from the detector of 2026-11-26, which heard chatter 7 % above the SDM limit at
+EM28-80's pocket (now 1–2 %). The cuts cannot tell δ from the limit, so its prior carries to the band
+(``docs/design/shop.md``, *The label offset refitted*). Labels by ear or by another detector may be heard later:
+give their offset (``label_offset``; the old default is the cautious guess).
 Chatter must also have *grown* to be heard, and just past the limit it grows slowly: e^{κ ln(a/a_lim) t} over a cut
 of t seconds, κ = Re ∂s/∂ln a the growth rate of the sample's limiting lobe
 (:func:`~toolpoint.shop.model.growth_rate`, ≈ ζω_n of the chattering mode). So each cut's boundary moves up by a
@@ -464,6 +465,10 @@ def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, s
                                  f"{1e3 * s.depth_m:g} mm but chatter at {1e3 * c.depth_m:g} mm "
                                  f"({s.rpm:g} / {c.rpm:g} rpm); check the labels", file=source, field="result")
 
+
+LABEL_OFFSET = (0.01, 0.02)
+"""``update``'s default prior of the label offset δ, (mean, sd) in ln: where ``cut``'s labels lie above the limit,
+besides the growth term (module docstring; ``docs/design/shop.md``, *The label offset refitted*)."""
 
 NOISY_POCKET = 0.025
 """A noisy shop's late chatter at a pocket's top, ν: where the cutting force's noise drives the tool's modes
@@ -940,7 +945,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "sdm", sdm_refs: int = 4,
            min_step: float | None = None, sdm_train: int = SDM_TRAIN, sdm_train_model: str = "quadratic",
            miss_rate: float = 0.0,
-           label_offset: tuple = (0.035, 0.035), label_growth: tuple = (2.5, 0.5),
+           label_offset: tuple = LABEL_OFFSET, label_growth: tuple = (2.5, 0.5),
            cut_duration_s: float = 1.0, risk_after_chatter: float | None = None,
            skip_repeats: bool = True, step_until_chatter: bool | str = True, creep_span: float = 0.02,
            audible_margin: float = 0.025, max_cut_duration_s: float = 5.0,
@@ -1028,16 +1033,15 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         search). ``"quadratic"``: each sample's own ratio from a least-squares fit quadratic in its prior
         coordinates (:class:`_RatioFit`; the searches as :data:`OWN_NEAR`), the fit's residual sd added to the
         width — the sampling then sees each sample's own limit at the cut speeds, not one mean for all.
-    label_offset : (float, float), default (0.035, 0.035)
+    label_offset : (float, float), default :data:`LABEL_OFFSET` (0.01, 0.02)
         Mean and standard deviation of δ, ln of how far above the stability limit the shop first *hears* chatter:
         the labels' boundary is a_lim e^δ, one δ for all the cuts (a parameter of the posterior, column ``P`` of
         ``z``), while the lobes, P(stable), the recommended point and the next cut's P(chatter) are those of
         a_lim itself. The cuts cannot tell δ from the limit (both move the labels' boundary alike), so its
-        prior carries to the band at the cut speeds. Measured on the whole loop's labels against each truth's
-        SDM limit (probit fits, ``docs/design/shop.md``): δ = 0.004 on the Cornelius case and 0.070 on
-        EM28-80, whose pocket speed hides chatter up to 6 % above the limit; with δ = 0 EM28-80's recommended
-        depth was above the true limit in 30–55 % of 20 truths after 3–6 cuts, where it claims 5 % (5–15 % with
-        this default). (0, 0): the labels are the limit (a detector checked on this machine and tool).
+        prior carries to the band at the cut speeds. Measured on the whole loop's labels (``cut`` on the
+        simulated shop's microphone) against each truth's SDM limit: the module docstring and
+        ``benchmarks/label_fit.py``. (0, 0): the labels are the limit (a detector checked on this machine and
+        tool); (0.035, 0.035), the default until 2026-12-07: labels heard later, by ear or another detector.
     label_growth : (float, float), default (2.5, 0.5)
         Median G̃ and log standard deviation s_G of G, the ln of how much chatter must grow within a cut to be heard (a
         parameter of the posterior, column ``P + 1`` of ``z``): each cut's labels' boundary moves up by a further min(G
