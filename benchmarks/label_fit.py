@@ -13,7 +13,8 @@ of the label model of ``toolpoint.shop.update``, P(chatter) = ε + (1 − 2ε) �
   (its mean and sd under a flat prior on a grid), the figure its ``label_offset`` prior stands for. This δ holds the
   growth term G / (κ t) too: the labels' whole offset.
 
-A campaign printed in two logs (the same seed and tool: a rerun with more cuts repeats the first ones) is counted once.
+A campaign printed in two logs (the same tool, seed and settings: a rerun with more cuts repeats the first ones) is
+counted once.
 """
 
 from __future__ import annotations
@@ -38,12 +39,15 @@ def read(paths):
         for block in open(p, encoding="utf-8").read().split("## update")[1:]:
             m = re.search(r"library prior (\S+?):", block)
             tool = m.group(1) if m else "Cornelius 2024 two-mode"
+            # the run's settings (update options, force noise) from its header line: campaigns of other settings
+            # on the same seeds are other campaigns
+            setting = block.splitlines()[0].split(";", 1)[-1]
             for line in block.splitlines():
                 s = re.match(r"\s+seed (\d+): .*?; cuts (.*?); width", line)
                 if not s:
                     continue
                 for k, (_, _, lab, r, _) in enumerate(_CUT.findall(s.group(2))):
-                    out.setdefault(tool, {})[(int(s.group(1)), k)] = (float(r), lab == "C")
+                    out.setdefault(tool, {})[(setting, int(s.group(1)), k)] = (float(r), lab == "C")
     return out
 
 
@@ -79,7 +83,7 @@ def main(argv):
             sel = (r >= lo) & (r < hi)
             shares.append(f"{y[sel].mean():.2f} ({sel.sum()})" if sel.any() else "—")
         d, w, m, s = fit(r, y)
-        n_camp = len({k[0] for k in cuts})
+        n_camp = len({k[:2] for k in cuts})
         print(f"{tool} | {len(r)} ({n_camp}) | {' / '.join(shares)} | {d:.3f}, {w:.3f} | {m:.3f} ({s:.3f})")
     return 0
 
