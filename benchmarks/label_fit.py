@@ -6,12 +6,13 @@ LOG is the output of ``bench_shop.py --only update --shops sim --verbose`` (one 
 printed as ``rpm/depth_mm`` + ``s`` or ``C`` (heard stable or chatter) + ``<a / a_lim>`` (the cut's depth over the
 truth's SDM limit at its speed) + ``(duration)``. Per tool (the ``library prior`` line of its block, else the
 Cornelius case) this prints the share of cuts heard as chatter in bins of a / a_lim, and two maximum-likelihood fits
-of the label model of ``toolpoint.shop.update``, P(chatter) = ε + (1 − 2ε) Φ((ln(a / a_lim) − δ) / w), ε = 0.002:
+of the label model of ``toolpoint.shop.update``, P(chatter) = ε + (1 − 2ε) Φ((ln(a / a_lim) − δ) / w), ε = ``update``'s
+``label_noise`` (0.002):
 
 * δ and w both free — where the labels' boundary lies and how sharp it is;
-* w fixed at ``update``'s boundary width 0.05 — the δ that ``update``'s own likelihood would read from these labels
-  (its mean and sd under a flat prior on a grid), the figure its ``label_offset`` prior stands for. This δ holds the
-  growth term G / (κ t) too: the labels' whole offset.
+* w fixed at ``update``'s ``boundary_width`` (0.05) — the δ that ``update``'s own likelihood would read from these
+  labels (its mean and sd under a flat prior on a grid), the figure its ``label_offset`` prior stands for. This δ
+  holds the growth term G / (κ t) too: the labels' whole offset.
 
 A campaign printed in two logs (the same tool, seed and settings: a rerun with more cuts repeats the first ones) is
 counted once.
@@ -26,8 +27,17 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.stats import norm
 
-EPS = 0.002
-W_UPDATE = 0.05
+
+def _update_default(name):
+    """``update``'s own default of one likelihood setting (one home: the fits use what ``update`` uses)."""
+    import inspect
+
+    from toolpoint.shop.update import update
+    return inspect.signature(update).parameters[name].default
+
+
+EPS = _update_default("label_noise")
+W_UPDATE = _update_default("boundary_width")
 BINS = (0.0, 0.9, 0.97, 1.0, 1.03, 1.06, 1.10, 1.20, np.inf)
 _CUT = re.compile(r"(\d+)/([\d.]+)([sC])<([\d.]+)>\(([\d.]+)s\)")
 
@@ -74,7 +84,7 @@ def main(argv):
         return 2
     data = read(argv)
     print("tool | cuts (campaigns) | heard chatter at a/a_lim " + " / ".join(
-        f"{lo:g}–{hi:g}" for lo, hi in zip(BINS[1:-2], BINS[2:-1])) + " | δ, w free | δ with w = 0.05 (sd)")
+        f"{lo:g}–{hi:g}" for lo, hi in zip(BINS[1:-2], BINS[2:-1])) + f" | δ, w free | δ with w = {W_UPDATE:g} (sd)")
     for tool, cuts in data.items():
         r = np.array([v[0] for v in cuts.values()])
         y = np.array([v[1] for v in cuts.values()])
