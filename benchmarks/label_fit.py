@@ -10,8 +10,8 @@ of the label model of ``toolpoint.shop.update``, P(chatter) = ε + (1 − 2ε) �
 ``label_noise`` (0.002):
 
 * δ and w both free — where the labels' boundary lies and how sharp it is;
-* w fixed at ``update``'s ``boundary_width`` (0.05) — the δ that ``update``'s own likelihood would read from these
-  labels (its mean and sd under a flat prior on a grid), the figure its ``label_offset`` prior stands for. This δ
+* w fixed at ``update``'s ``boundary_width`` (0.05 by default) — the δ that ``update``'s own likelihood would read from
+  these labels (its mean and sd under a flat prior on a grid), the figure its ``label_offset`` prior stands for. This δ
   holds the growth term G / (κ t) too: the labels' whole offset.
 
 A campaign printed in two logs (the same tool, seed and settings: a rerun with more cuts repeats the first ones) is
@@ -67,7 +67,7 @@ def _nll(r, y, delta, w):
 
 
 def fit(r, y):
-    """(δ, w) free by maximum likelihood; then δ's mean and sd with w = 0.05 (flat prior on a grid)."""
+    """(δ, w) free by maximum likelihood; then δ's mean and sd with ``update``'s w (flat prior on a grid)."""
     res = minimize(lambda q: _nll(r, y, q[0], np.exp(q[1])), [0.02, np.log(0.03)], method="Nelder-Mead",
                    options={"xatol": 1e-5, "fatol": 1e-6})
     grid = np.linspace(-0.15, 0.2, 1401)

@@ -30,9 +30,9 @@ def test_a_chatter_label_is_softened_by_the_precursor_share_and_a_stable_one_is_
     f = pr.freq_grid()
     a_lim = limit_at_speeds(pr, th, [rpm], f)[0][:, 0]
     u = np.log(depth / a_lim)
-    kw = dict(freq_hz=f, label_offset=0.0, label_growth=0.0)
+    eps, w = 0.002, 0.05  # the boundary width stated, not taken from the default: the algebra holds at any w
+    kw = dict(freq_hz=f, label_offset=0.0, label_growth=0.0, boundary_width=w)
     pi, r, s = PRECURSOR
-    eps, w = 0.002, 0.05
     for cut, kind in ((TestCut(rpm, depth, False), "chatter"), (TestCut(rpm, depth, True), "stable"),
                       (TestCut(rpm, depth, False, growth_per_s=40.0), "grew")):
         d = log_likelihood(pr, th, [cut], precursor=PRECURSOR, **kw) - log_likelihood(pr, th, [cut], **kw)

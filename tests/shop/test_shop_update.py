@@ -129,11 +129,15 @@ def test_the_label_growth_moves_the_boundary_by_g_over_kappa_t():
     for dur, kw in ((0.5, {}), (None, {"cut_duration_s": 0.2}), (1e-3, {})):
         t = kw.get("cut_duration_s", dur)
         cut = [TestCut(rpm, float(a[0, 0] * np.exp(x)), True, duration_s=dur)]
-        got = np.exp(log_likelihood(pr, th, cut, label_noise=eps, label_growth=g, **kw)[0])
+        got = np.exp(log_likelihood(pr, th, cut, label_noise=eps, label_growth=g, boundary_width=w, **kw)[0])
         shift = min(g / (kap * t), 0.5)
         assert got == pytest.approx(eps + (1 - 2 * eps) * norm.cdf((shift - x) / w), rel=1e-6), (dur, kw)
-    assert np.exp(log_likelihood(pr, th, cut, label_noise=eps)[0]) == \
+    assert np.exp(log_likelihood(pr, th, cut, label_noise=eps, boundary_width=w)[0]) == \
         pytest.approx(eps + (1 - 2 * eps) * norm.cdf(-x / w), rel=1e-6)  # G = 0: no shift
+    # the default boundary width is update's (BOUNDARY_WIDTH), the same closed form
+    from toolpoint.shop.update import BOUNDARY_WIDTH
+    assert np.exp(log_likelihood(pr, th, cut, label_noise=eps)[0]) == \
+        pytest.approx(eps + (1 - 2 * eps) * norm.cdf(-x / BOUNDARY_WIDTH), rel=1e-6)
 
 
 def _one_slow_mode():
@@ -319,6 +323,10 @@ def test_a_missed_chatter_rate_weakens_stable_labels_only():
     assert q[0.0][0] > 1.2 * a0 and q[m][0] < q[0.0][0] and q[m][1] < q[0.0][1], q
     with pytest.raises(InputError, match="miss_rate|0, 1"):
         update(pr, cut, rng=np.random.default_rng(0), forward="zoa", n_samples=50, miss_rate=1.0)
+    for w in (0.0, -0.03, float("nan"), 0.9):  # the boundary width, likewise
+        with pytest.raises(InputError) as e:
+            update(pr, cut, rng=np.random.default_rng(0), forward="zoa", n_samples=50, boundary_width=w)
+        assert e.value.field == "boundary_width", w
 
 
 def test_a_chatter_frequency_read_anywhere_says_nothing():
@@ -674,6 +682,13 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
                  "--label-offset", "0,0"]) == 0
     lobes0 = np.genfromtxt(o0 / "lobes.csv", delimiter=",", names=True)
     assert lobes0["p05_mm"][k] > lobes["p05_mm"][k], (lobes0["p05_mm"][k], lobes["p05_mm"][k])
+    # --boundary-width LN: a stable label rules out limits under the cut less sharply, so the band's 5 % line at the
+    # stable cut lies lower with the old 0.1-wide boundary than with the default
+    ow = tmp_path / "ow"
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(ow), "--samples", "300",
+                 "--label-offset", "0,0", "--boundary-width", "0.1"]) == 0
+    lobes_w = np.genfromtxt(ow / "lobes.csv", delimiter=",", names=True)
+    assert lobes_w["p05_mm"][k] < lobes0["p05_mm"][k], (lobes_w["p05_mm"][k], lobes0["p05_mm"][k])
     for bad in ("0.1", "0.1,x", "0.1,-0.1", "0.9,0.1", "nan,0.1"):
         capsys.readouterr()
         assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o5"),
@@ -687,7 +702,8 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     for flag, bad in (("--label-growth", "2"), ("--label-growth", "-1,0.5"), ("--label-growth", "2,x"),
                       ("--label-growth", "30,0.5"), ("--cut-duration", "0"), ("--cut-duration", "inf"),
                       ("--max-cut-duration", "0"), ("--max-cut-duration", "1e5"), ("--audible-margin", "-0.1"),
-                      ("--audible-margin", "0.9")):
+                      ("--audible-margin", "0.9"), ("--boundary-width", "0"), ("--boundary-width", "0.9"),
+                      ("--boundary-width", "nan")):
         capsys.readouterr()
         assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o6"),
                      f"{flag}={bad}"]) == 2, bad

@@ -76,6 +76,10 @@ def register(sub) -> None:
                    "deviation; default 0.01,0.02: where `cut`'s labels lie, fitted to 1 440 simulated cuts of six "
                    "tools, docs/design/shop.md); 0.035,0.035 for labels by ear or another detector, heard later; "
                    "0,0 if your labels are the limit itself")
+    p.add_argument("--boundary-width", metavar="LN",
+                   help="ln of how far from the limit your cuts' labels are uncertain (default 0.05; 0.03 converged in "
+                   "fewer cuts on the campaign tools and put the recommended depth above the true limit more often "
+                   "on one, docs/design/shop.md; benchmarks/label_fit.py fits w from logged cuts)")
     p.add_argument("--label-growth", metavar="MEDIAN,SD",
                    help="ln of how much chatter must grow within a cut to be heard (median, log standard deviation; "
                    "default 2.5,0.5: fitted to the chatter detector's labels, docs/design/shop.md); just past the "
@@ -126,6 +130,9 @@ def run(args) -> int:
         offset["step_until_chatter"] = "near"
     if args.label_offset is not None:
         offset["label_offset"] = _pair(args.label_offset, "--label-offset", "MEAN,SD", (-0.2, 0.5), (0, 0.5))
+    if args.boundary_width is not None:
+        offset["boundary_width"] = check_number(args.boundary_width, "--boundary-width", above=0, maximum=0.5,
+                                                why="ln")
     if args.label_growth is not None:
         offset["label_growth"] = _pair(args.label_growth, "--label-growth", "MEDIAN,SD", (0, 20), (0, 1.5))
     if args.cut_duration is not None:

@@ -23,15 +23,19 @@ posterior (column P + 1), with prior ln G ~ N(ln 2.5, 0.5²); it took EM12-60's 
 limit for 24 % of 20 truths (1–6 cuts, mean) to 8 %, at the price of a wider band (``docs/design/shop.md``). On a
 campaign tool whose chatter at the productive speeds is a 750 Hz mode with ζ ≈ 0.4 % (EM12-60: κ ≈ 25–40 /s) this is
 7–12 % for a 0.9 s cut; on a well-damped mode (κ ≈ 500 /s) 0.5 %.
-w (default 0.05) the relative width of the fuzzy boundary (a cut 5 % below the limit is stable with
-probability Φ(1) = 0.84: the limit of a real cut is not a sharp line), ε (default 0.002) the probability that
-a label is simply wrong, whatever the distance to the limit. ε sets how tight a bracket of cuts can make the band:
-the samples outside a bracket [stable a_s, chatter a_c] keep a weight ε against ~1 inside, so with a bracket
-holding 15 % of the prior's mass ε = 0.02 left ~10 % of the posterior outside it and the 5–95 % band could
-not close without more cuts (measured: ``docs/design/shop.md``). Labels that are wrong *near* the limit (a
-detector, a forward model that is not the shop's) belong in w, not in ε. A detector that misses chatter (a
-microphone at a pocket speed, where a resonant tooth-passing harmonic hides it) is ``miss_rate`` m: P(label
-stable) = p_s + m p_c, P(label chatter) = (1 − m) p_c (off by default: measured in ``docs/design/shop.md``).
+w (default 0.05) the relative width of the fuzzy boundary (a cut 5 % below the limit is stable with probability
+Φ(1) = 0.84: the limit of a real cut is not a sharp line). `cut`'s labels turn from stable to chatter more sharply,
+within w ≤ 0.02 of their boundary on six tools (``benchmarks/label_fit.py``, w free): w = 0.03 converged within six
+cuts more often (EM16-50 on 36 of 60 truths 490–549, against 15 of 40 of 490–529 with 0.05) and put the recommended
+depth above the truth more often (EM12-60 after 20 of 240 updates, where it claims 5 %: a label `cut` missed far past
+the limit weighs more), so it is an option, not the default (``docs/design/shop.md``, *The boundary width from the
+labels*). ε (default 0.002) the probability that a label is simply wrong, whatever the distance to the limit. ε sets
+how tight a bracket of cuts can make the band: the samples outside a bracket [stable a_s, chatter a_c] keep a weight
+ε against ~1 inside, so with a bracket holding 15 % of the prior's mass ε = 0.02 left ~10 % of the posterior outside
+it and the 5–95 % band could not close without more cuts (measured: ``docs/design/shop.md``). Labels that are wrong
+*near* the limit (a detector, a forward model that is not the shop's) belong in w, not in ε. A detector that misses
+chatter (a microphone at a pocket speed, where a resonant tooth-passing harmonic hides it) is ``miss_rate`` m:
+P(label stable) = p_s + m p_c, P(label chatter) = (1 − m) p_c (off by default: measured in ``docs/design/shop.md``).
 A chattering cut with a measured
 chatter frequency f adds
 
@@ -466,6 +470,10 @@ def check_consistent(cuts, *, rpm_rel: float = 0.005, depth_rel: float = 0.05, s
                                  f"({s.rpm:g} / {c.rpm:g} rpm); check the labels", file=source, field="result")
 
 
+BOUNDARY_WIDTH = 0.05
+"""``update``'s default boundary width w (ln): how far from the limit a cut's label is uncertain (module docstring;
+``docs/design/shop.md``, *The boundary width from the labels*)."""
+
 LABEL_OFFSET = (0.01, 0.02)
 """``update``'s default prior of the label offset δ, (mean, sd) in ln: where ``cut``'s labels lie above the limit,
 besides the growth term (module docstring; ``docs/design/shop.md``, *The label offset refitted*)."""
@@ -532,9 +540,9 @@ def noisy_shop(cuts) -> int | None:
     return next((r for r, c in enumerate(cuts) if _ring_readable(c)), None)
 
 
-def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = 0.05, label_noise: float = 0.002,
-                   freq_sigma: float = 0.02, freq_outlier: float = 0.05, freq_hz=None, log_ratio=None,
-                   miss_rate: float = 0.0, label_offset=0.0, label_growth=0.0,
+def log_likelihood(prior: ModalPrior, theta, cuts, *, boundary_width: float = BOUNDARY_WIDTH,
+                   label_noise: float = 0.002, freq_sigma: float = 0.02, freq_outlier: float = 0.05,
+                   freq_hz=None, log_ratio=None, miss_rate: float = 0.0, label_offset=0.0, label_growth=0.0,
                    cut_duration_s: float = 1.0, growth_error=None, growth_x=None, ring_x=None,
                    ring_outlier: float = RING_ERROR[1], precursor=None, kappa=None,
                    kappa_log_ratio=None, noisy_pocket=None) -> np.ndarray:
@@ -939,7 +947,7 @@ def _ess(logw):
 
 
 def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int = 1000, method: str = "smc",
-           rpm_grid=None, n_moves: int = 3, boundary_width: float = 0.05, label_noise: float = 0.002,
+           rpm_grid=None, n_moves: int = 3, boundary_width: float = BOUNDARY_WIDTH, label_noise: float = 0.002,
            freq_sigma: float = 0.02, freq_outlier: float = 0.05, rule: str = "info", risk: float | None = None,
            lobe_samples: int = 400,
            n_depths: int = 60, chatter_cost: float = 0.0, forward: str = "sdm", sdm_refs: int = 4,
@@ -971,11 +979,12 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         Metropolis moves per tempering step.
     boundary_width, label_noise, freq_sigma, freq_outlier
         The likelihood's w, ε, σ_f and ε_f (the share of chatter frequencies read anywhere; 1: the frequency says
-        nothing). Measured (2026-11-30; ``docs/design/shop.md``, *Tried, not adopted: a sharper chatter-frequency
-        term*): 26 of 32 chattering cuts' frequencies on EM12-60 and on EM16-50 lay within 0.5 % of the zero-order
-        limiting lobe's or an alias, 5 and 4 more than 2 % off (the SDM's chatter on another mode;
-        ``benchmarks/bench_shop.py --only heard``); in EM12-60's whole loop σ_f = 0.005 with ε_f = 0.25 converged
-        no more often than the defaults.
+        nothing). w (ln, default ``BOUNDARY_WIDTH`` = 0.05, in (0, 0.5]) is how sharply the labels turn at the limit
+        (module docstring: 0.03 converges faster, and is less safe on EM12-60). Measured (2026-11-30;
+        ``docs/design/shop.md``, *Tried, not adopted: a sharper chatter-frequency term*): 26 of 32 chattering cuts'
+        frequencies on EM12-60 and on EM16-50 lay within 0.5 % of the zero-order limiting lobe's or an alias, 5 and 4
+        more than 2 % off (the SDM's chatter on another mode; ``benchmarks/bench_shop.py --only heard``); in EM12-60's
+        whole loop σ_f = 0.005 with ε_f = 0.25 converged no more often than the defaults.
     rule : {"info", "risk"}, default "info"
         How the next test cut is chosen (module docstring).
     risk : float, optional
@@ -1132,10 +1141,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         truths 11 → 6) for a band barely better calibrated (EM12-60's held out after 6 cuts: coverage 0.78 → 0.80,
         claims 0.90; ``docs/design/shop.md``, *Tried again and not kept: cuts near one speed share their boundary*).
     min_step : float, optional
-        ``"info"`` rule: a cut e^min_step above the highest stable cut near a speed is a candidate even where it
-        exceeds ``risk``, when the risk bound stops short of it — until the first chatter
-        (``step_until_chatter``), or once two stable cuts crept closer than e^min_step (default 0.1 =
-        2 × ``boundary_width`` for ``"info"``; 0: never; the ``"risk"`` rule has no step: module docstring).
+        ``"info"`` rule: a cut e^min_step above the highest stable cut near a speed is a candidate even where it exceeds
+        ``risk``, when the risk bound stops short of it — until the first chatter (``step_until_chatter``), or once two
+        stable cuts crept closer than e^min_step (default 0.1 for ``"info"``, twice the default boundary width, 0.05;
+        0: never; the ``"risk"`` rule has no step: module docstring).
     step_until_chatter : bool or "near", default True
         ``"info"`` rule: offer the step after any stable cut while no cut has chattered, and never after; False:
         only once the two highest stable cuts near a speed crept closer than e^min_step, chatter or not (the
@@ -1257,6 +1266,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         raise InputError(f"must be 'mean' or 'quadratic', got {sdm_train_model!r}", field="sdm_train_model")
     if not 0 <= miss_rate < 1:
         raise InputError(f"must be in [0, 1), got {miss_rate}", field="miss_rate")
+    if not (math.isfinite(boundary_width) and 0 < boundary_width <= 0.5):
+        raise InputError(f"must be in (0, 0.5] (ln), got {boundary_width}", field="boundary_width")
     if not (math.isfinite(freq_sigma) and 0 < freq_sigma <= 0.5):
         raise InputError(f"must be in (0, 0.5] (relative), got {freq_sigma}", field="freq_sigma")
     if not 0 < freq_outlier <= 1:
@@ -2202,7 +2213,8 @@ def _own_limits(prior, z, f, grid, lim, k, lobe_samples=True):
     return np.where(np.isfinite(own), own, np.inf)
 
 
-def _recommended_own(prior, z, f, grid, lim, rec, lobe_samples=False, cuts=(), kw=None, boundary_width=0.05):
+def _recommended_own(prior, z, f, grid, lim, rec, lobe_samples=False, cuts=(), kw=None,
+                     boundary_width=BOUNDARY_WIDTH):
     """The recommended depth checked against the own SDM limits of posterior samples ``z`` that are not the lobe
     samples: the lower of the band's 5 % limit and theirs, P(stable) from theirs.
 
