@@ -43,7 +43,7 @@ _CUT = re.compile(r"(\d+)/([\d.]+)([sC])<([\d.]+)>\(([\d.]+)s\)")
 
 
 def read(paths):
-    """{tool: {(seed, k): (a / a_lim, chatter)}} from the verbose lines of the logs."""
+    """{tool: {(settings, seed, k): (a / a_lim, chatter)}} from the verbose lines of the logs (k the cut's place)."""
     out: dict = {}
     for p in paths:
         for block in open(p, encoding="utf-8").read().split("## update")[1:]:
@@ -62,8 +62,10 @@ def read(paths):
 
 
 def _nll(r, y, delta, w):
-    p = np.clip(EPS + (1 - 2 * EPS) * norm.cdf((np.log(r) - delta) / w), 1e-300, 1.0)
-    return -(np.log(p[y]).sum() + np.log1p(-p[~y]).sum())
+    """Negative log-likelihood of the labels y at depths r (a / a_lim); ``delta`` a number or an array of them."""
+    d = np.asarray(delta, float)[..., None]
+    p = np.clip(EPS + (1 - 2 * EPS) * norm.cdf((np.log(r) - d) / w), 1e-300, 1.0)
+    return -(np.log(p[..., y]).sum(axis=-1) + np.log1p(-p[..., ~y]).sum(axis=-1))
 
 
 def fit(r, y):
@@ -71,7 +73,7 @@ def fit(r, y):
     res = minimize(lambda q: _nll(r, y, q[0], np.exp(q[1])), [0.02, np.log(0.03)], method="Nelder-Mead",
                    options={"xatol": 1e-5, "fatol": 1e-6})
     grid = np.linspace(-0.15, 0.2, 1401)
-    ll = -np.array([_nll(r, y, d, W_UPDATE) for d in grid])
+    ll = -_nll(r, y, grid, W_UPDATE)  # the whole grid at once
     p = np.exp(ll - ll.max())
     p /= p.sum()
     mean = float((grid * p).sum())
