@@ -329,6 +329,32 @@ def test_a_missed_chatter_rate_weakens_stable_labels_only():
         assert e.value.field == "boundary_width", w
 
 
+def test_the_recommended_speed_held_at_a_cut_speed_within_its_margin():
+    """``cut_speed_margin`` s: a speed within ±0.5 % of a cut is recommended where its n · a₀₅ is at least (1 − s) of
+    the best. One stable cut 1.5 % under the prior's recommended speed, 300-sample zero-order updates on a 0.5 % grid:
+    with s = 0 the recommendation is that without the option (same draws); the cut speed removes 9 % less than the
+    best here, so 0.03 keeps the best and 0.5 takes the cut speed (``at_cut_speed``); bad shares are refused."""
+    pr = cornelius_2024(0.1)
+    grid = 12000 * 1.005 ** np.arange(-40, 41)
+    kw = dict(forward="zoa", n_samples=300, lobe_samples=200, rpm_grid=grid)
+    r0 = update(pr, [], rng=np.random.default_rng(0), **kw).recommended["rpm"]
+    rc = 0.985 * r0
+    a = float(limit_at_speeds(pr, pr.theta(np.zeros((1, pr.sigma.size))), [rc])[0][0, 0])
+    cuts = [TestCut(rc, 0.7 * a, True)]
+    base = update(pr, cuts, rng=np.random.default_rng(1), **kw).recommended
+    got = {s: update(pr, cuts, rng=np.random.default_rng(1), cut_speed_margin=s, **kw) for s in (0.0, 0.03, 0.5)}
+    assert got[0.0].recommended == base and not base["at_cut_speed"] and abs(base["rpm"] / rc - 1) > 0.005
+    best = np.nanmax(got[0.5].rpm * got[0.5].limit_q_m[0])
+    ratio = {s: p.recommended["rpm"] * p.recommended["limit_p05_m"] / best for s, p in got.items()}
+    assert got[0.03].recommended["rpm"] == base["rpm"] and ratio[0.03] == pytest.approx(1.0)
+    rec = got[0.5].recommended
+    assert rec["at_cut_speed"] and abs(rec["rpm"] / rc - 1) <= 0.005 and 0.5 <= ratio[0.5] < 0.97, (rec, ratio)
+    for s in (-0.01, 0.6, float("nan")):
+        with pytest.raises(InputError) as e:
+            update(pr, cuts, rng=np.random.default_rng(0), forward="zoa", n_samples=50, cut_speed_margin=s)
+        assert e.value.field == "cut_speed_margin", s
+
+
 def test_a_chatter_frequency_read_anywhere_says_nothing():
     """``freq_outlier`` = 1: every frequency is an outlier, so a chattering cut's frequency adds a constant to every
     sample's log-likelihood and the posterior is the one without it (the same draws: tempering sees only the
@@ -648,6 +674,13 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     # the zero-order forward model has no SDM check: the recommended depth is the band's 5 % limit
     assert doc["recommended"]["depth_mm"] == doc["recommended"]["limit_p05_mm"]
     assert doc["recommended"]["own_sdm_p05_mm"] is None and doc["recommended"]["own_sdm_held_out"] is None
+    # --cut-speed-margin 0.5: a speed already cut (12000 or 20000 rpm, ±0.5 %) removing at least half the best's rate
+    om = tmp_path / "om"
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(om), "--samples", "300",
+                 "--cut-speed-margin", "0.5"]) == 0
+    rm = json.loads((om / "update.json").read_text())["recommended"]
+    assert rm["at_cut_speed"] and min(abs(rm["rpm"] / r - 1) for r in (12000, 20000)) <= 0.005, rm
+    assert doc["recommended"]["at_cut_speed"] in (True, False)
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "src='http" not in html and "<script src" not in html
     lobes = np.genfromtxt(out / "lobes.csv", delimiter=",", names=True)
@@ -703,7 +736,8 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
                       ("--label-growth", "30,0.5"), ("--cut-duration", "0"), ("--cut-duration", "inf"),
                       ("--max-cut-duration", "0"), ("--max-cut-duration", "1e5"), ("--audible-margin", "-0.1"),
                       ("--audible-margin", "0.9"), ("--boundary-width", "0"), ("--boundary-width", "0.9"),
-                      ("--boundary-width", "nan")):
+                      ("--boundary-width", "nan"), ("--cut-speed-margin", "-0.1"), ("--cut-speed-margin", "0.6"),
+                      ("--cut-speed-margin", "nan")):
         capsys.readouterr()
         assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o6"),
                      f"{flag}={bad}"]) == 2, bad

@@ -80,6 +80,10 @@ def register(sub) -> None:
                    help="ln of how far from the limit your cuts' labels are uncertain (default 0.05; 0.03 converged in "
                    "fewer cuts on the campaign tools and put the recommended depth above the true limit more often "
                    "on one, docs/design/shop.md; benchmarks/label_fit.py fits w from logged cuts)")
+    p.add_argument("--cut-speed-margin", metavar="SHARE",
+                   help="recommend a speed already cut (±0.5 %%) where its removal rate at the 5 %% limit is within "
+                   "SHARE of the best speed's (default 0: the best; 0.03 converged in fewer cuts on one campaign "
+                   "tool at the same safety, docs/design/shop.md); report.json says whether it is at a cut speed")
     p.add_argument("--label-growth", metavar="MEDIAN,SD",
                    help="ln of how much chatter must grow within a cut to be heard (median, log standard deviation; "
                    "default 2.5,0.5: fitted to the chatter detector's labels, docs/design/shop.md); just past the "
@@ -133,6 +137,9 @@ def run(args) -> int:
     if args.boundary_width is not None:
         offset["boundary_width"] = check_number(args.boundary_width, "--boundary-width", above=0, maximum=0.5,
                                                 why="ln")
+    if args.cut_speed_margin is not None:
+        offset["cut_speed_margin"] = check_number(args.cut_speed_margin, "--cut-speed-margin", minimum=0,
+                                                  maximum=0.5, why="a share of the removal rate")
     if args.label_growth is not None:
         offset["label_growth"] = _pair(args.label_growth, "--label-growth", "MEDIAN,SD", (0, 20), (0, 1.5))
     if args.cut_duration is not None:

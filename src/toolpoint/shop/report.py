@@ -106,6 +106,8 @@ def _doc(post: Posterior) -> dict:
                         "own_sdm_p05_mm": (None if rc["own_sdm_p05_m"] is None
                                            else round(1e3 * rc["own_sdm_p05_m"], 4)),
                         "own_sdm_held_out": rc["own_sdm_held_out"],
+                        # cut_speed_margin: a speed already cut, within the margin of the most productive one
+                        "at_cut_speed": rc.get("at_cut_speed", False),
                         # the band's samples weighted by their own SDM limits at the cut speeds (update's own_sdm)
                         "lobes_own_sdm": post.own_sdm_ess is not None},
         "next_cut": {**{k: v for k, v in nc.items() if k != "depth_m"}, "depth_mm": round(1e3 * nc["depth_m"], 4)},
