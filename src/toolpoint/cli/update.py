@@ -82,8 +82,9 @@ def register(sub) -> None:
                    "on one, docs/design/shop.md; benchmarks/label_fit.py fits w from logged cuts)")
     p.add_argument("--cut-speed-margin", metavar="SHARE",
                    help="recommend a speed already cut (±0.5 %%) where its removal rate at the 5 %% limit is within "
-                   "SHARE of the best speed's (default 0: the best; 0.03 converged in fewer cuts on one campaign "
-                   "tool at the same safety, docs/design/shop.md); report.json says whether it is at a cut speed")
+                   "SHARE of the best speed's (default 0: the best; 0.03 converged in fewer cuts on two of three "
+                   "truth sets of one campaign tool, not on the third, docs/design/shop.md); update.json says "
+                   "whether it is at a cut speed")
     p.add_argument("--label-growth", metavar="MEDIAN,SD",
                    help="ln of how much chatter must grow within a cut to be heard (median, log standard deviation; "
                    "default 2.5,0.5: fitted to the chatter detector's labels, docs/design/shop.md); just past the "
