@@ -1235,7 +1235,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         ``"info"`` rule, which narrows the band at the recommended speed, follows it instead of bracketing the
         limit at one speed. With 0.03 (removal rate at most 3 % below the band's best) EM16-50 converged within 6
         cuts for 10 and 11 of 20 truths against 7 and 8 in the whole loop (490–529), at the same safety, but for 8 of
-        20 fresh truths (530–549; the default 6 of the 12 it finished, the option 5) (``docs/design/shop.md``, *The
+        20 fresh truths (530–549; the default 9) (``docs/design/shop.md``, *The
         recommended speed held at a cut speed*). 0: the most productive speed, as before 2026-12-07.
 
     Returns
