@@ -62,7 +62,7 @@ def register(sub) -> None:
     p.add_argument("--min-step",
                    help="info rule: until the first chatter, a cut e^STEP above the highest stable cut near a speed "
                    "(±2 %%) may be proposed even past --risk, so stable cuts do not creep (default 0.1 = 2 × the "
-                   "boundary width; 0: never: docs/design/shop.md)")
+                   "default boundary width; 0: never: docs/design/shop.md)")
     p.add_argument("--step-only-after-creep", action="store_true",
                    help="info rule: step only once the two highest stable cuts near a speed (±2 %%) crept closer "
                    "than e^--min-step, chatter or not (the trigger before 2026-11-29): fewer chattering cuts, a "

@@ -23,19 +23,20 @@ posterior (column P + 1), with prior ln G ~ N(ln 2.5, 0.5²); it took EM12-60's 
 limit for 24 % of 20 truths (1–6 cuts, mean) to 8 %, at the price of a wider band (``docs/design/shop.md``). On a
 campaign tool whose chatter at the productive speeds is a 750 Hz mode with ζ ≈ 0.4 % (EM12-60: κ ≈ 25–40 /s) this is
 7–12 % for a 0.9 s cut; on a well-damped mode (κ ≈ 500 /s) 0.5 %.
-w (default 0.05) the relative width of the fuzzy boundary (a cut 5 % below the limit is stable with probability
-Φ(1) = 0.84: the limit of a real cut is not a sharp line). `cut`'s labels turn from stable to chatter more sharply,
-within w ≤ 0.02 of their boundary on six tools (``benchmarks/label_fit.py``, w free): w = 0.03 converged within six
-cuts more often (EM16-50 on 36 of 60 truths 490–549, against 15 of 40 of 490–529 with 0.05) and put the recommended
-depth above the truth more often (EM12-60 after 20 of 240 updates, where it claims 5 %: a label `cut` missed far past
-the limit weighs more), so it is an option, not the default (``docs/design/shop.md``, *The boundary width from the
-labels*). ε (default 0.002) the probability that a label is simply wrong, whatever the distance to the limit. ε sets
-how tight a bracket of cuts can make the band: the samples outside a bracket [stable a_s, chatter a_c] keep a weight
-ε against ~1 inside, so with a bracket holding 15 % of the prior's mass ε = 0.02 left ~10 % of the posterior outside
-it and the 5–95 % band could not close without more cuts (measured: ``docs/design/shop.md``). Labels that are wrong
-*near* the limit (a detector, a forward model that is not the shop's) belong in w, not in ε. A detector that misses
-chatter (a microphone at a pocket speed, where a resonant tooth-passing harmonic hides it) is ``miss_rate`` m:
-P(label stable) = p_s + m p_c, P(label chatter) = (1 − m) p_c (off by default: measured in ``docs/design/shop.md``).
+w (default 0.05) the relative width of the fuzzy boundary (a cut 5 % below the limit is stable with probability Φ(1) =
+0.84: the limit of a real cut is not a sharp line). `cut`'s labels turn from stable to chatter more sharply, within w ≤
+0.02 of their boundary on six tools (``benchmarks/label_fit.py``, w free): w = 0.03 converged within six cuts more often
+(EM16-50 on 36 of 60 truths 490–549, against 24 of 60 with 0.05) and put the recommended depth above the
+truth more often (EM12-60 after 20 of 240 updates, where it claims 5 %: in part a label `cut` missed far past the limit
+weighing more, in part lobes over-confident away from the cuts), so it is an option, not the default
+(``docs/design/shop.md``, *The boundary width from the labels*). ε (default 0.002) the probability that a label is
+simply wrong, whatever the distance to the limit. ε sets how tight a bracket of cuts can make the band: the samples
+outside a bracket [stable a_s, chatter a_c] keep a weight ε against ~1 inside, so with a bracket holding 15 % of the
+prior's mass ε = 0.02 left ~10 % of the posterior outside it and the 5–95 % band could not close without more cuts
+(measured: ``docs/design/shop.md``). Labels that are wrong *near* the limit (a detector, a forward model that is not the
+shop's) belong in w, not in ε. A detector that misses chatter (a microphone at a pocket speed, where a resonant
+tooth-passing harmonic hides it) is ``miss_rate`` m: P(label stable) = p_s + m p_c, P(label chatter) = (1 − m) p_c (off
+by default: measured in ``docs/design/shop.md``).
 A chattering cut with a measured
 chatter frequency f adds
 
