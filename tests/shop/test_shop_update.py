@@ -355,6 +355,30 @@ def test_the_recommended_speed_held_at_a_cut_speed_within_its_margin():
         assert e.value.field == "cut_speed_margin", s
 
 
+def test_the_next_cut_at_the_recommended_speed_only():
+    """``next_speeds`` = 0: the ``info`` rule proposes the next cut at the recommended speed; with the default 6 it may
+    take a neighbouring productive speed (here it does, for at least one of three cut tables); bad counts refused."""
+    pr = cornelius_2024(0.1)
+    grid = 12000 * 1.005 ** np.arange(-40, 41)
+    kw = dict(forward="zoa", n_samples=300, lobe_samples=200, rpm_grid=grid)
+    r0 = update(pr, [], rng=np.random.default_rng(0), **kw).recommended["rpm"]
+    a = float(limit_at_speeds(pr, pr.theta(np.zeros((1, pr.sigma.size))), [r0])[0][0, 0])
+    moved = []
+    for cuts in ([TestCut(r0, 0.6 * a, True)], [TestCut(r0, 0.6 * a, True), TestCut(r0, 0.7 * a, True)],
+                 [TestCut(r0, 0.7 * a, True), TestCut(r0, 1.1 * a, False)]):
+        one = update(pr, cuts, rng=np.random.default_rng(1), next_speeds=0, **kw)
+        assert one.next_cut["rpm"] == one.recommended["rpm"], (cuts, one.next_cut)
+        assert "at that speed" in one.next_cut["description"]
+        six = update(pr, cuts, rng=np.random.default_rng(1), **kw)
+        assert six.recommended == one.recommended  # the option moves the next cut only
+        moved.append(six.next_cut["rpm"] != six.recommended["rpm"])
+    assert any(moved), moved
+    for k in (-1, 2.5, 51, True, float("nan")):
+        with pytest.raises(InputError) as e:
+            update(pr, [], rng=np.random.default_rng(0), forward="zoa", n_samples=50, next_speeds=k)
+        assert e.value.field == "next_speeds", k
+
+
 def test_a_chatter_frequency_read_anywhere_says_nothing():
     """``freq_outlier`` = 1: every frequency is an outlier, so a chattering cut's frequency adds a constant to every
     sample's log-likelihood and the posterior is the one without it (the same draws: tempering sees only the
@@ -681,6 +705,13 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
     rm = json.loads((om / "update.json").read_text())["recommended"]
     assert rm["at_cut_speed"] and min(abs(rm["rpm"] / r - 1) for r in (12000, 20000)) <= 0.005, rm
     assert doc["recommended"]["at_cut_speed"] in (True, False)
+    # --next-speeds 0: the next cut at the recommended speed itself
+    on = tmp_path / "on"
+    assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(on), "--samples", "300",
+                 "--next-speeds", "0"]) == 0
+    dn = json.loads((on / "update.json").read_text())
+    assert dn["next_cut"]["rpm"] == pytest.approx(dn["recommended"]["rpm"], abs=0.1)  # as written: to 0.1 rpm
+    assert "at that speed" in dn["next_cut"]["description"]
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "src='http" not in html and "<script src" not in html
     lobes = np.genfromtxt(out / "lobes.csv", delimiter=",", names=True)
@@ -737,7 +768,8 @@ def test_cli_update_writes_files_and_report(tmp_path, capsys):
                       ("--max-cut-duration", "0"), ("--max-cut-duration", "1e5"), ("--audible-margin", "-0.1"),
                       ("--audible-margin", "0.9"), ("--boundary-width", "0"), ("--boundary-width", "0.9"),
                       ("--boundary-width", "nan"), ("--cut-speed-margin", "-0.1"), ("--cut-speed-margin", "0.6"),
-                      ("--cut-speed-margin", "nan")):
+                      ("--cut-speed-margin", "nan"), ("--next-speeds", "-1"), ("--next-speeds", "2.5"),
+                      ("--next-speeds", "51")):
         capsys.readouterr()
         assert main([*UPDATE_ZOA, "--prior", str(prior), "--cuts", str(cuts), "--out", str(tmp_path / "o6"),
                      f"{flag}={bad}"]) == 2, bad

@@ -83,8 +83,9 @@ cut**, two rules:
 
 * ``"info"`` (default): the cut that most reduces the expected log width ln(a₉₅/a₀₅) of the limit at
   the recommended speed, among cuts at the most productive speeds (the 6 best by n · a₅₀ and the
-  recommended one) and depths with P(chatter) ≤ ``risk`` (default 0.3): for each candidate the posterior after
-  "stable" and after "chatter" is the current samples reweighted by the cut's likelihood, and the expected
+  recommended one; ``next_speeds`` 0: the recommended one alone) and depths with P(chatter) ≤ ``risk``
+  (default 0.3): for each candidate the posterior after "stable" and after "chatter" is the current samples
+  reweighted by the cut's likelihood, and the expected
   width is P(stable) W_stable + P(chatter) W_chatter (+ ``chatter_cost`` × P(chatter), default 0). The
   log width, not (a₉₅ − a₀₅)/a₅₀: dividing by the median made a chatter outcome (lower median) look wider
   than it is and pushed the rule to creep up from below. Above a stable cut a_s the risk bound alone creeps
@@ -961,7 +962,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
            growth_error: tuple | None = GROWTH_ERROR, ring_error: tuple | None = RING_ERROR,
            precursor: tuple | None = PRECURSOR, own_sdm: bool = True, growth_by: str = "zoa",
            own_pocket: int = POCKET_SPEEDS, band_noise: bool = True,
-           noisy_pocket: float | None = NOISY_POCKET, cut_speed_margin: float = 0.0) -> Posterior:
+           noisy_pocket: float | None = NOISY_POCKET, cut_speed_margin: float = 0.0,
+           next_speeds: int = 6) -> Posterior:
     """Posterior of the tool's modal parameters and K_t from test cuts; lobes, P(stable), the next cut.
 
     Parameters
@@ -1238,6 +1240,16 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         cuts for 10 and 11 of 20 truths against 7 and 8 in the whole loop (490–529), at the same safety, but for 8 of
         20 fresh truths (530–549; the default 9) (``docs/design/shop.md``, *The
         recommended speed held at a cut speed*). 0: the most productive speed, as before 2026-12-07.
+    next_speeds : int, default 6
+        The ``"info"`` rule's speeds: the next cut is at the recommended speed or at one of the ``next_speeds`` most
+        productive by n · a₅₀; 0: at the recommended speed only. A cut at a neighbouring speed tells the limit at the
+        recommended speed only through the lobes' slope between the two, and on a lobe's steep side that slope is
+        what the posterior knows least: in EM16-50's whole loop a cut 18 % deeper than a stable one, at a speed 0.6 %
+        away, chattered at 1.15 × the limit there, the truth's limit 11 % lower at that speed. With ``cut_speed_margin``
+        0.03 as well, EM16-50 converged within 6 cuts for 11 of 20 truths 490–509 (default 7) but 9 of 20 fresh
+        530–549 (default 9), EM12-60 for 15 of 20 (the default 15 and 11 in two Python environments), its
+        recommended depth above the truth after 8 of 120 updates (the default 5 and 6): an option, not the default
+        (``docs/design/shop.md``, *The next cut at the recommended speed*).
 
     Returns
     -------
@@ -1283,6 +1295,8 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
     if not (math.isfinite(cut_speed_margin) and 0 <= cut_speed_margin <= 0.5):
         raise InputError(f"must be in [0, 0.5] (a share of the removal rate), got {cut_speed_margin}",
                          field="cut_speed_margin")
+    if isinstance(next_speeds, bool) or not isinstance(next_speeds, (int, np.integer)) or not 0 <= next_speeds <= 50:
+        raise InputError(f"must be a whole number in [0, 50], got {next_speeds!r}", field="next_speeds")
     if not (math.isfinite(freq_sigma) and 0 < freq_sigma <= 0.5):
         raise InputError(f"must be in (0, 0.5] (relative), got {freq_sigma}", field="freq_sigma")
     if not 0 < freq_outlier <= 1:
@@ -1510,7 +1524,7 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         # that at a pocket's top may be chatter unheard (noisy_pocket; EM25-55 climbed its pocket to 1.4 × the limit)
         step = 0.0 if "noisy_pocket" in kw else min_step
         nxt = _next_info(lim, grid, j, bound, boundary_width, label_noise, chatter_cost, cuts, step, miss_rate,
-                         offset, skip_repeats, creep_span, step_until_chatter)
+                         offset, skip_repeats, creep_span, step_until_chatter, next_speeds)
     if forward == "sdm":
         # the recommended depth checked by the own SDM limits of posterior samples that the choice of its speed did
         # not see: the lobe samples' tail is light at the speed where they look most productive (their own 5 %
@@ -2390,7 +2404,7 @@ def _median_ratio(q50, grid, k, rpm) -> float:
 
 
 def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), min_step=0.0, miss_rate=0.0,
-               offset=None, skip_repeats=False, creep_span=0.005, step_until_chatter=False):
+               offset=None, skip_repeats=False, creep_span=0.005, step_until_chatter=False, n_speeds=6):
     """The ``"info"`` rule: min expected relative band width at the recommended speed, P(chatter) ≤ risk —
     or a step of ``min_step`` (log) above the highest stable cut near that speed (±``creep_span``, depths moved
     by the posterior median's ratio), where the risk bound stops short of it: while no cut has chattered
@@ -2407,7 +2421,7 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
 
     q50 = np.quantile(lim, 0.5, axis=0)
     score = np.where(np.isfinite(q50), grid * q50, -np.inf)
-    speeds = np.unique(np.r_[np.argsort(-score)[:6], j_rec])
+    speeds = np.unique(np.r_[np.argsort(-score)[:n_speeds], j_rec]).astype(int)
     off = offset(speeds)  # (S, len(speeds)): one call for all the candidate speeds
     levels = np.linspace(0.02, risk, 12)
     target = lim[:, j_rec]
@@ -2459,7 +2473,7 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
                          i >= n_capped))
     if not cand:  # every candidate repeats a known outcome (skip_repeats): as without the skip, and said
         out = _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost, cuts, min_step, miss_rate, offset,
-                         creep_span=creep_span, step_until_chatter=step_until_chatter)
+                         creep_span=creep_span, step_until_chatter=step_until_chatter, n_speeds=n_speeds)
         out["description"] += " (every such cut repeats one already made at its speed: this one too)"
         return dict(out, repeat=True)
     cand = [c for c in cand if c[4] <= risk + 1e-9 or c[5]] or cand
@@ -2468,7 +2482,8 @@ def _next_info(lim, grid, j_rec, risk, width, eps, chatter_cost=0.0, cuts=(), mi
     return {"rule": "info", "risk": risk, "rpm": float(grid[k]), "depth_m": d, "p_chatter": pc,
             "expected_log_width": e, "log_width_now": now, "stepped": bool(stepped), "repeat": False,
             "description": "the cut that most reduces the expected relative 5–95 % width of the limit at the "
-                           f"recommended speed, among productive speeds, with P(chatter) ≤ {risk:g}"
+                           "recommended speed, " + ("at that speed" if n_speeds == 0 else "among productive speeds")
+                           + f", with P(chatter) ≤ {risk:g}"
                            + ((f" or, until a cut chatters near its speed, a step of ×{math.exp(min_step):.3f} "
                                "above the highest stable cut there" if step_until_chatter == "near" else
                                f" or, until the first chatter, a step of ×{math.exp(min_step):.3f} above the "
