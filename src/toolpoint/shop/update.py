@@ -1237,9 +1237,10 @@ def update(prior: ModalPrior, cuts, *, rng: np.random.Generator, n_samples: int 
         rising side the best then moves one grid speed (0.5 %) up, to a speed with no cut, each update — and the
         ``"info"`` rule, which narrows the band at the recommended speed, follows it instead of bracketing the
         limit at one speed. With 0.03 (removal rate at most 3 % below the band's best) EM16-50 converged within 6
-        cuts for 10 and 11 of 20 truths against 7 and 8 in the whole loop (490–529), at the same safety, but for 8 of
-        20 fresh truths (530–549; the default 9) (``docs/design/shop.md``, *The
-        recommended speed held at a cut speed*). 0: the most productive speed, as before 2026-12-07.
+        cuts for 10 and 11 of 20 truths against 7 and 8 in the whole loop (490–529; the default's runs in an earlier
+        Python environment, where a rerun moves up to 4 of 20), at the same safety, but for 8 of 20 fresh truths
+        (530–549; the default 9, the same environment) (``docs/design/shop.md``, *The recommended speed held at a cut
+        speed*). 0: the most productive speed, as before 2026-12-07.
     next_speeds : int, default 6
         The ``"info"`` rule's speeds: the next cut is at the recommended speed or at one of the ``next_speeds`` most
         productive by n · a₅₀; 0: at the recommended speed only. A cut at a neighbouring speed tells the limit at the
