@@ -63,7 +63,9 @@ CPU time (time.process_time), not wall time: the machine is shared.
    truth's SDM limit at one speed exactly (no simulation, no detector: an oracle's labels), with the label model and
    with exact labels — the floor the label offset sets on the loop's width target, however well the cuts are placed.
 8. ``prior-pocket``: the prior's band (``update`` with no cut) near its recommended speed, where the first cuts go,
-   against the SDM limits of 400 truths drawn from the prior: the share below its 5 % and above its 95 % line.
+   against the SDM limits of 400 truths drawn from the prior: the share below its 5 % and above its 95 % line; and
+   the truths' SDM limits' 5–95 % range there against their zero-order limits' (the whole loop's prior width against
+   the zero-order shop's).
 9. ``exact`` (only when asked; ``--seeds`` truths from ``--seed-start``, ``--cases``): ``update``'s SDM-path
    posterior against an exact-likelihood SMC (each sample's own SDM limit at the cut speeds) on the ``sdm`` shop with
    δ = G = 0 — what its approximations cost in coverage, against the 0.90 an exact posterior holds on average.
@@ -956,7 +958,9 @@ def bench_heard(cases, library_prior=None, truths=12, seed_start=60):
 def bench_prior_pocket(cases, library_prior=None, truths=400, seed=123):
     """The prior's band (``update`` with no cut, ``forward="sdm"``, defaults) at the recommended speed and every third
     grid speed within ±3 % of it — where the first cuts go — against the SDM limits of ``truths`` tools drawn from
-    the same prior (their own rng): the share below the band's 5 % and above its 95 % (each claims 0.05)."""
+    the same prior (their own rng): the share below the band's 5 % and above its 95 % (each claims 0.05); and how
+    widely the truths' SDM limits spread there against their zero-order limits (the whole loop's truth is the SDM's,
+    the zero-order shop's the zero-order one: a wider spread is a wider prior for the cuts to narrow)."""
     from toolpoint.shop.model import sdm_limits
 
     print(f"\n## prior-pocket: the prior's 5-95 % band near the recommended speed against {truths} truths' SDM limits")
@@ -969,15 +973,24 @@ def bench_prior_pocket(cases, library_prior=None, truths=400, seed=123):
         sel = np.where(np.abs(post.rpm / post.rpm[j] - 1) <= 0.03)[0][::3]
         th = pr.theta(np.random.default_rng(seed).standard_normal((truths, pr.sigma.size)) * (pr.sigma > 0))
         lims = np.array([sdm_limits(pr, t, post.rpm[sel])[0] for t in th])  # (truths, speeds), m
+        zoa = limit_at_speeds(pr, th, post.rpm[sel])[0]  # the same truths' zero-order limits
         q = post.limit_q_m[:, sel]
         tq = np.quantile(lims, [0.05, 0.5, 0.95], axis=0)
+        zq = np.quantile(zoa, [0.05, 0.5, 0.95], axis=0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lr = np.log(lims / zoa)
         print(f"{pr.name[:40]:40s} recommended {post.recommended['rpm']:.0f} rpm; speeds "
               + " ".join(f"{r:.0f}" for r in post.rpm[sel]) + "; below the 5 %: "
               + " ".join(f"{v:.3f}" for v in (lims < q[0]).mean(0)) + "; above the 95 %: "
               + " ".join(f"{v:.3f}" for v in (lims > q[2]).mean(0)) + " (each claims 0.05); band 5/50/95 % "
               + " ".join("/".join(f"{1e3 * v:.2f}" for v in q[:, k]) for k in range(sel.size))
               + " mm; truths' " + " ".join("/".join(f"{1e3 * v:.2f}" for v in tq[:, k]) for k in range(sel.size))
-              + f" mm; {time.process_time() - c0:.0f} s CPU", flush=True)
+              + " mm; the truths' 5-95 % range over their median, SDM limit / zero-order limit: "
+              + " ".join(f"{(tq[2, k] - tq[0, k]) / tq[1, k]:.2f}/{(zq[2, k] - zq[0, k]) / zq[1, k]:.2f}"
+                         for k in range(sel.size))
+              + "; ln(SDM / zero-order) mean/sd " + " ".join(
+                  f"{np.nanmean(lr[:, k]):.3f}/{np.nanstd(lr[:, k]):.3f}" for k in range(sel.size))
+              + f"; {time.process_time() - c0:.0f} s CPU", flush=True)
 
 
 def bench_exact(cases, library_prior=None, truths=20, seed_start=250, particles=400, band_samples=100):
